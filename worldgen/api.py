@@ -1,0 +1,76 @@
+"""The public entry point: parameters and a seed in, a checked World out.
+
+    params + seed -> generator -> Scene -> feasibility -> World (exporters on demand)
+
+The seed becomes a ``numpy.random.Generator`` here and nowhere else. Attempt
+``k`` draws from ``SeedSequence(seed, spawn_key=(k,))``, so a world never
+depends on how many attempts a caller allowed, only on which one succeeded.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from typing import Any
+
+import numpy as np
+
+from worldgen import feasibility
+from worldgen.errors import InfeasibleError, ParameterError
+from worldgen.generators import get, robot_from_params
+from worldgen.world import World
+
+__all__ = ["generate", "attempt_rng", "MAX_SEED"]
+
+MAX_SEED = 2**63 - 1
+
+
+def attempt_rng(seed: int, attempt: int) -> np.random.Generator:
+    """The RNG of draw number ``attempt`` (0-based) for ``seed``."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(attempt,)))
+
+
+def check_seed(seed: Any) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
+        raise ParameterError(f"parameter 'seed' must be an integer in [0, {MAX_SEED}], got {seed!r}")
+    return int(seed)
+
+
+def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **params: Any) -> World:
+    """Generate, check and return one world; no disk I/O.
+
+    Raises :class:`~worldgen.errors.ParameterError` for bad parameters and
+    :class:`~worldgen.errors.InfeasibleError` when ``max_attempts`` draws all
+    failed a check. With ``allow_infeasible`` the last failed draw that has a
+    scene is returned instead, its ``feasibility`` saying why (for negative tests).
+    """
+    spec = get(name)
+    seed = check_seed(seed)
+    resolved = spec.resolve(params)
+    robot = robot_from_params(resolved)
+    failures: Counter[str] = Counter()
+    details: dict[str, str] = {}
+    last = None
+    budget = resolved["max_attempts"]
+    for attempt in range(budget):
+        draft = spec.build(resolved, attempt_rng(seed, attempt))
+        if draft.rejected:
+            failures[draft.rejected] += 1
+            details.setdefault(draft.rejected, draft.detail)
+            continue
+        report = feasibility.check(draft.scene, draft.tasks, robot)
+        world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1)
+        if report.feasible:
+            return world
+        for failed in report.failed():
+            failures[failed.name] += 1
+            details.setdefault(failed.name, failed.detail)
+        last = world
+    if allow_infeasible and last is not None:
+        return last
+    summary = ", ".join(f"{check} failed {count}x" for check, count in sorted(failures.items()))
+    first = sorted(failures)[0] if failures else None
+    hint = f" (first {first}: {details[first]})" if first and details.get(first) else ""
+    raise InfeasibleError(
+        f"no feasible '{name}' world for seed {seed} within max_attempts={budget}: {summary}{hint}",
+        dict(failures),
+    )

@@ -1,0 +1,128 @@
+"""2-D footprints of a scene's colliders, as a robot on the floor meets them.
+
+The robot is a vertical cylinder standing on the floor, so what matters of an
+obstacle is its shadow on the floor, for the part of it below the robot's top.
+Upright cylinders and spheres keep an exact disc (a polygon would cut corners
+and under-report distances); everything else becomes a convex polygon that
+contains the shape's projection (exact for boxes that are only yawed).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+import shapely
+
+from worldgen.scene import Scene
+
+__all__ = ["Footprint", "FootprintIndex", "scene_footprints", "distances_to"]
+
+_VERTICAL = 1e-9
+
+
+@dataclass(frozen=True, eq=False)
+class Footprint:
+    """The floor shadow of one node: a disc (centre, radius) or a convex polygon."""
+
+    name: str
+    role: str
+    polygon: Optional[shapely.Polygon] = None
+    centre: Optional[tuple[float, float]] = None
+    radius: float = 0.0
+
+    @property
+    def is_disc(self) -> bool:
+        return self.polygon is None
+
+    def bounds(self) -> tuple[float, float, float, float]:
+        """(minx, miny, maxx, maxy)."""
+        if self.is_disc:
+            cx, cy = self.centre
+            return (cx - self.radius, cy - self.radius, cx + self.radius, cy + self.radius)
+        return tuple(self.polygon.bounds)
+
+    def distance(self, xy: np.ndarray) -> np.ndarray:
+        """(n,) distance from each of the (n, 2) points to this footprint, 0 inside."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        if self.is_disc:
+            return np.maximum(np.hypot(xy[:, 0] - self.centre[0], xy[:, 1] - self.centre[1]) - self.radius, 0.0)
+        return shapely.distance(self.polygon, shapely.points(xy))
+
+
+def scene_footprints(scene: Scene, height: float) -> list[Footprint]:
+    """Footprints of every collider that reaches into the slab 0 < z < ``height``."""
+    out = []
+    for node in scene.colliders():
+        lo, hi = scene.aabb(node.name)
+        if hi[2] <= 1e-9 or lo[2] >= height:
+            continue
+        m = scene.world_matrix(node.name)
+        shape = node.shape
+        upright = abs(abs(m[2, 2]) - 1.0) < _VERTICAL
+        if shape.kind == "sphere" or (shape.kind == "cylinder" and upright):
+            radius = shape.radius
+            if shape.kind == "sphere":
+                # The widest slice inside the slab: the equator, unless it lies outside it.
+                zc = m[2, 3]
+                dz = 0.0 if 0.0 <= zc <= height else min(abs(zc), abs(zc - height))
+                radius = float(np.sqrt(max(shape.radius**2 - dz**2, 0.0)))
+            out.append(Footprint(node.name, node.role, centre=(float(m[0, 3]), float(m[1, 3])), radius=radius))
+            continue
+        if shape.kind == "mesh":
+            pts = shape.scaled_vertices() @ m[:3, :3].T + m[:3, 3]
+        elif shape.kind == "cylinder":
+            # A tilted cylinder: the hull of its two end circles, sampled finely and pushed out
+            # so the polygon contains the true shadow.
+            ang = np.linspace(0, 2 * np.pi, 64, endpoint=False)
+            r_out = shape.radius / np.cos(np.pi / 64)
+            ring = np.stack([r_out * np.cos(ang), r_out * np.sin(ang)], axis=1)
+            local = np.concatenate([np.c_[ring, np.full(64, z)] for z in (-shape.length / 2, shape.length / 2)])
+            pts = local @ m[:3, :3].T + m[:3, 3]
+        else:
+            pts = shape.local_corners() @ m[:3, :3].T + m[:3, 3]
+        hull = shapely.MultiPoint(pts[:, :2]).convex_hull
+        if hull.geom_type != "Polygon":  # a degenerate (flat) shadow still blocks
+            hull = hull.buffer(1e-6)
+        out.append(Footprint(node.name, node.role, polygon=hull))
+    return out
+
+
+def distances_to(footprints: list[Footprint], xy: np.ndarray) -> np.ndarray:
+    """(n,) distance from each of the (n, 2) points to the nearest footprint (inf if none)."""
+    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+    best = np.full(len(xy), np.inf)
+    for fp in footprints:
+        np.minimum(best, fp.distance(xy), out=best)
+    return best
+
+
+class FootprintIndex:
+    """Nearest-footprint distances for many points at once.
+
+    Discs are kept as arrays, polygons in a shapely STRtree, so a query costs
+    one vectorised pass however many obstacles there are.
+    """
+
+    def __init__(self, footprints: list[Footprint]):
+        self.footprints = list(footprints)
+        discs = [f for f in self.footprints if f.is_disc]
+        self._disc_xy = np.array([f.centre for f in discs], dtype=float).reshape(-1, 2)
+        self._disc_r = np.array([f.radius for f in discs], dtype=float)
+        self._polygons = [f.polygon for f in self.footprints if not f.is_disc]
+        self._tree = shapely.STRtree(self._polygons) if self._polygons else None
+
+    def distance(self, xy: np.ndarray) -> np.ndarray:
+        """(n,) distance from each of the (n, 2) points to the nearest footprint, 0 inside."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        best = np.full(len(xy), np.inf)
+        if len(self._disc_r):
+            d = np.hypot(xy[:, None, 0] - self._disc_xy[None, :, 0], xy[:, None, 1] - self._disc_xy[None, :, 1])
+            best = np.minimum(best, np.maximum(d - self._disc_r[None, :], 0.0).min(axis=1))
+        if self._tree is not None and len(xy):
+            (ipt, _), dist = self._tree.query_nearest(shapely.points(xy), return_distance=True, all_matches=False)
+            poly_best = np.full(len(xy), np.inf)
+            np.minimum.at(poly_best, ipt, dist)
+            best = np.minimum(best, poly_best)
+        return best

@@ -1,0 +1,61 @@
+"""What a generator is: a name, its parameters, and a pure build function."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping, Optional
+
+import numpy as np
+
+from worldgen.params import COMMON_PARAMS, Param, validate_params
+from worldgen.scene import Robot, Scene, Task
+
+__all__ = ["Draft", "GeneratorSpec", "robot_from_params"]
+
+
+@dataclass(frozen=True)
+class Draft:
+    """One draw of a generator: a scene and its tasks, not yet checked for feasibility.
+
+    ``rejected`` names the check a draw failed on the generator's side (e.g. the
+    obstacles did not fit); the pipeline counts it like a failed feasibility check.
+    """
+
+    scene: Optional[Scene]
+    tasks: tuple[Task, ...] = ()
+    rejected: Optional[str] = None
+    detail: str = ""
+
+
+@dataclass(frozen=True)
+class GeneratorSpec:
+    """A registered generator.
+
+    ``build(params, rng)`` must be a pure function of the validated parameters and
+    the ``numpy.random.Generator``; ``check(params)`` may reject combinations of
+    parameters (raising :class:`~worldgen.errors.ParameterError`).
+    """
+
+    name: str
+    summary: str
+    params: tuple[Param, ...]
+    build: Callable[[Mapping[str, Any], np.random.Generator], Draft]
+    check: Optional[Callable[[Mapping[str, Any]], None]] = None
+    examples: tuple[str, ...] = field(default=())
+
+    @property
+    def all_params(self) -> tuple[Param, ...]:
+        """The generator's own parameters plus the common ones, by name."""
+        own = {p.name for p in self.params}
+        return tuple(sorted(self.params + tuple(p for p in COMMON_PARAMS if p.name not in own), key=lambda p: p.name))
+
+    def resolve(self, given: Mapping[str, Any]) -> dict[str, Any]:
+        """Validated parameters with every default filled in."""
+        resolved = validate_params(self.all_params, given)
+        if self.check is not None:
+            self.check(resolved)
+        return resolved
+
+
+def robot_from_params(params: Mapping[str, Any]) -> Robot:
+    return Robot(params["robot_radius"], params["robot_height"], params["clearance"])

@@ -1,0 +1,198 @@
+"""``cluttered``: a rectangular room with static boxes and cylinders scattered on the floor.
+
+The classic random-obstacle world of navigation tests and DRL training: the
+room, then ``n_obstacles`` obstacles (or ``density`` per square metre) placed
+uniformly with at least ``min_gap`` between any two, then spawn/goal pairs on
+free floor. Obstacles and tasks draw from separate RNG streams, so asking for
+more tasks does not move a single obstacle.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+import shapely
+
+from worldgen.errors import ParameterError
+from worldgen.floats import round_float
+from worldgen.footprint import FootprintIndex, scene_footprints
+from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
+from worldgen.generators.registry import register
+from worldgen.generators.room import floor_node, room_bounds, wall_nodes
+from worldgen.generators.tasks import sample_tasks
+from worldgen.params import Param
+from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene
+
+__all__ = ["SPEC", "build"]
+
+#: Tries to place one obstacle before the draw counts as overcrowded.
+PLACEMENT_TRIES = 60
+#: Density of obstacles (kg/m^3) for their nominal mass: static, but inertia must be valid.
+OBSTACLE_DENSITY = 300.0
+
+BOX_RGBA = (0.80, 0.52, 0.25, 1.0)
+CYLINDER_RGBA = (0.25, 0.50, 0.75, 1.0)
+
+PARAMS = (
+    Param("size", "pair", [10.0, 10.0], "inner extents (x, y) of the room, centred on the origin", 1.0, 500.0, unit="m"),
+    Param("n_obstacles", "int", 20, "number of obstacles (ignored when density is set)", 0, 5000),
+    Param("density", "float", None, "obstacles per square metre of floor; replaces n_obstacles when set",
+          0.0, 5.0, optional=True, unit="1/m^2"),
+    Param("obstacle_shapes", "choice", "mixed", "which obstacle shapes to draw", choices=("box", "cylinder", "mixed")),
+    Param("box_size", "range", [0.3, 1.0], "range of each box side length (x and y drawn separately)", 0.01, 50.0, unit="m"),
+    Param("cylinder_radius", "range", [0.1, 0.4], "range of cylinder radii", 0.01, 25.0, unit="m"),
+    Param("obstacle_height", "range", [0.5, 1.5], "range of obstacle heights", 0.01, 50.0, unit="m"),
+    Param("random_yaw", "bool", True, "turn each box by a random yaw"),
+    Param("min_gap", "float", 0.1, "smallest distance between any two obstacles", 0.0, 50.0, unit="m"),
+    Param("walls", "bool", True, "surround the room with walls"),
+    Param("wall_height", "float", 1.0, "height of the walls", 0.05, 50.0, unit="m"),
+    Param("wall_thickness", "float", 0.1, "thickness of the walls", 0.01, 10.0, unit="m"),
+    Param("min_spawn_goal_distance", "float", 3.0, "smallest straight-line distance from spawn to goal", 0.0, 1000.0, unit="m"),
+)
+
+
+def check(params: Mapping[str, Any]) -> None:
+    """Reject parameter combinations no draw could satisfy."""
+    sx, sy = params["size"]
+    inflation = params["robot_radius"] + params["clearance"]
+    if min(sx, sy) <= 2 * inflation:
+        raise ParameterError(
+            f"parameter 'size' must exceed 2 x (robot_radius + clearance) = {2 * inflation:g} m on both axes, got {params['size']!r}"
+        )
+    reach = math.hypot(sx - 2 * inflation, sy - 2 * inflation)
+    if params["min_spawn_goal_distance"] > reach:
+        raise ParameterError(
+            f"parameter 'min_spawn_goal_distance' must be in [0, {reach:.3f}] for this room and robot "
+            f"(the usable diagonal), got {params['min_spawn_goal_distance']!r}"
+        )
+
+
+def obstacle_count(params: Mapping[str, Any]) -> int:
+    if params["density"] is not None:
+        sx, sy = params["size"]
+        return int(round(params["density"] * sx * sy))
+    return params["n_obstacles"]
+
+
+def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
+    obstacle_rng, task_rng = rng.spawn(2)
+    size = params["size"]
+    bounds = room_bounds(size)
+    friction = params["friction"]
+    nodes = [floor_node(size, params["wall_thickness"] if params["walls"] else 0.5, friction)]
+    if params["walls"]:
+        nodes += wall_nodes(size, params["wall_height"], params["wall_thickness"], friction)
+    obstacles = _place_obstacles(params, obstacle_rng, bounds, obstacle_count(params))
+    if obstacles is None:
+        return Draft(None, rejected="obstacle_placement",
+                     detail=f"could not place {obstacle_count(params)} obstacles with min_gap {params['min_gap']:g} m")
+    nodes += obstacles
+    scene = Scene(tuple(nodes), (), bounds, Physics(params["step_size"], params["real_time_factor"]))
+    robot = robot_from_params(params)
+    index = FootprintIndex(scene_footprints(scene, robot.height))
+    tasks, reason = sample_tasks(task_rng, index, bounds, robot, params["n_tasks"],
+                                 params["min_spawn_goal_distance"], params["goal_tolerance"])
+    if reason:
+        return Draft(scene, rejected="task_placement", detail=reason)
+    return Draft(scene, tuple(tasks))
+
+
+def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
+    """Obstacle nodes placed with the minimum gap, or None when the room is too full."""
+    (x0, y0), (x1, y1) = bounds
+    gap = params["min_gap"]
+    shapes = params["obstacle_shapes"]
+    width = len(str(max(count - 1, 0)))
+    placed: list[tuple[float, float, float, object]] = []  # (x, y, bounding radius, exact footprint)
+    grid: dict[tuple[int, int], list[int]] = {}
+    max_reach = max(math.hypot(*[params["box_size"][1]] * 2) / 2, params["cylinder_radius"][1])
+    cell = 2 * max_reach + gap
+    nodes = []
+    for i in range(count):
+        kind = shapes if shapes != "mixed" else ("box" if rng.random() < 0.5 else "cylinder")
+        height = round_float(rng.uniform(*params["obstacle_height"]))
+        if kind == "box":
+            sx, sy = (round_float(v) for v in rng.uniform(*params["box_size"], size=2))
+            yaw = round_float(rng.uniform(-math.pi, math.pi)) if params["random_yaw"] else 0.0
+            reach = math.hypot(sx, sy) / 2
+            shape = Box((sx, sy, height))
+        else:
+            r = round_float(rng.uniform(*params["cylinder_radius"]))
+            yaw, reach = 0.0, r
+            shape = Cylinder(r, height)
+        for _ in range(PLACEMENT_TRIES):
+            x = round_float(rng.uniform(x0, x1))
+            y = round_float(rng.uniform(y0, y1))
+            exact = _footprint(kind, shape, x, y, yaw)
+            if not _inside(exact, bounds):
+                continue
+            if _clear_of_neighbours(x, y, reach, exact, gap, placed, grid, cell):
+                break
+        else:
+            return None
+        key = (int(math.floor(x / cell)), int(math.floor(y / cell)))
+        grid.setdefault(key, []).append(len(placed))
+        placed.append((x, y, reach, exact))
+        mat = Material("obstacle_box" if kind == "box" else "obstacle_cylinder",
+                       BOX_RGBA if kind == "box" else CYLINDER_RGBA, params["friction"])
+        nodes.append(Node(f"obstacle_{i:0{width}d}", "obstacle", shape, Pose(x, y, height / 2, 0.0, 0.0, yaw),
+                          mass=round_float(max(shape.volume() * OBSTACLE_DENSITY, 1e-3)), material=mat))
+    return nodes
+
+
+def _footprint(kind, shape, x, y, yaw):
+    if kind == "cylinder":
+        return ("disc", x, y, shape.radius)
+    c, s = math.cos(yaw), math.sin(yaw)
+    hx, hy = shape.size[0] / 2, shape.size[1] / 2
+    corners = [(x + c * px - s * py, y + s * px + c * py) for px, py in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
+    return ("polygon", shapely.Polygon(corners))
+
+
+def _inside(exact, bounds) -> bool:
+    (x0, y0), (x1, y1) = bounds
+    if exact[0] == "disc":
+        _, x, y, r = exact
+        return x0 + r <= x <= x1 - r and y0 + r <= y <= y1 - r
+    bx0, by0, bx1, by1 = exact[1].bounds
+    return bx0 >= x0 and by0 >= y0 and bx1 <= x1 and by1 <= y1
+
+
+def _distance(a, b) -> float:
+    if a[0] == "disc" and b[0] == "disc":
+        return math.hypot(a[1] - b[1], a[2] - b[2]) - a[3] - b[3]
+    if a[0] == "disc":
+        a, b = b, a
+    if b[0] == "disc":
+        return a[1].distance(shapely.Point(b[1], b[2])) - b[3]
+    return a[1].distance(b[1])
+
+
+def _clear_of_neighbours(x, y, reach, exact, gap, placed, grid, cell) -> bool:
+    cx, cy = int(math.floor(x / cell)), int(math.floor(y / cell))
+    for gx in (cx - 1, cx, cx + 1):
+        for gy in (cy - 1, cy, cy + 1):
+            for j in grid.get((gx, gy), ()):
+                px, py, preach, pexact = placed[j]
+                if math.hypot(x - px, y - py) >= reach + preach + gap:
+                    continue
+                if _distance(exact, pexact) < gap:
+                    return False
+    return True
+
+
+SPEC = register(
+    GeneratorSpec(
+        name="cluttered",
+        summary="a walled room with randomly placed static boxes and cylinders",
+        params=PARAMS,
+        build=build,
+        check=check,
+        examples=(
+            "worldgen generate cluttered --seed 7 --set size=20,20 --set n_obstacles=50 --out worlds",
+            "worldgen generate cluttered --set density=0.2 --set obstacle_shapes=box --count 10 --out worlds",
+        ),
+    )
+)

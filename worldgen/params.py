@@ -1,0 +1,166 @@
+"""Typed, range-checked generator parameters.
+
+Every generator declares its parameters as :class:`Param` objects; validation
+fills defaults and rejects unknown names, wrong types and out-of-range values
+with one message shape: the parameter, the rule, the value received.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping, Optional, Sequence
+
+from worldgen.errors import ParameterError
+
+__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "describe_range"]
+
+_KINDS = ("float", "int", "bool", "choice", "pair", "range")
+
+
+@dataclass(frozen=True)
+class Param:
+    """One parameter.
+
+    ``kind``:
+      - ``float`` / ``int``: a number in [low, high];
+      - ``bool``;
+      - ``choice``: one of ``choices``;
+      - ``pair``: two floats, each in [low, high] (e.g. ``size`` = x, y extents);
+      - ``range``: two floats lo <= hi, each in [low, high] (a size range to draw from).
+    ``default`` None means "unset" and is allowed only where ``optional``.
+    """
+
+    name: str
+    kind: str
+    default: Any
+    doc: str
+    low: Optional[float] = None
+    high: Optional[float] = None
+    choices: tuple = ()
+    optional: bool = False
+    unit: str = ""
+
+    def __post_init__(self):
+        assert self.kind in _KINDS, self.kind
+
+    def check(self, value: Any) -> Any:
+        """Return ``value`` normalised, or raise :class:`ParameterError`."""
+        if value is None:
+            if self.optional:
+                return None
+            raise self._error("is required", value)
+        if self.kind == "bool":
+            if isinstance(value, bool):
+                return value
+            raise self._error("must be true or false", value)
+        if self.kind == "choice":
+            if value in self.choices:
+                return value
+            raise self._error(f"must be one of {', '.join(map(str, self.choices))}", value)
+        if self.kind in ("float", "int"):
+            return self._number(value)
+        # pair / range
+        if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or len(value) != 2:
+            raise self._error(f"must be two numbers, each {describe_range(self)}", value)
+        a, b = (self._number(v, whole=False) for v in value)
+        if self.kind == "range" and a > b:
+            raise self._error("must be [min, max] with min <= max", value)
+        return [a, b]
+
+    def _number(self, value: Any, whole: bool | None = None) -> Any:
+        whole = self.kind == "int" if whole is None else whole
+        if isinstance(value, bool):
+            raise self._error(f"must be {'an integer' if whole else 'a number'} {describe_range(self)}", value)
+        try:
+            if whole:
+                if isinstance(value, float) and not value.is_integer():
+                    raise ValueError
+                number = int(value)
+            else:
+                number = float(value)
+        except (TypeError, ValueError, OverflowError):
+            raise self._error(f"must be {'an integer' if whole else 'a number'} {describe_range(self)}", value) from None
+        if not math.isfinite(number) or (self.low is not None and number < self.low) or (
+            self.high is not None and number > self.high
+        ):
+            raise self._error(f"must be {describe_range(self)}", value)
+        return number
+
+    def _error(self, rule: str, value: Any) -> ParameterError:
+        return ParameterError(f"parameter '{self.name}' {rule}, got {value!r}")
+
+
+def describe_range(p: Param) -> str:
+    """The allowed values of ``p`` in words, e.g. ``in [0, 2000]``."""
+    if p.kind == "choice":
+        return "one of " + ", ".join(map(str, p.choices))
+    if p.kind == "bool":
+        return "true or false"
+    lo = "-inf" if p.low is None else _num(p.low)
+    hi = "inf" if p.high is None else _num(p.high)
+    return f"in [{lo}, {hi}]"
+
+
+def _num(x: float) -> str:
+    return str(int(x)) if float(x).is_integer() else repr(float(x))
+
+
+def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[str, Any]:
+    """Defaults filled, every value checked, unknown names rejected; sorted by name."""
+    by_name = {p.name: p for p in specs}
+    unknown = sorted(set(given) - set(by_name))
+    if unknown:
+        raise ParameterError(
+            f"unknown parameter '{unknown[0]}'; known parameters: {', '.join(sorted(by_name))}"
+        )
+    resolved = {}
+    for name in sorted(by_name):
+        p = by_name[name]
+        resolved[name] = p.check(given.get(name, p.default))
+    return resolved
+
+
+def parse_value(p: Param, text: str) -> Any:
+    """Turn command-line text into a value for ``p`` (checked later by :meth:`Param.check`)."""
+    t = text.strip()
+    if p.kind == "bool":
+        low = t.lower()
+        if low in ("true", "yes", "1", "on"):
+            return True
+        if low in ("false", "no", "0", "off"):
+            return False
+        return t
+    if p.kind in ("pair", "range"):
+        parts = [s for s in t.replace("x", ",").replace(" ", ",").strip("[]()").split(",") if s]
+        return [_maybe_number(s) for s in parts]
+    if p.kind in ("float", "int"):
+        return _maybe_number(t)
+    if t.lower() in ("none", "null") and p.optional:
+        return None
+    return t
+
+
+def _maybe_number(s: str) -> Any:
+    try:
+        return int(s)
+    except ValueError:
+        try:
+            return float(s)
+        except ValueError:
+            return s
+
+
+#: Parameters every generator takes, under the same names, so users can guess them.
+COMMON_PARAMS: tuple[Param, ...] = (
+    Param("robot_radius", "float", 0.2, "radius of the robot footprint (a vertical cylinder)", 0.01, 5.0, unit="m"),
+    Param("robot_height", "float", 0.4, "height of the robot footprint", 0.01, 5.0, unit="m"),
+    Param("clearance", "float", 0.05, "margin kept between the footprint's edge and obstacles", 0.0, 2.0, unit="m"),
+    Param("max_attempts", "int", 50, "draws tried (each with a derived seed) before giving up", 1, 10000),
+    Param("n_tasks", "int", 1, "spawn/goal pairs per world", 1, 64),
+    Param("goal_tolerance", "float", 0.2, "distance from the goal that counts as reached", 0.01, 5.0, unit="m"),
+    Param("robot_speed", "float", 0.5, "speed assumed for each task's time_limit", 0.01, 20.0, unit="m/s"),
+    Param("friction", "float", 1.0, "Coulomb friction of every surface", 0.0, 10.0),
+    Param("step_size", "float", 0.002, "physics step in every format", 0.0001, 0.1, unit="s"),
+    Param("real_time_factor", "float", 1.0, "Gazebo real-time factor; 0 runs as fast as possible", 0.0, 1000.0),
+)

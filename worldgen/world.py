@@ -1,0 +1,199 @@
+"""A generated, checked world: its scene, tasks and feasibility report, exportable on demand."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import shutil
+import tempfile
+from functools import cached_property
+from pathlib import Path
+from typing import Any, Iterable, Mapping, Optional, Sequence
+
+from worldgen.errors import OutputError, ParameterError
+from worldgen.scene import Robot, Scene, Task
+
+__all__ = ["World", "FORMATS", "FILE_NAMES", "SDF_VERSIONS"]
+
+#: Every format a world can be written in, in the order they are written.
+FORMATS = ("sdf", "mjcf", "urdf")
+FILE_NAMES = {"sdf": "world.sdf", "mjcf": "world.mjcf.xml", "urdf": "world.urdf"}
+METADATA_NAME = "world.json"
+SDF_VERSIONS = ("1.9", "1.6")
+
+
+class World:
+    """One world. Nothing here touches the disk until :meth:`write`.
+
+    ``params`` holds every parameter resolved (defaults filled in), so
+    ``generate(generator, seed, **params)`` rebuilds exactly this world.
+    ``attempts`` is how many draws it took (1 = the first draw passed).
+    """
+
+    def __init__(self, generator: str, seed: int, params: Mapping[str, Any], scene: Scene,
+                 tasks: Sequence[Task], robot: Robot, feasibility, attempts: int):
+        self.generator = generator
+        self.seed = seed
+        self.params = dict(params)
+        self.scene = scene
+        self.tasks = tuple(tasks)
+        self.robot = robot
+        self.feasibility = feasibility
+        self.attempts = attempts
+        self.path: Optional[Path] = None  # the folder once written
+
+    def __repr__(self) -> str:
+        try:
+            return f"<World {self.world_id} feasible={self.feasibility.feasible}>"
+        except Exception:  # a repr must never raise
+            return f"<World {self.generator} seed={self.seed}>"
+
+    @cached_property
+    def content_hash(self) -> str:
+        return self.scene.content_hash()
+
+    @cached_property
+    def world_id(self) -> str:
+        """``<generator>-s<seed>-<8 hex of content_hash>``: stable and filesystem-safe."""
+        return f"{self.generator}-s{self.seed}-{self.content_hash.split(':', 1)[1][:8]}"
+
+    # -- in-memory exports -------------------------------------------------
+    def to_sdf(self, version: str = "1.9") -> str:
+        """The world as SDFormat ``version`` (1.9 for Gazebo Fortress-Harmonic, 1.6 for classic)."""
+        if version not in SDF_VERSIONS:
+            raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
+        from worldgen.export import sdf
+        return _text(sdf.to_sdf(self.scene, version=version, name=self.world_id))
+
+    def to_mjcf(self) -> str:
+        """The world as MJCF, loadable with ``mujoco.MjModel.from_xml_string``."""
+        from worldgen.export import mjcf
+        return _text(mjcf.to_mjcf(self.scene, name=self.world_id))
+
+    def to_urdf(self) -> str:
+        """The world as one URDF robot: a root link with every entity on a fixed joint."""
+        from worldgen.export import urdf
+        return _text(urdf.to_urdf(self.scene, name=self.world_id))
+
+    def export(self, fmt: str, sdf_version: str = "1.9") -> str:
+        if fmt == "sdf":
+            return self.to_sdf(sdf_version)
+        if fmt == "mjcf":
+            return self.to_mjcf()
+        if fmt == "urdf":
+            return self.to_urdf()
+        raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {fmt!r}")
+
+    def mesh_files(self) -> dict[str, bytes]:
+        """Mesh files the exported formats refer to: relative path -> bytes."""
+        from worldgen.export import meshes
+        return meshes.mesh_files(self.scene)
+
+    def metadata_for(self, files: Mapping[str, tuple[str, bytes]]) -> dict:
+        """world.json as a dict, for the given ``{key: (relative path, bytes)}`` files."""
+        from worldgen.export import metadata
+        return metadata.build(self, {k: (p, hashlib.sha256(b).hexdigest()) for k, (p, b) in files.items()})
+
+    def rendered_files(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> dict[str, tuple[str, bytes]]:
+        """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
+        formats = normalise_formats(formats)
+        files = {fmt: (FILE_NAMES[fmt], self.export(fmt, sdf_version).encode()) for fmt in formats}
+        if "sdf" in formats or "urdf" in formats:
+            for rel, data in self.mesh_files().items():
+                files[f"mesh:{rel}"] = (rel, data)
+        return files
+
+    @cached_property
+    def metadata(self) -> dict:
+        """world.json of this world written in every format (SDF 1.9)."""
+        return self.metadata_for(self.rendered_files())
+
+    def to_json(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> str:
+        from worldgen.export import metadata
+        return metadata.dumps(self.metadata_for(self.rendered_files(formats, sdf_version)))
+
+    # -- disk --------------------------------------------------------------
+    def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> Path:
+        """Write ``out_dir/<world_id>/`` (the world's files and world.json); return that folder.
+
+        The folder appears complete or not at all: files are written into a
+        temporary folder beside it, which is then renamed into place.
+        """
+        from worldgen.export import metadata
+
+        files = self.rendered_files(formats, sdf_version)
+        meta = self.metadata_for(files)
+        blobs = {path: data for path, data in files.values()}
+        blobs[METADATA_NAME] = metadata.dumps(meta).encode()
+        target = write_folder_atomically(Path(out_dir), self.world_id, blobs)
+        self.path = target
+        return target
+
+    def file(self, fmt: str) -> Path:
+        """Path of a written file (``sdf``, ``mjcf``, ``urdf`` or ``json``)."""
+        if self.path is None:
+            raise OutputError("this world has not been written yet; call World.write(folder) first")
+        return self.path / (METADATA_NAME if fmt == "json" else FILE_NAMES[fmt])
+
+
+def normalise_formats(formats: Iterable[str]) -> tuple[str, ...]:
+    if isinstance(formats, str):
+        formats = [f for f in formats.split(",") if f.strip()]
+    chosen = [f.strip().lower() for f in formats]
+    for f in chosen:
+        if f not in FORMATS:
+            raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {f!r}")
+    if not chosen:
+        raise ParameterError(f"parameter 'formats' must name at least one of {', '.join(FORMATS)}, got nothing")
+    return tuple(f for f in FORMATS if f in chosen)
+
+
+def _text(tree) -> str:
+    from worldgen.export.xml import to_bytes
+    return to_bytes(tree).decode()
+
+
+def _safe_relative(rel: str) -> str:
+    parts = Path(rel).parts
+    if Path(rel).is_absolute() or ".." in parts or not parts:
+        raise OutputError(f"refusing to write {rel!r} outside the world folder")
+    return rel
+
+
+def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]) -> Path:
+    """Write ``blobs`` (relative path -> bytes) as ``out_dir/name``; complete or absent."""
+    if "/" in name or name in ("", ".", ".."):
+        raise OutputError(f"refusing folder name {name!r}")
+    try:
+        out_dir.mkdir(parents=True, exist_ok=True)
+        if not out_dir.is_dir():
+            raise OutputError(f"output folder '{out_dir}' is not a folder")
+        tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".tmp", dir=out_dir))
+    except OutputError:
+        raise
+    except OSError as exc:
+        raise OutputError(f"cannot write to output folder '{out_dir}': {exc.strerror or exc}") from None
+    target = out_dir / name
+    try:
+        for rel, data in sorted(blobs.items()):
+            path = tmp / _safe_relative(rel)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with open(path, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        os.chmod(tmp, 0o755)
+        if target.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=out_dir))
+            os.rename(target, old / "w")
+            os.rename(tmp, target)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.rename(tmp, target)
+    except OSError as exc:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise OutputError(f"cannot write world folder '{target}': {exc.strerror or exc}") from None
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return target
