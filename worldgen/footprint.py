@@ -9,6 +9,7 @@ contains the shape's projection (exact for boxes that are only yawed).
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Optional
 
@@ -51,21 +52,35 @@ class Footprint:
         return shapely.distance(self.polygon, shapely.points(xy))
 
 
+_CACHE: "weakref.WeakKeyDictionary[Scene, dict[float, list[Footprint]]]" = weakref.WeakKeyDictionary()
+
+
 def scene_footprints(scene: Scene, height: float) -> list[Footprint]:
-    """Footprints of every collider that reaches into the slab 0 < z < ``height``."""
+    """Footprints of every collider that reaches into the slab 0 < z < ``height``.
+
+    Scenes are immutable, so the result is remembered per scene and height: the
+    generator and the feasibility check ask for the same footprints.
+    """
+    per_scene = _CACHE.setdefault(scene, {})
+    if height not in per_scene:
+        per_scene[height] = _footprints(scene, height)
+    return list(per_scene[height])
+
+
+def _footprints(scene: Scene, height: float) -> list[Footprint]:
     out = []
     for node in scene.colliders():
-        lo, hi = scene.aabb(node.name)
-        if hi[2] <= 1e-9 or lo[2] >= height:
-            continue
         m = scene.world_matrix(node.name)
         shape = node.shape
         upright = abs(abs(m[2, 2]) - 1.0) < _VERTICAL
         if shape.kind == "sphere" or (shape.kind == "cylinder" and upright):
+            zc = m[2, 3]
+            half = shape.radius if shape.kind == "sphere" else shape.length / 2
+            if zc + half <= 1e-9 or zc - half >= height:
+                continue
             radius = shape.radius
             if shape.kind == "sphere":
                 # The widest slice inside the slab: the equator, unless it lies outside it.
-                zc = m[2, 3]
                 dz = 0.0 if 0.0 <= zc <= height else min(abs(zc), abs(zc - height))
                 radius = float(np.sqrt(max(shape.radius**2 - dz**2, 0.0)))
             out.append(Footprint(node.name, node.role, centre=(float(m[0, 3]), float(m[1, 3])), radius=radius))
@@ -82,7 +97,14 @@ def scene_footprints(scene: Scene, height: float) -> list[Footprint]:
             pts = local @ m[:3, :3].T + m[:3, 3]
         else:
             pts = shape.local_corners() @ m[:3, :3].T + m[:3, 3]
-        hull = shapely.MultiPoint(pts[:, :2]).convex_hull
+        if pts[:, 2].max() <= 1e-9 or pts[:, 2].min() >= height:
+            continue
+        if shape.kind == "box" and upright:
+            # local_corners() lists (-,-,-), (-,-,+), (-,+,-), (-,+,+), (+,-,-), ...: the bottom
+            # face, in order around the rectangle, is corners 0, 2, 6, 4.
+            hull = shapely.Polygon(pts[[0, 2, 6, 4], :2])
+        else:
+            hull = shapely.MultiPoint(pts[:, :2]).convex_hull
         if hull.geom_type != "Polygon":  # a degenerate (flat) shadow still blocks
             hull = hull.buffer(1e-6)
         out.append(Footprint(node.name, node.role, polygon=hull))
@@ -112,6 +134,18 @@ class FootprintIndex:
         self._disc_r = np.array([f.radius for f in discs], dtype=float)
         self._polygons = [f.polygon for f in self.footprints if not f.is_disc]
         self._tree = shapely.STRtree(self._polygons) if self._polygons else None
+
+    def blocked(self, xy: np.ndarray, radius: float) -> np.ndarray:
+        """(n,) bool: True where a footprint lies within ``radius`` of the point (or covers it)."""
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        hit = np.zeros(len(xy), dtype=bool)
+        if len(self._disc_r):
+            d = np.hypot(xy[:, None, 0] - self._disc_xy[None, :, 0], xy[:, None, 1] - self._disc_xy[None, :, 1])
+            hit |= (d - self._disc_r[None, :] <= radius).any(axis=1)
+        if self._tree is not None and len(xy):
+            ipt, _ = self._tree.query(shapely.points(xy), predicate="dwithin", distance=radius)
+            hit[ipt] = True
+        return hit
 
     def distance(self, xy: np.ndarray) -> np.ndarray:
         """(n,) distance from each of the (n, 2) points to the nearest footprint, 0 inside."""

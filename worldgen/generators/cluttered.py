@@ -105,7 +105,7 @@ def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
     gap = params["min_gap"]
     shapes = params["obstacle_shapes"]
     width = len(str(max(count - 1, 0)))
-    placed: list[tuple[float, float, float, object]] = []  # (x, y, bounding radius, exact footprint)
+    placed: list[_Footprint] = []
     grid: dict[tuple[int, int], list[int]] = {}
     max_reach = max(math.hypot(*[params["box_size"][1]] * 2) / 2, params["cylinder_radius"][1])
     cell = 2 * max_reach + gap
@@ -116,25 +116,23 @@ def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
         if kind == "box":
             sx, sy = (round_float(v) for v in rng.uniform(*params["box_size"], size=2))
             yaw = round_float(rng.uniform(-math.pi, math.pi)) if params["random_yaw"] else 0.0
-            reach = math.hypot(sx, sy) / 2
             shape = Box((sx, sy, height))
         else:
-            r = round_float(rng.uniform(*params["cylinder_radius"]))
-            yaw, reach = 0.0, r
-            shape = Cylinder(r, height)
+            yaw = 0.0
+            shape = Cylinder(round_float(rng.uniform(*params["cylinder_radius"])), height)
         for _ in range(PLACEMENT_TRIES):
             x = round_float(rng.uniform(x0, x1))
             y = round_float(rng.uniform(y0, y1))
-            exact = _footprint(kind, shape, x, y, yaw)
-            if not _inside(exact, bounds):
+            candidate = _Footprint(kind, shape, x, y, yaw)
+            if not candidate.inside(bounds):
                 continue
-            if _clear_of_neighbours(x, y, reach, exact, gap, placed, grid, cell):
+            if _clear_of_neighbours(candidate, gap, placed, grid, cell):
                 break
         else:
             return None
         key = (int(math.floor(x / cell)), int(math.floor(y / cell)))
         grid.setdefault(key, []).append(len(placed))
-        placed.append((x, y, reach, exact))
+        placed.append(candidate)
         mat = Material("obstacle_box" if kind == "box" else "obstacle_cylinder",
                        BOX_RGBA if kind == "box" else CYLINDER_RGBA, params["friction"])
         nodes.append(Node(f"obstacle_{i:0{width}d}", "obstacle", shape, Pose(x, y, height / 2, 0.0, 0.0, yaw),
@@ -142,43 +140,61 @@ def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
     return nodes
 
 
-def _footprint(kind, shape, x, y, yaw):
-    if kind == "cylinder":
-        return ("disc", x, y, shape.radius)
-    c, s = math.cos(yaw), math.sin(yaw)
-    hx, hy = shape.size[0] / 2, shape.size[1] / 2
-    corners = [(x + c * px - s * py, y + s * px + c * py) for px, py in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
-    return ("polygon", shapely.Polygon(corners))
+class _Footprint:
+    """An obstacle's floor shadow while placing: a disc, or a yawed rectangle built lazily."""
+
+    __slots__ = ("kind", "x", "y", "yaw", "radius", "half", "reach", "_polygon")
+
+    def __init__(self, kind, shape, x, y, yaw):
+        self.kind, self.x, self.y, self.yaw = kind, x, y, yaw
+        if kind == "cylinder":
+            self.radius = shape.radius
+            self.reach = shape.radius
+        else:
+            self.half = (shape.size[0] / 2, shape.size[1] / 2)
+            self.reach = math.hypot(*self.half)
+        self._polygon = None
+
+    @property
+    def polygon(self):
+        if self._polygon is None:
+            c, s = math.cos(self.yaw), math.sin(self.yaw)
+            hx, hy = self.half
+            self._polygon = shapely.Polygon(
+                [(self.x + c * px - s * py, self.y + s * px + c * py) for px, py in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
+            )
+        return self._polygon
+
+    def inside(self, bounds) -> bool:
+        (x0, y0), (x1, y1) = bounds
+        if self.kind == "cylinder":
+            ex = ey = self.radius
+        else:
+            c, s = abs(math.cos(self.yaw)), abs(math.sin(self.yaw))
+            hx, hy = self.half
+            ex, ey = c * hx + s * hy, s * hx + c * hy
+        return x0 + ex <= self.x <= x1 - ex and y0 + ey <= self.y <= y1 - ey
+
+    def distance(self, other: "_Footprint") -> float:
+        a, b = self, other
+        if a.kind == "cylinder" and b.kind == "cylinder":
+            return math.hypot(a.x - b.x, a.y - b.y) - a.radius - b.radius
+        if a.kind == "cylinder":
+            a, b = b, a
+        if b.kind == "cylinder":
+            return a.polygon.distance(shapely.Point(b.x, b.y)) - b.radius
+        return a.polygon.distance(b.polygon)
 
 
-def _inside(exact, bounds) -> bool:
-    (x0, y0), (x1, y1) = bounds
-    if exact[0] == "disc":
-        _, x, y, r = exact
-        return x0 + r <= x <= x1 - r and y0 + r <= y <= y1 - r
-    bx0, by0, bx1, by1 = exact[1].bounds
-    return bx0 >= x0 and by0 >= y0 and bx1 <= x1 and by1 <= y1
-
-
-def _distance(a, b) -> float:
-    if a[0] == "disc" and b[0] == "disc":
-        return math.hypot(a[1] - b[1], a[2] - b[2]) - a[3] - b[3]
-    if a[0] == "disc":
-        a, b = b, a
-    if b[0] == "disc":
-        return a[1].distance(shapely.Point(b[1], b[2])) - b[3]
-    return a[1].distance(b[1])
-
-
-def _clear_of_neighbours(x, y, reach, exact, gap, placed, grid, cell) -> bool:
-    cx, cy = int(math.floor(x / cell)), int(math.floor(y / cell))
+def _clear_of_neighbours(candidate: _Footprint, gap: float, placed, grid, cell) -> bool:
+    cx, cy = int(math.floor(candidate.x / cell)), int(math.floor(candidate.y / cell))
     for gx in (cx - 1, cx, cx + 1):
         for gy in (cy - 1, cy, cy + 1):
             for j in grid.get((gx, gy), ()):
-                px, py, preach, pexact = placed[j]
-                if math.hypot(x - px, y - py) >= reach + preach + gap:
+                other = placed[j]
+                if math.hypot(candidate.x - other.x, candidate.y - other.y) >= candidate.reach + other.reach + gap:
                     continue
-                if _distance(exact, pexact) < gap:
+                if candidate.distance(other) < gap:
                     return False
     return True
 

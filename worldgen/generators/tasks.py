@@ -33,7 +33,7 @@ def free_points(rng: np.random.Generator, index: FootprintIndex, bounds, robot: 
         return np.zeros((0, 2))
     xy = np.column_stack([rng.uniform(x0 + r, x1 - r, count), rng.uniform(y0 + r, y1 - r, count)])
     xy = np.round(xy, 6)
-    return xy[index.distance(xy) > r]
+    return xy[~index.blocked(xy, r)]
 
 
 def sample_tasks(

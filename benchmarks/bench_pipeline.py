@@ -1,0 +1,135 @@
+"""Per-stage timings of the whole pipeline for cluttered worlds.
+
+    make bench                      # or: .venv/bin/python benchmarks/bench_pipeline.py [--runs N]
+
+Each stage is timed with time.perf_counter over many seeds and reported as a
+median (these machines are noisy: compare ratios within one run, not absolute
+times across runs). Stages:
+  build        the generator's draw (obstacles, spawn/goal) for the draw that passed
+  feasibility  feasibility.check on that draw (planner + FCL verification)
+  sdf/mjcf/urdf each exporter, Scene -> text
+  metadata     world.json from the rendered files
+  pipeline     generate() + all three formats + metadata, in memory (what an RL loop pays)
+  write        World.write to a temporary folder (files + fsync + rename)
+Series "default" uses the generator's default obstacle sizes and robot; series
+"scaling" uses small obstacles and a small robot so that 1000 obstacles still
+fit in 20 x 20 m, to show how cost grows with the obstacle count.
+The table goes to stdout, the figures to benchmarks/results/pipeline.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import worldgen
+from worldgen import feasibility
+from worldgen.api import attempt_rng
+from worldgen.generators import get, robot_from_params
+
+RESULTS = Path(__file__).resolve().parent / "results" / "pipeline.json"
+
+SERIES = {
+    "default": ({"size": [20, 20]}, (10, 50, 200)),
+    "scaling": (
+        {"size": [20, 20], "box_size": [0.1, 0.25], "cylinder_radius": [0.05, 0.12], "min_gap": 0.05,
+         "robot_radius": 0.1, "clearance": 0.02, "max_attempts": 200},
+        (10, 50, 200, 1000),
+    ),
+}
+STAGES = ("build", "feasibility", "sdf", "mjcf", "urdf", "metadata", "pipeline", "write")
+
+
+def _ms(seconds: float) -> float:
+    return round(seconds * 1e3, 3)
+
+
+def time_world(params: dict, seed: int, out_dir: Path) -> dict[str, float]:
+    t = {}
+    t0 = time.perf_counter()
+    world = worldgen.generate("cluttered", seed=seed, **params)
+    files = world.rendered_files()
+    world.metadata_for(files)
+    t["pipeline"] = time.perf_counter() - t0
+
+    spec = get("cluttered")
+    resolved = spec.resolve(params)
+    rng = attempt_rng(seed, world.attempts - 1)
+    t0 = time.perf_counter()
+    draft = spec.build(resolved, rng)
+    t["build"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    feasibility.check(draft.scene, draft.tasks, robot_from_params(resolved))
+    t["feasibility"] = time.perf_counter() - t0
+    for fmt in ("sdf", "mjcf", "urdf"):
+        t0 = time.perf_counter()
+        world.export(fmt)
+        t[fmt] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    world.metadata_for(files)
+    t["metadata"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    world.write(out_dir)
+    t["write"] = time.perf_counter() - t0
+    t["attempts"] = world.attempts
+    return t
+
+
+def run(runs: int) -> dict:
+    results = {"worldgen_version": worldgen.__version__, "python": platform.python_version(),
+               "machine": platform.machine(), "cpus": os.cpu_count(), "runs": runs, "series": {}}
+    for series, (base, counts) in SERIES.items():
+        rows = {}
+        for n in counts:
+            params = dict(base, n_obstacles=n)
+            seeds = range(runs if n < 1000 else max(5, runs // 3))
+            samples = []
+            with tempfile.TemporaryDirectory() as tmp:
+                time_world(params, 10_000, Path(tmp))  # warm-up: imports, caches
+                for seed in seeds:
+                    samples.append(time_world(params, seed, Path(tmp)))
+            rows[str(n)] = {
+                **{stage: _ms(statistics.median(s[stage] for s in samples)) for stage in STAGES},
+                "attempts_mean": round(statistics.mean(s["attempts"] for s in samples), 2),
+                "worlds": len(samples),
+            }
+        results["series"][series] = rows
+    return results
+
+
+def print_table(results: dict) -> None:
+    for series, rows in results["series"].items():
+        print(f"\nseries '{series}' (median ms over {results['runs']} seeds; 1000 obstacles: fewer)")
+        print(f"{'obstacles':>9} " + " ".join(f"{s:>11}" for s in STAGES) + f" {'attempts':>8} {'x per obst.':>11}")
+        first = None
+        for n, row in rows.items():
+            per = row["pipeline"] / int(n)
+            first = first or (row["pipeline"], int(n))
+            growth = (row["pipeline"] / first[0]) / (int(n) / first[1])
+            print(f"{n:>9} " + " ".join(f"{row[s]:>11.2f}" for s in STAGES)
+                  + f" {row['attempts_mean']:>8.2f} {growth:>11.2f}")
+        print("  'x per obst.': pipeline time ratio to the first row divided by the obstacle-count ratio"
+              " (1.0 = linear, below 1 = sub-linear)")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--runs", type=int, default=30, help="seeds per configuration (default 30)")
+    args = ap.parse_args(argv)
+    results = run(args.runs)
+    print_table(results)
+    RESULTS.parent.mkdir(parents=True, exist_ok=True)
+    RESULTS.write_text(json.dumps(results, indent=2, sort_keys=True) + "\n")
+    print(f"\nfigures written to {RESULTS}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
