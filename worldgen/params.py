@@ -124,6 +124,8 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
 def parse_value(p: Param, text: str) -> Any:
     """Turn command-line text into a value for ``p`` (checked later by :meth:`Param.check`)."""
     t = text.strip()
+    if p.optional and t.lower() in ("none", "null"):
+        return None
     if p.kind == "bool":
         low = t.lower()
         if low in ("true", "yes", "1", "on"):
@@ -136,8 +138,6 @@ def parse_value(p: Param, text: str) -> Any:
         return [_maybe_number(s) for s in parts]
     if p.kind in ("float", "int"):
         return _maybe_number(t)
-    if t.lower() in ("none", "null") and p.optional:
-        return None
     return t
 
 
