@@ -1,0 +1,217 @@
+"""The ``worldgen`` command: a thin click layer over the Python API.
+
+It parses, calls :func:`worldgen.generate` and :meth:`World.write`, and turns
+every :class:`~worldgen.errors.WorldgenError` (and every click usage error)
+into one line on stderr, ``error: ...``, with exit status 2: a user's mistake
+never shows a traceback. Anything else that escapes is a bug and keeps its
+traceback on purpose.
+"""
+
+from __future__ import annotations
+
+import errno
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any, Optional, Sequence
+
+import click
+
+import worldgen
+from worldgen.api import MAX_SEED
+from worldgen.errors import OutputError, ParameterError, WorldgenError
+from worldgen.generators import all_specs, get
+from worldgen.params import Param, describe_range, parse_value
+from worldgen.world import FORMATS, SDF_VERSIONS, normalise_formats
+
+__all__ = ["main", "cli", "parse_settings", "describe_param"]
+
+#: Exit status of every user mistake (click's own usage errors use it too).
+USAGE_STATUS = 2
+_CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+
+
+def _examples() -> str:
+    try:
+        lines = [ex for spec in all_specs() for ex in spec.examples]
+    except WorldgenError:  # a broken plugin must not break --help; `worldgen list` reports it
+        return ""
+    return "\b\nExamples:\n" + "\n".join(f"  {ex}" for ex in lines) if lines else ""
+
+
+@click.group(context_settings=_CONTEXT, epilog="Run 'worldgen list' for every generator and its parameters.")
+@click.version_option(worldgen.__version__, "--version", prog_name="worldgen", message="%(prog)s %(version)s")
+def cli() -> None:
+    """Seeded, feasibility-checked test worlds for robot simulation.
+
+    Each world is written as SDF, MJCF and URDF plus world.json, the ground
+    truth (spawn, goal, shortest path, clearances) a test asserts against.
+    """
+
+
+@cli.command("list", context_settings=_CONTEXT)
+@click.option("--json", "as_json", is_flag=True, help="Print the same as JSON (stable key order).")
+def list_command(as_json: bool) -> None:
+    """List generators and every parameter: kind, default, allowed range, unit."""
+    specs = all_specs()
+    if as_json:
+        doc = {
+            "worldgen_version": worldgen.__version__,
+            "generators": [
+                {"name": s.name, "summary": s.summary, "examples": list(s.examples),
+                 "params": [describe_param(p) for p in s.all_params]}
+                for s in specs
+            ],
+        }
+        click.echo(json.dumps(doc, indent=2, sort_keys=True))
+        return
+    for i, spec in enumerate(specs):
+        if i:
+            click.echo("")
+        click.echo(f"{spec.name}: {spec.summary}")
+        rows = [("parameter", "kind", "default", "allowed", "unit", "meaning")]
+        rows += [(d["name"], d["kind"], d["default_text"], d["allowed"], d["unit"] or "-", d["doc"])
+                 for d in (describe_param(p) for p in spec.all_params)]
+        widths = [max(len(r[c]) for r in rows) for c in range(5)]
+        for row in rows:
+            click.echo("  " + "  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[5])
+        for ex in spec.examples:
+            click.echo(f"  e.g. {ex}")
+
+
+@cli.command("generate", context_settings=_CONTEXT, epilog=_examples())
+@click.argument("generator")
+@click.option("--seed", type=click.IntRange(0, MAX_SEED), default=0, show_default=True,
+              help="Seed of the first world; --count K makes seeds N .. N+K-1.")
+@click.option("--set", "settings", multiple=True, metavar="KEY=VALUE",
+              help="Set a generator parameter (repeatable), e.g. --set size=20,20 --set n_obstacles=50.")
+@click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
+              help="Folder to write DIR/<world_id>/ into (created if missing).")
+@click.option("--formats", default=",".join(FORMATS), show_default=True,
+              help=f"Comma-separated subset of {', '.join(FORMATS)}; world.json is always written.")
+@click.option("--sdf-version", type=click.Choice(SDF_VERSIONS), default=SDF_VERSIONS[0], show_default=True,
+              help="SDFormat version: 1.9 (Gazebo Fortress to Harmonic) or 1.6 (Gazebo classic).")
+@click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
+              help="Number of worlds, one per consecutive seed.")
+def generate_command(generator: str, seed: int, settings: Sequence[str], out: Path, formats: str,
+                     sdf_version: str, count: int) -> None:
+    """Generate, check and write worlds of GENERATOR.
+
+    Prints one line per world: its folder, the reference path length of each
+    task and how many draws it took. Each folder appears complete or not at all.
+    """
+    spec = get(generator)
+    params = parse_settings(spec.all_params, settings, spec.name)
+    spec.resolve(params)  # every parameter mistake surfaces before any world is drawn
+    chosen = normalise_formats(formats)
+    if seed + count - 1 > MAX_SEED:
+        raise ParameterError(f"parameter 'count' must be in [1, {MAX_SEED - seed + 1}] for seed {seed}, got {count}")
+    _check_out(out)
+    for s in range(seed, seed + count):
+        world = worldgen.generate(spec.name, seed=s, **params)
+        folder = world.write(out, formats=chosen, sdf_version=sdf_version)
+        lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
+        click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}")
+
+
+def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
+    """``["key=value", ...]`` -> ``{key: value}``, each value parsed for its parameter's kind.
+
+    Values are only parsed here; :meth:`GeneratorSpec.resolve` checks them. A
+    key given twice keeps its last value, as on most command lines.
+    """
+    by_name = {p.name: p for p in params}
+    out: dict[str, Any] = {}
+    for item in settings:
+        key, sep, text = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise ParameterError(f"--set expects KEY=VALUE (e.g. --set n_obstacles=50), got {item!r}")
+        if key not in by_name:
+            hint = " (the seed is set with --seed)" if key == "seed" else ""
+            raise ParameterError(
+                f"unknown parameter '{key}' for generator '{generator}'{hint}; "
+                f"known parameters: {', '.join(sorted(by_name))}"
+            )
+        out[key] = parse_value(by_name[key], text)
+    return out
+
+
+def describe_param(p: Param) -> dict[str, Any]:
+    """One parameter as ``worldgen list`` shows it (also its --json form)."""
+    if p.kind == "range":
+        allowed = f"min <= max, each {describe_range(p)}"
+    elif p.kind == "pair":
+        allowed = f"each {describe_range(p)}"
+    elif p.kind == "int":
+        allowed = f"integer {describe_range(p)}"
+    else:
+        allowed = describe_range(p)
+    if p.optional:
+        allowed += " or none"
+    return {
+        "name": p.name, "kind": p.kind, "default": p.default, "default_text": _value_text(p.default),
+        "allowed": allowed, "low": p.low, "high": p.high, "choices": list(p.choices),
+        "optional": p.optional, "unit": p.unit, "doc": p.doc,
+    }
+
+
+def _value_text(value: Any) -> str:
+    """A value as it would be typed after --set key=."""
+    if value is None:
+        return "none"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (list, tuple)):
+        return ",".join(_value_text(v) for v in value)
+    return f"{value:g}" if isinstance(value, float) else str(value)
+
+
+def _check_out(out: Path) -> None:
+    """Fail before drawing anything when --out can never be written.
+
+    The nearest existing folder on the way to ``out`` must be a writable
+    folder; ``World.write`` creates what is missing below it.
+    """
+    if out.exists() and not out.is_dir():
+        raise OutputError(f"--out '{out}' is not a folder; give a folder to write worlds into")
+    base = out
+    while not base.exists() and base.parent != base:
+        base = base.parent
+    if not base.is_dir():
+        raise OutputError(f"--out '{out}' cannot be created: '{base}' is a file, not a folder")
+    if not os.access(base, os.W_OK | os.X_OK):
+        raise OutputError(f"--out '{out}' is not writable (no write permission on '{base}')")
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Run the command line; return the exit status (0 ok, 2 user mistake)."""
+    try:
+        rv = cli.main(args=list(argv) if argv is not None else None, prog_name="worldgen", standalone_mode=False)
+        return rv if isinstance(rv, int) else 0
+    except click.exceptions.NoArgsIsHelpError as exc:  # bare `worldgen`: help is the answer
+        click.echo(exc.ctx.get_help() if exc.ctx else str(exc))
+        return 0
+    except click.ClickException as exc:
+        hint = f" (see '{exc.ctx.command_path} --help')" if getattr(exc, "ctx", None) is not None else ""
+        click.echo(f"error: {_one_line(exc.format_message())}{hint}", err=True)
+        return USAGE_STATUS
+    except WorldgenError as exc:
+        click.echo(f"error: {_one_line(str(exc))}", err=True)
+        return USAGE_STATUS
+    except click.Abort:
+        click.echo("error: aborted", err=True)
+        return 130
+    except OSError as exc:
+        if exc.errno == errno.EPIPE:  # `worldgen list | head`: the reader left, nothing is wrong
+            return 0
+        raise
+
+
+if __name__ == "__main__":
+    sys.exit(main())

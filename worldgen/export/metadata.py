@@ -1,0 +1,272 @@
+"""world.json: the ground truth a test asserts against (../shared/design/METADATA.md).
+
+``build(world, files)`` turns a checked :class:`~worldgen.world.World` into a
+plain dict whose field names are the public contract; ``dumps`` writes it in
+the one canonical text form (sorted keys, every float through
+:func:`worldgen.floats.round_float`, two-space indent, final newline), so the
+same world always gives the same bytes. ``schema()`` loads the JSON Schema
+shipped beside this package; ``validate()`` checks a dict against it.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from functools import lru_cache
+from importlib import resources
+from typing import Any, Mapping
+
+import numpy as np
+import shapely
+
+from worldgen.floats import round_float
+from worldgen.footprint import scene_footprints
+from worldgen.params import COMMON_PARAMS
+
+__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "time_limit", "free_area_ratio"]
+
+#: The value of world.json's ``schema`` field; a breaking change bumps the number.
+SCHEMA_ID = "worldgen.world/1"
+
+#: time_limit = TIME_FACTOR x path length / robot_speed + TIME_MARGIN: twice the time an
+#: ideal run needs, plus a fixed allowance for start-up and turning on the spot.
+TIME_FACTOR = 2.0
+TIME_MARGIN = 10.0
+
+#: Segments per quarter circle when a disc footprint becomes a polygon for area sums:
+#: the polygon's area is within 0.1 % of the disc's.
+_DISC_QUAD_SEGS = 32
+
+
+def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
+    """world.json of ``world`` as a plain dict (floats already rounded).
+
+    ``files`` maps each key (``sdf``, ``mjcf``, ``urdf``, ``mesh:<path>``) to
+    ``(path relative to the world folder, sha256 hex of the bytes)``.
+    """
+    scene, report, robot = world.scene, world.feasibility, world.robot
+    (x0, y0), (x1, y1) = scene.bounds
+    narrowest = _finite_or_none(report.narrowest_passage)
+    paths = list(report.paths) + [None] * max(0, len(world.tasks) - len(report.paths))
+    speed = world.params.get("robot_speed", _default("robot_speed"))
+    meta = {
+        "schema": SCHEMA_ID,
+        "worldgen_version": _version(),
+        "world_id": world.world_id,
+        "generator": world.generator,
+        "seed": int(world.seed),
+        "params": dict(world.params),
+        "content_hash": world.content_hash,
+        "bounds": {"min": [x0, y0], "max": [x1, y1]},
+        "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
+        "entities": [_entity(scene, node) for node in scene.nodes],
+        "doors": [],
+        "dynamic_obstacles": [],
+        "tasks": [_task(task, path, speed) for task, path in zip(world.tasks, paths)],
+        "feasibility": {
+            "feasible": bool(report.feasible),
+            "checker": report.checker,
+            "checks": [
+                {"name": c.name, "ok": bool(c.ok), "value": _finite_or_none(c.value), "detail": c.detail}
+                for c in report.checks
+            ],
+            "narrowest_passage": narrowest,
+            "resolution": _finite_or_none(report.resolution),
+            "attempts": int(world.attempts),
+        },
+        "metrics": {
+            "obstacle_count": sum(1 for n in scene.nodes if n.role == "obstacle"),
+            "free_area_ratio": free_area_ratio(scene, robot.height),
+            "narrowest_passage": narrowest,
+        },
+        "files": {key: {"path": path, "sha256": digest} for key, (path, digest) in sorted(files.items())},
+    }
+    return _plain(meta)
+
+
+def dumps(meta: Mapping[str, Any]) -> str:
+    """The canonical text of ``meta``: same dict, same bytes, on any machine.
+
+    Keys sorted, two-space indent, a final newline; a list of plain numbers
+    (a pose, a point, a size) stays on one line so a 1000-entity world stays
+    readable. ``dumps(json.loads(dumps(m))) == dumps(m)``.
+    """
+    return _emit(_plain(meta), "") + "\n"
+
+
+def time_limit(length: float, robot_speed: float) -> float:
+    """A generous time bound (s) for a path of ``length`` m at ``robot_speed`` m/s."""
+    return TIME_FACTOR * length / robot_speed + TIME_MARGIN
+
+
+def free_area_ratio(scene, height: float) -> float:
+    """Share of the bounds' area not covered by the floor shadow of any collider below ``height``.
+
+    Shadows that touch no other shadow are summed directly (a disc inside the
+    bounds exactly as pi r^2); only those that overlap, or cross the bounds, are
+    unioned as polygons. A union of every shadow would be exact too, but costs
+    milliseconds per world where this costs a fraction of one.
+    """
+    (x0, y0), (x1, y1) = scene.bounds
+    area = shapely.box(x0, y0, x1, y1)
+    prints = scene_footprints(scene, height)
+    if not prints:
+        return 1.0
+    discs = [fp for fp in prints if fp.is_disc]
+    polys = [fp.polygon for fp in prints if not fp.is_disc]
+    centre = np.array([fp.centre for fp in discs], dtype=float).reshape(-1, 2)
+    radius = np.array([fp.radius for fp in discs], dtype=float)
+    inside_d = ((centre[:, 0] - radius >= x0) & (centre[:, 0] + radius <= x1)
+                & (centre[:, 1] - radius >= y0) & (centre[:, 1] + radius <= y1))
+    inside_p = np.array([shapely.contains_properly(area, p) for p in polys], dtype=bool)
+    lone_d, lone_p = inside_d.copy(), inside_p.copy()
+    if len(discs) > 1:
+        gap = np.hypot(*(centre[:, None, :] - centre[None, :, :]).transpose(2, 0, 1)) - radius[:, None] - radius[None, :]
+        np.fill_diagonal(gap, np.inf)
+        lone_d &= ~(gap <= 0).any(axis=1)
+    if polys:
+        tree = shapely.STRtree(polys)
+        a, b = tree.query(polys, predicate="intersects")
+        lone_p[a[a != b]] = False
+        if discs:
+            d, p = tree.query(shapely.points(centre), predicate="dwithin", distance=radius)
+            lone_d[d] = False
+            lone_p[p] = False
+    covered = float(np.pi * np.sum(radius[lone_d] ** 2)) + sum(polys[i].area for i in np.flatnonzero(lone_p))
+    rest = [shapely.Point(centre[i]).buffer(radius[i], quad_segs=_DISC_QUAD_SEGS) for i in np.flatnonzero(~lone_d)]
+    rest += [polys[i] for i in np.flatnonzero(~lone_p)]
+    if rest:
+        covered += shapely.intersection(shapely.union_all(rest), area).area
+    return min(1.0, max(0.0, 1.0 - covered / area.area))
+
+
+@lru_cache(maxsize=1)
+def schema() -> dict:
+    """The JSON Schema (draft 2020-12) of world.json, as shipped in ``worldgen/schema``."""
+    text = resources.files("worldgen.schema").joinpath("world.schema.json").read_text(encoding="utf-8")
+    return json.loads(text)
+
+
+def validate(meta: Mapping[str, Any]) -> None:
+    """Raise ``jsonschema.ValidationError`` unless ``meta`` follows the schema.
+
+    Needs the optional ``jsonschema`` package (``pip install worldgen[test]``).
+    """
+    try:
+        import jsonschema
+    except ImportError:  # pragma: no cover - depends on the environment
+        raise ImportError("worldgen.export.metadata.validate needs jsonschema: pip install 'worldgen[test]'") from None
+    jsonschema.Draft202012Validator(schema()).validate(meta)
+
+
+# -- pieces -----------------------------------------------------------------
+
+def _entity(scene, node) -> dict:
+    return {
+        "name": node.name,
+        "role": node.role,
+        "static": bool(node.static),
+        "pose": scene.world_pose(node.name).as_list(),
+        "shape": None if node.shape is None else node.shape.describe(),
+        "aabb": scene.aabb(node.name).tolist(),
+    }
+
+
+def _task(task, path, speed: float) -> dict:
+    spawn, goal = task.spawn, task.goal
+    out = {
+        "id": task.id,
+        "spawn": spawn.as_list(),
+        "goal": goal.as_list(),
+        "goal_tolerance": task.goal_tolerance,
+        "straight_line_distance": math.hypot(goal.x - spawn.x, goal.y - spawn.y),
+        "path": None,
+        "time_limit": None,
+        "requires_door_open": False,
+    }
+    if path is not None:
+        out["path"] = {
+            "waypoints": np.asarray(path.waypoints, dtype=float).reshape(-1, 2).tolist(),
+            "length": path.length,
+            "min_clearance": _finite_or_none(path.min_clearance),
+        }
+        out["time_limit"] = time_limit(path.length, speed)
+    return out
+
+
+def _finite_or_none(x):
+    """None for a missing or unbounded figure (e.g. no obstacle in reach): JSON has no inf."""
+    if x is None:
+        return None
+    x = float(x)
+    return x if math.isfinite(x) else None
+
+
+def _default(name: str):
+    return next(p.default for p in COMMON_PARAMS if p.name == name)
+
+
+def _version() -> str:
+    import worldgen
+
+    return worldgen.__version__
+
+
+def _emit(obj, indent: str) -> str:
+    if isinstance(obj, dict):
+        if not obj:
+            return "{}"
+        inner = indent + "  "
+        items = [f"{inner}{_scalar(k)}: {_emit(obj[k], inner)}" for k in sorted(obj)]
+        return "{\n" + ",\n".join(items) + "\n" + indent + "}"
+    if isinstance(obj, list):
+        if not obj:
+            return "[]"
+        if not any(isinstance(v, (dict, list)) for v in obj):
+            return "[" + ", ".join(_scalar(v) for v in obj) + "]"
+        inner = indent + "  "
+        return "[\n" + ",\n".join(inner + _emit(v, inner) for v in obj) + "\n" + indent + "]"
+    return _scalar(obj)
+
+
+def _scalar(value) -> str:
+    # Floats are already rounded; repr() is json's own float text, the shortest that reads back equal.
+    kind = type(value)
+    if kind is float:
+        return repr(value)
+    if kind is bool:
+        return "true" if value else "false"
+    if kind is int:
+        return str(value)
+    if value is None:
+        return "null"
+    return json.dumps(value, ensure_ascii=False)
+
+
+def _plain(obj):
+    """Plain JSON types, floats rounded, tuples as lists; dict keys must be strings."""
+    kind = type(obj)
+    if kind is float:  # the common case first: this runs once per number written
+        return round_float(obj)
+    if kind is str or obj is None:
+        return obj
+    if kind is bool or isinstance(obj, np.bool_):
+        return bool(obj)
+    if kind is int or isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return round_float(obj)
+    if kind is list or kind is tuple:
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _plain(obj.tolist())
+    if kind is dict or isinstance(obj, Mapping):
+        out = {}
+        for key, value in obj.items():
+            if type(key) is not str:
+                raise TypeError(f"world.json keys must be strings, got {key!r}")
+            out[key] = _plain(value)
+        return out
+    if isinstance(obj, str):
+        return str(obj)
+    raise TypeError(f"cannot write {type(obj).__name__} {obj!r} to world.json")
