@@ -1,0 +1,184 @@
+"""MJCF exporter: Scene -> lxml tree for MuJoCo, filled into ``templates/world.mjcf.xml``.
+
+How the scene maps onto MJCF:
+
+- Every node's name is its geom's name (and its body's name where it has a body).
+- A static root node without children is a bare geom in ``<worldbody>`` at its
+  world pose: nothing can move it, so it needs no body.
+- A dynamic root node is a body with a ``<freejoint>`` (named after the node),
+  its mass and diagonal inertia in an ``<inertial>``.
+- A node with a parent is a body nested in its parent's body at ``node.pose``:
+  on a ``hinge`` when a revolute scene Joint names it as child, rigidly
+  otherwise (a fixed Joint, or no Joint at all).
+- Initial joint angle: ``node.pose`` is where the node *is* (the pose the
+  feasibility check and world.json use), that is the pose at ``joint.initial``.
+  The hinge gets ``ref = initial``: MuJoCo then sets ``qpos0 = initial`` and
+  rotates the body by ``qpos - ref``, so the model compiles with the door where
+  the scene has it and ``qpos`` reads the same angle as the scene's Joint and
+  as world.json's ``doors[].angle``; the range is the Joint's limits as given.
+- Sizes: boxes as half extents, cylinders as "radius half-length", spheres as
+  radius. Meshes are inlined as ``<mesh vertex face scale>`` assets so that
+  ``mujoco.MjModel.from_xml_string`` needs no files (MuJoCo re-centres a mesh
+  on its centroid: ``model.mesh_pos``/``mesh_quat`` hold that offset).
+- Friction: "slide torsional rolling" = node.material.friction and MuJoCo's own
+  defaults for the two others. Colour: ``rgba``.
+- Nodes without collision (role ``marker``): ``contype="0" conaffinity="0"``.
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+from worldgen.export.xml import load_template, sub
+from worldgen.floats import fmt, fmt_seq, round_float
+from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere
+
+__all__ = ["to_mjcf", "TEMPLATE", "joints_by_child", "mass_properties", "RESERVED_NAME"]
+
+TEMPLATE = "world.mjcf.xml"
+#: MuJoCo's defaults for the torsional and rolling friction coefficients.
+TORSIONAL_FRICTION = 0.005
+ROLLING_FRICTION = 0.0001
+#: MuJoCo's world body, and URDF's conventional fixed root, are called this.
+RESERVED_NAME = "world"
+#: The smallest positive number that survives 6-decimal output: a tiny body's mass or
+#: moment rounded to 0 would be rejected by MuJoCo, so it is written as this instead.
+SMALLEST = 1e-6
+
+
+def mass_properties(node: Node) -> tuple[str, tuple[str, str, str]]:
+    """(mass, (ixx, iyy, izz)) as written in MJCF and URDF, each at least :data:`SMALLEST`."""
+    def text(x: float) -> str:
+        return fmt(max(round_float(x), SMALLEST))
+    ixx, iyy, izz = node.inertia
+    return text(node.mass), (text(ixx), text(iyy), text(izz))
+
+
+def joints_by_child(scene: Scene) -> dict[str, Joint]:
+    """``{child node name: Joint}``, after checking each joint fits the node tree.
+
+    A joint must connect a node to that node's parent (``"world"`` for a root
+    node), and a node hangs on at most one joint.
+    """
+    found: dict[str, Joint] = {}
+    names: set[str] = set()
+    for joint in scene.joints:
+        if joint.name in names:
+            raise ValueError(f"joint name {joint.name!r} is used twice; joint names must be unique")
+        names.add(joint.name)
+        if joint.child == RESERVED_NAME:
+            raise ValueError(f"joint {joint.name!r}: the world cannot be a joint's child")
+        if joint.child in found:
+            raise ValueError(f"node {joint.child!r} is the child of joints {found[joint.child].name!r} and {joint.name!r}")
+        parent = scene.node(joint.child).parent or RESERVED_NAME
+        if joint.parent != parent:
+            raise ValueError(
+                f"joint {joint.name!r} connects {joint.parent!r} to {joint.child!r}, "
+                f"but the node's parent is {parent!r}"
+            )
+        found[joint.child] = joint
+    for node in scene.nodes:
+        if node.name == RESERVED_NAME:
+            raise ValueError(f"node name {RESERVED_NAME!r} is reserved for the world frame in MJCF and URDF")
+    return found
+
+
+def to_mjcf(scene: Scene, name: str = "world"):
+    """The scene as an MJCF document (an lxml ElementTree)."""
+    joints = joints_by_child(scene)
+    tree = load_template(TEMPLATE)
+    root = tree.getroot()
+    root.set("model", name)
+    option = root.find("option")
+    option.set("timestep", fmt(scene.physics.step_size))
+    option.set("gravity", fmt_seq(scene.physics.gravity))
+    mesh_assets = _write_mesh_assets(root.find("asset"), scene)
+    _check_joint_names(scene, joints)
+    worldbody = root.find("worldbody")
+    children: dict[Optional[str], list[Node]] = {}
+    for node in scene.nodes:  # one pass, keeping the scene's node order
+        children.setdefault(node.parent, []).append(node)
+    for node in children.get(None, ()):
+        _write_node(worldbody, node, joints, children, mesh_assets)
+    return tree
+
+
+def _check_joint_names(scene: Scene, joints: dict[str, Joint]) -> None:
+    """Free joints are named after their node; they must not clash with a scene joint."""
+    scene_names = {j.name for j in scene.joints}
+    for node in scene.nodes:
+        if _is_free(node, joints) and node.name in scene_names:
+            raise ValueError(f"node {node.name!r} is dynamic and its free joint's name clashes with a scene joint")
+
+
+def _is_free(node: Node, joints: dict[str, Joint]) -> bool:
+    return node.parent is None and not node.static and node.name not in joints
+
+
+def _write_mesh_assets(asset, scene: Scene) -> dict[tuple, str]:
+    """One ``<mesh>`` per distinct (uri, scale); returns {(uri, scale): asset name}."""
+    names: dict[tuple, str] = {}
+    for node in scene.nodes:
+        shape = node.shape
+        if not isinstance(shape, Mesh):
+            continue
+        key = (shape.uri, shape.scale)
+        if key in names:
+            continue
+        # Named after the first node using it: node names are unique and plain.
+        names[key] = node.name
+        sub(asset, "mesh", name=node.name, scale=fmt_seq(shape.scale),
+            vertex=fmt_seq(shape.vertices.ravel()), face=" ".join(str(int(i)) for i in shape.faces.ravel()))
+    return names
+
+
+def _pose_attrs(pose) -> dict[str, str]:
+    return {"pos": fmt_seq((pose.x, pose.y, pose.z)), "euler": fmt_seq((pose.roll, pose.pitch, pose.yaw))}
+
+
+def _write_node(parent_el, node: Node, joints, children, mesh_assets) -> None:
+    joint = joints.get(node.name)
+    kids = children.get(node.name, ())
+    if node.parent is None and node.static and joint is None and not kids:
+        if node.shape is not None:
+            _write_geom(parent_el, node, mesh_assets, _pose_attrs(node.pose))
+        return
+    body = sub(parent_el, "body", name=node.name, **_pose_attrs(node.pose))
+    mass, inertia = mass_properties(node)
+    sub(body, "inertial", pos="0 0 0", mass=mass, diaginertia=" ".join(inertia))
+    if _is_free(node, joints):
+        sub(body, "freejoint", name=node.name)
+    elif joint is not None and joint.kind == "revolute":
+        rot = joint.pose.rotation
+        axis = rot @ joint.axis  # MJCF wants the axis in the body (child) frame
+        lo, hi = joint.limits
+        sub(body, "joint", name=joint.name, type="hinge", pos=fmt_seq((joint.pose.x, joint.pose.y, joint.pose.z)),
+            axis=fmt_seq(axis), limited="true", range=fmt_seq((lo, hi)), ref=fmt(joint.initial),
+            damping=fmt(joint.damping), actuatorfrclimited="true",
+            actuatorfrcrange=fmt_seq((-joint.effort, joint.effort)))
+    if node.shape is not None:
+        _write_geom(body, node, mesh_assets, {})
+    for child in kids:
+        _write_node(body, child, joints, children, mesh_assets)
+
+
+def _write_geom(parent_el, node: Node, mesh_assets, pose_attrs: dict[str, str]) -> None:
+    attrs = {"name": node.name}
+    shape = node.shape
+    if isinstance(shape, Box):
+        attrs.update(type="box", size=fmt_seq(s / 2.0 for s in shape.size))
+    elif isinstance(shape, Cylinder):
+        attrs.update(type="cylinder", size=fmt_seq((shape.radius, shape.length / 2.0)))
+    elif isinstance(shape, Sphere):
+        attrs.update(type="sphere", size=fmt(shape.radius))
+    elif isinstance(shape, Mesh):
+        attrs.update(type="mesh", mesh=mesh_assets[(shape.uri, shape.scale)])
+    else:
+        raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
+    attrs.update(pose_attrs)
+    attrs["rgba"] = fmt_seq(node.material.rgba)
+    attrs["friction"] = fmt_seq((node.material.friction, TORSIONAL_FRICTION, ROLLING_FRICTION))
+    if not node.collision:
+        # Visual only: no contact with anything, drawn in group 2 with the other visuals.
+        attrs.update(contype="0", conaffinity="0", group="2")
+    sub(parent_el, "geom", **attrs)

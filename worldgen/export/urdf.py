@@ -1,0 +1,205 @@
+"""URDF exporter: Scene -> lxml tree, filled into ``templates/world.urdf``.
+
+URDF describes one kinematic tree, so a world becomes one "robot":
+
+- The root link is ``world`` (in the skeleton). MuJoCo's importer maps a link
+  of that name onto its world body and Gazebo welds it to the world, so the
+  root carries no inertia that a simulator could reject.
+- Every node is a link of the same name, with an ``<inertial>`` from the
+  node's mass and inertia (valid for every shape), a ``<visual>`` with its
+  material, and a ``<collision>`` named after the node unless the node has no
+  collision (markers). MuJoCo names its geom after the collision.
+- A root node hangs from ``world`` on a joint named after the node: ``fixed``
+  when static, ``floating`` when dynamic (MuJoCo imports that as a free joint,
+  so a dynamic body moves as in the MJCF; check_urdf accepts it), or on its
+  scene Joint when one names it (``parent="world"``).
+- A child node hangs from its parent's link on the scene Joint naming it
+  (``revolute`` with ``<limit lower upper effort velocity>`` and
+  ``<dynamics damping>``), or on a ``fixed`` joint named after the node.
+- URDF puts a child link's frame on its joint, so for a revolute child the
+  link frame is the scene Joint's frame and the shapes are offset back by the
+  inverse of ``joint.pose``.
+- Initial angle: URDF has no place for it, and its joint origin is the pose
+  at angle 0. ``node.pose`` is the pose at ``joint.initial`` (as in the MJCF),
+  so the origin is that pose turned back by ``-initial`` about the axis; a
+  test or simulator sets the joint to world.json's ``doors[].angle``.
+- Friction is not part of URDF. Each colliding link gets
+  ``<gazebo reference=...><mu1/><mu2/></gazebo>`` (Gazebo's URDF extension,
+  read when Gazebo converts the URDF; check_urdf and MuJoCo ignore it).
+- Meshes refer to ``shape.uri`` (relative to the world folder, written by
+  :mod:`worldgen.export.meshes`) with ``scale``.
+- A ``<mujoco>`` element in the skeleton keeps MuJoCo from fusing the fixed
+  links into one body and from stripping ``meshes/`` off mesh paths.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from lxml import etree
+
+from worldgen.export.mjcf import RESERVED_NAME, joints_by_child, mass_properties
+from worldgen.export.xml import load_template, sub
+from worldgen.floats import fmt, fmt_seq
+from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose
+
+__all__ = ["to_urdf", "TEMPLATE", "link_offset", "zero_angle_origin"]
+
+TEMPLATE = "world.urdf"
+
+
+def rotation_about(axis, angle: float) -> np.ndarray:
+    """(4, 4) rotation by ``angle`` rad about ``axis`` (any non-zero length) through the origin."""
+    a = np.asarray(axis, dtype=float)
+    a = a / np.linalg.norm(a)
+    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+    m = np.eye(4)
+    m[:3, :3] = np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)  # Rodrigues
+    return m
+
+
+def link_offset(joint: Joint | None) -> np.ndarray:
+    """(4, 4) pose of a node's URDF link frame in the node's frame.
+
+    A revolute joint's frame (``joint.pose``, in the child's frame) becomes the
+    link frame; elsewhere the link frame is the node frame.
+    """
+    if joint is not None and joint.kind == "revolute":
+        return joint.pose.matrix()
+    return np.eye(4)
+
+
+def zero_angle_origin(scene: Scene, node: Node, joint: Joint | None, parent_joint: Joint | None) -> np.ndarray:
+    """(4, 4) URDF joint origin: the node's link frame in its parent's link frame, at angle 0."""
+    local = node.pose.matrix() @ link_offset(joint)  # link frame in the parent node's frame, at initial
+    if joint is not None and joint.kind == "revolute" and joint.initial != 0.0:
+        local = local @ rotation_about(joint.axis, -joint.initial)
+    return np.linalg.inv(link_offset(parent_joint)) @ local
+
+
+def to_urdf(scene: Scene, name: str = "world"):
+    """The scene as a URDF document (an lxml ElementTree)."""
+    joints = joints_by_child(scene)
+    _check_joint_names(scene, joints)
+    tree = load_template(TEMPLATE)
+    robot = tree.getroot()
+    robot.set("name", name)
+    materials = _write_materials(robot, scene)
+    for node in scene.nodes:
+        joint = joints.get(node.name)
+        parent_joint = joints.get(node.parent) if node.parent is not None else None
+        _write_link(robot, node, joint, materials)
+        _write_joint(robot, scene, node, joint, parent_joint)
+        if node.shape is not None and node.collision:
+            gz = sub(robot, "gazebo", reference=node.name)
+            sub(gz, "mu1", fmt(node.material.friction))
+            sub(gz, "mu2", fmt(node.material.friction))
+    return tree
+
+
+def _joint_name(node: Node, joint: Joint | None) -> str:
+    return joint.name if joint is not None else node.name
+
+
+def _check_joint_names(scene: Scene, joints: dict[str, Joint]) -> None:
+    seen: dict[str, str] = {}
+    for node in scene.nodes:
+        jname = _joint_name(node, joints.get(node.name))
+        if jname in seen:
+            raise ValueError(f"URDF joint name {jname!r} would attach both {seen[jname]!r} and {node.name!r}; "
+                             "rename the scene joint")
+        seen[jname] = node.name
+
+
+def _write_materials(robot, scene: Scene) -> dict[str, str]:
+    """Top-level ``<material>`` elements; returns {node name: material name}.
+
+    Materials are shared by name; a name reused with another colour gets a suffix,
+    because URDF keeps one colour per material name.
+    """
+    by_key: dict[tuple, str] = {}
+    used: set[str] = set()
+    result: dict[str, str] = {}
+    at = _first_link_index(robot) + 1  # after the root link, before any link that uses them
+    for node in scene.nodes:
+        if node.shape is None:
+            continue
+        key = (node.material.name, node.material.rgba)
+        if key not in by_key:
+            mname, k = node.material.name, 1
+            while mname in used:
+                mname, k = f"{node.material.name}_{k}", k + 1
+            used.add(mname)
+            by_key[key] = mname
+            mat = etree.Element("material", name=mname)
+            sub(mat, "color", rgba=fmt_seq(node.material.rgba))
+            robot.insert(at, mat)
+            at += 1
+        result[node.name] = by_key[key]
+    return result
+
+
+def _first_link_index(robot) -> int:
+    for i, child in enumerate(robot):
+        if child.tag == "link":
+            return i
+    return len(robot)
+
+
+def _origin(parent_el, m: np.ndarray):
+    pose = matrix_to_pose(m)
+    return sub(parent_el, "origin", xyz=fmt_seq((pose.x, pose.y, pose.z)), rpy=fmt_seq((pose.roll, pose.pitch, pose.yaw)))
+
+
+def _write_link(robot, node: Node, joint: Joint | None, materials) -> None:
+    link = sub(robot, "link", name=node.name)
+    back = np.linalg.inv(link_offset(joint))  # the node frame in the link frame
+    inertial = sub(link, "inertial")
+    _origin(inertial, back)
+    mass, (ixx, iyy, izz) = mass_properties(node)
+    sub(inertial, "mass", value=mass)
+    sub(inertial, "inertia", ixx=ixx, ixy="0", ixz="0", iyy=iyy, iyz="0", izz=izz)
+    if node.shape is None:
+        return
+    visual = sub(link, "visual", name=node.name)
+    _origin(visual, back)
+    _geometry(visual, node)
+    sub(visual, "material", name=materials[node.name])
+    if node.collision:
+        collision = sub(link, "collision", name=node.name)
+        _origin(collision, back)
+        _geometry(collision, node)
+
+
+def _geometry(parent_el, node: Node) -> None:
+    geometry = sub(parent_el, "geometry")
+    shape = node.shape
+    if isinstance(shape, Box):
+        sub(geometry, "box", size=fmt_seq(shape.size))
+    elif isinstance(shape, Cylinder):
+        sub(geometry, "cylinder", radius=fmt(shape.radius), length=fmt(shape.length))
+    elif isinstance(shape, Sphere):
+        sub(geometry, "sphere", radius=fmt(shape.radius))
+    elif isinstance(shape, Mesh):
+        sub(geometry, "mesh", filename=shape.uri, scale=fmt_seq(shape.scale))
+    else:
+        raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
+
+
+def _write_joint(robot, scene: Scene, node: Node, joint: Joint | None, parent_joint: Joint | None) -> None:
+    if joint is not None and joint.kind == "revolute":
+        kind = "revolute"
+    elif node.parent is None and not node.static and joint is None:
+        kind = "floating"
+    else:
+        kind = "fixed"
+    el = sub(robot, "joint", name=_joint_name(node, joint), type=kind)
+    sub(el, "parent", link=node.parent or RESERVED_NAME)
+    sub(el, "child", link=node.name)
+    _origin(el, zero_angle_origin(scene, node, joint, parent_joint))
+    if kind == "revolute":
+        sub(el, "axis", xyz=fmt_seq(joint.axis))
+        lo, hi = joint.limits
+        sub(el, "limit", lower=fmt(lo), upper=fmt(hi), effort=fmt(joint.effort), velocity=fmt(joint.velocity))
+        sub(el, "dynamics", damping=fmt(joint.damping))
