@@ -1,0 +1,238 @@
+"""The ``worldgen`` command, end to end in real processes.
+
+Every user mistake must give exactly one line on stderr, ``error: ...``,
+naming what is wrong and what is allowed, exit status 2, no traceback, and
+nothing written.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import worldgen
+from worldgen.errors import InfeasibleError
+from worldgen.generators import get
+from worldgen.params import describe_range
+
+_SCRIPT = Path(sys.executable).with_name("worldgen")
+WORLDGEN = [str(_SCRIPT)] if _SCRIPT.exists() else [sys.executable, "-m", "worldgen"]
+#: A small, quick world for the end-to-end runs.
+QUICK = ["--set", "size=6,6", "--set", "n_obstacles=6"]
+
+
+def run(*args, cwd=None, cmd=None) -> subprocess.CompletedProcess:
+    return subprocess.run((cmd or WORLDGEN) + [str(a) for a in args], capture_output=True, text=True,
+                          cwd=cwd, timeout=120)
+
+
+def world_dirs(out: Path) -> list[Path]:
+    return sorted(p for p in out.iterdir() if p.is_dir()) if out.exists() else []
+
+
+# -- version, help, list ----------------------------------------------------------
+
+@pytest.mark.parametrize("how", ["script", "module"])
+def test_version(how):
+    cmd = WORLDGEN if how == "script" else [sys.executable, "-m", "worldgen.cli"]
+    r = run("--version", cmd=cmd)
+    assert r.returncode == 0 and r.stdout == f"worldgen {worldgen.__version__}\n" and r.stderr == ""
+
+
+def test_help_shows_commands_and_examples():
+    r = run("--help")
+    assert r.returncode == 0 and "generate" in r.stdout and "list" in r.stdout
+    r = run("generate", "--help")
+    assert r.returncode == 0
+    for option in ("--seed", "--set", "--out", "--formats", "--sdf-version", "--count"):
+        assert option in r.stdout
+    for example in get("cluttered").examples:
+        assert example in r.stdout
+    bare = run()
+    assert bare.returncode == 0 and "Usage:" in bare.stdout
+
+
+def test_list_shows_every_parameter_with_default_range_and_unit():
+    r = run("list")
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    spec = get("cluttered")
+    assert lines[0] == f"cluttered: {spec.summary}"
+    for p in spec.all_params:
+        row = next((line for line in lines if line.split()[:1] == [p.name]), None)
+        assert row is not None, p.name
+        assert p.kind in row.split()
+        assert describe_range(p) in row, (p.name, row)
+        if p.unit:
+            assert f"  {p.unit}  " in row
+        assert p.doc in row
+    assert re.search(r"^  n_obstacles\s+int\s+20\s+integer in \[0, 5000\]\s+-\s+number of obstacles", r.stdout, re.M)
+    assert re.search(r"^  size\s+pair\s+10,10\s+each in \[1, 500\]\s+m\s", r.stdout, re.M)
+
+
+def test_list_json_matches_the_registry():
+    r = run("list", "--json")
+    assert r.returncode == 0, r.stderr
+    doc = json.loads(r.stdout)
+    assert doc["worldgen_version"] == worldgen.__version__
+    gens = {g["name"]: g for g in doc["generators"]}
+    spec = get("cluttered")
+    params = {p["name"]: p for p in gens["cluttered"]["params"]}
+    assert set(params) == {p.name for p in spec.all_params}
+    for p in spec.all_params:
+        entry = params[p.name]
+        assert (entry["kind"], entry["default"], entry["low"], entry["high"], entry["unit"]) == (
+            p.kind, p.default, p.low, p.high, p.unit)
+    assert gens["cluttered"]["examples"] == list(spec.examples)
+
+
+# -- generate ---------------------------------------------------------------------
+
+def test_generate_writes_one_complete_folder_and_reports_it(tmp_path):
+    out = tmp_path / "worlds"
+    r = run("generate", "cluttered", "--seed", 7, *QUICK, "--out", out)
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == ""
+    [folder] = world_dirs(out)
+    assert sorted(p.name for p in folder.iterdir()) == ["world.json", "world.mjcf.xml", "world.sdf", "world.urdf"]
+    meta = json.loads((folder / "world.json").read_text())
+    assert folder.name == meta["world_id"] and meta["seed"] == 7
+    assert meta["params"]["size"] == [6.0, 6.0] and meta["params"]["n_obstacles"] == 6
+    [line] = r.stdout.splitlines()
+    assert line == (f"{folder}\tpath {meta['tasks'][0]['path']['length']:.3f} m"
+                    f"\tattempts {meta['feasibility']['attempts']}")
+    assert '<sdf version="1.9"' in (folder / "world.sdf").read_text()
+
+
+def test_count_makes_consecutive_seeds(tmp_path):
+    r = run("generate", "cluttered", "--seed", 40, "--count", 3, *QUICK, "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    folders = world_dirs(tmp_path)
+    seeds = sorted(json.loads((f / "world.json").read_text())["seed"] for f in folders)
+    assert seeds == [40, 41, 42]
+    assert len(r.stdout.splitlines()) == 3
+    assert {line.split("\t")[0] for line in r.stdout.splitlines()} == {str(f) for f in folders}
+
+
+@pytest.mark.parametrize("formats, files", [
+    ("mjcf", {"world.mjcf.xml"}),
+    ("urdf,sdf", {"world.sdf", "world.urdf"}),
+])
+def test_formats_subset_writes_only_those(tmp_path, formats, files):
+    r = run("generate", "cluttered", *QUICK, "--formats", formats, "--sdf-version", "1.6", "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    [folder] = world_dirs(tmp_path)
+    assert {p.name for p in folder.iterdir()} == files | {"world.json"}
+    meta = json.loads((folder / "world.json").read_text())
+    assert {e["path"] for e in meta["files"].values()} == files
+    if "world.sdf" in files:
+        assert '<sdf version="1.6"' in (folder / "world.sdf").read_text()
+
+
+# -- mistakes -----------------------------------------------------------------------
+
+MISTAKES = {
+    # name: (arguments after "generate" or a full command, regex of the one stderr line)
+    "unknown generator": (["generate", "forest", "--out", "{out}"],
+                          r"error: unknown generator 'forest'; available: .*cluttered"),
+    "unknown parameter": (["generate", "cluttered", "--set", "n_trees=3", "--out", "{out}"],
+                          r"error: unknown parameter 'n_trees' for generator 'cluttered'; known parameters: .*, n_obstacles, .*"),
+    "out of range": (["generate", "cluttered", "--set", "n_obstacles=9000", "--out", "{out}"],
+                     r"error: parameter 'n_obstacles' must be in \[0, 5000\], got 9000"),
+    "not a number": (["generate", "cluttered", "--set", "clearance=wide", "--out", "{out}"],
+                     r"error: parameter 'clearance' must be a number in \[0, 2\], got 'wide'"),
+    "bad pair": (["generate", "cluttered", "--set", "size=10", "--out", "{out}"],
+                 r"error: parameter 'size' must be two numbers, each in \[1, 500\], got \[10\]"),
+    "bad choice": (["generate", "cluttered", "--set", "obstacle_shapes=cone", "--out", "{out}"],
+                   r"error: parameter 'obstacle_shapes' must be one of box, cylinder, mixed, got 'cone'"),
+    "bad --set syntax": (["generate", "cluttered", "--set", "n_obstacles", "--out", "{out}"],
+                         r"error: --set expects KEY=VALUE \(e\.g\. --set n_obstacles=50\), got 'n_obstacles'"),
+    "seed in --set": (["generate", "cluttered", "--set", "seed=3", "--out", "{out}"],
+                      r"error: unknown parameter 'seed' for generator 'cluttered' \(the seed is set with --seed\); known .*"),
+    "bad formats": (["generate", "cluttered", "--formats", "sdf,obj", "--out", "{out}"],
+                    r"error: parameter 'formats' must name formats among sdf, mjcf, urdf, got 'obj'"),
+    "empty formats": (["generate", "cluttered", "--formats", ",", "--out", "{out}"],
+                      r"error: parameter 'formats' must name at least one of sdf, mjcf, urdf, got nothing"),
+    "bad sdf version": (["generate", "cluttered", "--sdf-version", "1.7", "--out", "{out}"],
+                        r"error: Invalid value for '--sdf-version': '1\.7' is not one of '1\.9', '1\.6'\..*"),
+    "negative seed": (["generate", "cluttered", "--seed", "-1", "--out", "{out}"],
+                      r"error: Invalid value for '--seed': -1 is not in the range 0<=x<=9223372036854775807\..*"),
+    "zero count": (["generate", "cluttered", "--count", "0", "--out", "{out}"],
+                   r"error: Invalid value for '--count': 0 is not in the range 1<=x<=100000\..*"),
+    "missing --out": (["generate", "cluttered"], r"error: Missing option '--out'\..*"),
+    "unknown command": (["grow", "cluttered"], r"error: No such command 'grow'\..*"),
+    "out is a file": (["generate", "cluttered", "--out", "{file}"],
+                      r"error: --out '.*afile' is not a folder; give a folder to write worlds into"),
+    "out under a file": (["generate", "cluttered", "--out", "{file}/worlds"],
+                         r"error: --out '.*afile/worlds' cannot be created: '.*afile' is a file, not a folder"),
+    "unreachable spawn-goal distance": (
+        ["generate", "cluttered", "--set", "min_spawn_goal_distance=50", "--out", "{out}"],
+        r"error: parameter 'min_spawn_goal_distance' must be in \[0, 13\.435\] for this room and robot .*, got 50\.0"),
+    "infeasible": (["generate", "cluttered", "--seed", "5", "--set", "size=5,5", "--set", "n_obstacles=400",
+                    "--set", "max_attempts=3", "--out", "{out}"],
+                   r"error: no feasible 'cluttered' world for seed 5 within max_attempts=3: "
+                   r"obstacle_placement failed 3x \(first obstacle_placement: could not place 400 obstacles .*\)"),
+}
+
+
+@pytest.mark.parametrize("mistake", sorted(MISTAKES))
+def test_mistake_gives_one_line_and_status_2(tmp_path, mistake):
+    args, pattern = MISTAKES[mistake]
+    out = tmp_path / "out"
+    afile = tmp_path / "afile"
+    afile.write_text("not a folder")
+    r = run(*[a.format(out=out, file=afile) for a in args], cwd=tmp_path)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert "Traceback" not in r.stderr and r.stdout == ""
+    lines = r.stderr.splitlines()
+    assert len(lines) == 1, r.stderr
+    assert re.fullmatch(pattern, lines[0]), lines[0]
+    assert not out.exists() or list(out.iterdir()) == []
+    assert afile.read_text() == "not a folder"
+
+
+# -- nothing half written ----------------------------------------------------------
+
+FRAGILE = {"size": [5.0, 5.0], "n_obstacles": 16, "max_attempts": 1, "min_spawn_goal_distance": 2.0}
+
+
+def _fragile_run_start() -> int:
+    """A seed s whose worlds s and s+1 can be made but s+2 cannot (with FRAGILE params)."""
+    ok = {}
+
+    def feasible(seed):
+        if seed not in ok:
+            try:
+                worldgen.generate("cluttered", seed, **FRAGILE)
+                ok[seed] = True
+            except InfeasibleError:
+                ok[seed] = False
+        return ok[seed]
+
+    for s in range(300):
+        if not feasible(s + 2) and feasible(s) and feasible(s + 1):
+            return s
+    pytest.fail("no seed run ok, ok, infeasible found for the fragile parameters")
+
+
+def test_failure_on_world_3_of_5_leaves_worlds_1_2_complete(tmp_path):
+    start = _fragile_run_start()
+    sets = [a for k, v in FRAGILE.items() for a in ("--set", f"{k}={v if not isinstance(v, list) else ','.join(map(str, v))}")]
+    r = run("generate", "cluttered", "--seed", start, "--count", 5, *sets, "--out", tmp_path)
+    assert r.returncode == 2
+    assert "Traceback" not in r.stderr
+    [line] = r.stderr.splitlines()
+    assert line.startswith(f"error: no feasible 'cluttered' world for seed {start + 2} within max_attempts=1: ")
+    assert len(r.stdout.splitlines()) == 2
+    # Exactly two folders, complete, and no temporary folder left behind.
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []
+    folders = world_dirs(tmp_path)
+    assert sorted(json.loads((f / "world.json").read_text())["seed"] for f in folders) == [start, start + 1]
+    for folder in folders:
+        meta = json.loads((folder / "world.json").read_text())
+        assert {p.name for p in folder.iterdir()} == {e["path"] for e in meta["files"].values()} | {"world.json"}
