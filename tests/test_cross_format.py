@@ -1,0 +1,186 @@
+"""The same world in every format: what MuJoCo compiles from the MJCF and from the URDF has the
+scene's names, world poses and (SDF-convention) sizes, and world.json's entities say the same.
+
+Everything is read back from the *compiled* model after ``mj_forward`` (``geom_xpos``,
+``geom_xmat``, ``geom_size``, mesh vertices), never from our own XML.
+"""
+
+from __future__ import annotations
+
+import json
+
+import mujoco
+import numpy as np
+import pytest
+
+from conftest import draft
+from export_scenes import showcase_scene
+from reftools_mujoco import load
+from worldgen.export import meshes, metadata, mjcf, urdf
+from worldgen.export.xml import to_bytes
+from worldgen.feasibility import FeasibilityReport
+from worldgen.scene import Robot, rpy_matrix
+from worldgen.world import World
+
+TOL = 2e-5  # 6-decimal output, composed through at most a few frames of a metre or two
+
+
+def _quat_matrix(q) -> np.ndarray:
+    m = np.zeros(9)
+    mujoco.mju_quat2Mat(m, np.asarray(q, dtype=float))
+    return m.reshape(3, 3)
+
+
+def compiled(scene, fmt: str):
+    """(model, data) after mj_forward, with every revolute joint at the scene's initial angle."""
+    if fmt == "mjcf":
+        model = load(to_bytes(mjcf.to_mjcf(scene)))
+    else:
+        model = load(to_bytes(urdf.to_urdf(scene)), assets=meshes.mesh_files(scene))
+    data = mujoco.MjData(model)
+    for joint in scene.joints:
+        if joint.kind == "revolute":
+            # MJCF starts there by itself (ref = initial); URDF cannot say it, so set it as a user would.
+            if fmt == "mjcf":
+                assert data.joint(joint.name).qpos[0] == pytest.approx(joint.initial)
+            data.joint(joint.name).qpos[0] = joint.initial
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def geom_frame(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """The world frame (position, rotation) of the entity a geom stands for.
+
+    MuJoCo re-centres a mesh on its centroid and turns it to its principal axes
+    (``mesh_pos``/``mesh_quat``); undo that to get back the entity's own frame.
+    """
+    g = model.geom(name)
+    pos, rot = data.geom(name).xpos.copy(), data.geom(name).xmat.reshape(3, 3).copy()
+    if g.type[0] == mujoco.mjtGeom.mjGEOM_MESH:
+        mesh = g.dataid[0]
+        mrot = _quat_matrix(model.mesh_quat[mesh])
+        rot = rot @ mrot.T
+        pos = pos - rot @ model.mesh_pos[mesh]
+    return pos, rot
+
+
+def world_aabb(model, data, name: str) -> np.ndarray:
+    """(2, 3) world AABB of a box or mesh geom, as the scene defines it, from the compiled model.
+
+    For a mesh that is the box around the mesh's own-frame bounding box (turned with the
+    entity), so the compiled vertices are first brought back into the entity's frame.
+    """
+    g = model.geom(name)
+    if g.type[0] == mujoco.mjtGeom.mjGEOM_BOX:
+        half = g.size
+    else:
+        mesh = g.dataid[0]
+        start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
+        local = model.mesh_vert[start:start + count] @ _quat_matrix(model.mesh_quat[mesh]).T + model.mesh_pos[mesh]
+        lo, hi = local.min(axis=0), local.max(axis=0)
+    pos, rot = geom_frame(model, data, name)
+    signs = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
+    if g.type[0] == mujoco.mjtGeom.mjGEOM_BOX:
+        corners = (2 * signs - 1) * half
+    else:
+        corners = lo + signs * (hi - lo)
+    pts = corners @ rot.T + pos
+    return np.array([pts.min(axis=0), pts.max(axis=0)])
+
+
+def sdf_size(model, name: str) -> dict:
+    """The geom's size in SDF's conventions (full box extents, cylinder radius and length)."""
+    g = model.geom(name)
+    kind, size = g.type[0], g.size
+    if kind == mujoco.mjtGeom.mjGEOM_BOX:
+        return {"type": "box", "size": list(2 * size)}
+    if kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+        return {"type": "cylinder", "radius": size[0], "length": 2 * size[1]}
+    if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+        return {"type": "sphere", "radius": size[0]}
+    assert kind == mujoco.mjtGeom.mjGEOM_MESH
+    return {"type": "mesh", "scale": list(model.mesh_scale[g.dataid[0]])}
+
+
+def assert_same_shape(got: dict, want: dict, what: str):
+    assert got["type"] == want["type"], what
+    for key, value in want.items():
+        if key in ("type", "uri"):
+            continue
+        np.testing.assert_allclose(got[key], value, atol=TOL, err_msg=f"{what} {key}")
+
+
+def scenes():
+    yield "showcase", showcase_scene()
+    for seed in (0, 1, 7):
+        yield f"cluttered-{seed}", draft("cluttered", seed)[0]
+    yield "cluttered-big", draft("cluttered", 2, size=[20.0, 20.0], n_obstacles=100)[0]
+
+
+SCENES = dict(scenes())
+
+
+@pytest.mark.parametrize("fmt", ["mjcf", "urdf"])
+@pytest.mark.parametrize("key", list(SCENES))
+def test_compiled_model_matches_the_scene(key, fmt):
+    scene = SCENES[key]
+    model, data = compiled(scene, fmt)
+    shaped = [n for n in scene.nodes if n.shape is not None]
+    # MJCF draws markers too; URDF's collision geoms are what MuJoCo keeps.
+    expected = [n for n in shaped if fmt == "mjcf" or n.collision]
+    assert sorted(model.geom(i).name for i in range(model.ngeom)) == sorted(n.name for n in expected)
+    for node in expected:
+        m = scene.world_matrix(node.name)
+        pos, rot = geom_frame(model, data, node.name)
+        np.testing.assert_allclose(pos, m[:3, 3], atol=TOL, err_msg=f"{fmt} {node.name} position")
+        np.testing.assert_allclose(rot, m[:3, :3], atol=TOL, err_msg=f"{fmt} {node.name} orientation")
+        assert_same_shape(sdf_size(model, node.name), node.shape.describe(), f"{fmt} {node.name}")
+        if node.shape.kind in ("box", "mesh"):
+            np.testing.assert_allclose(world_aabb(model, data, node.name), scene.aabb(node.name),
+                                       atol=1e-4, err_msg=f"{fmt} {node.name} aabb")
+
+
+def test_door_turns_the_same_way_in_mjcf_and_urdf():
+    """Same joint value, same leaf pose: axis, hinge point and zero angle agree between formats."""
+    scene = showcase_scene()
+    poses = []
+    for fmt in ("mjcf", "urdf"):
+        model, data = compiled(scene, fmt)
+        data.joint("door_hinge").qpos[0] = 1.2
+        mujoco.mj_forward(model, data)
+        poses.append((data.geom("door_leaf").xpos.copy(), data.geom("door_handle").xmat.copy()))
+        # The hinge line stays put while the leaf turns: the leaf's inner edge keeps its place.
+        hinge_world = data.body("door_post").xpos + data.body("door_post").xmat.reshape(3, 3) @ (0.0, 0.1, -0.05)
+        assert np.linalg.norm((data.geom("door_leaf").xpos - hinge_world)[:2]) == pytest.approx(0.45, abs=TOL)
+    np.testing.assert_allclose(poses[0][0], poses[1][0], atol=TOL)
+    np.testing.assert_allclose(poses[0][1], poses[1][1], atol=TOL)
+
+
+def _world_json(scene) -> dict:
+    """world.json of ``scene`` through the metadata exporter, parsed back from its canonical text."""
+    world = World("cluttered", 0, {}, scene, (), Robot(0.2, 0.5, 0.1), FeasibilityReport((), (), None), 1)
+    return json.loads(metadata.dumps(world.metadata_for({})))
+
+
+@pytest.mark.parametrize("fmt", ["mjcf", "urdf"])
+@pytest.mark.parametrize("key", ["showcase", "cluttered-1"])
+def test_compiled_model_matches_world_json(key, fmt):
+    scene = SCENES[key]
+    model, data = compiled(scene, fmt)
+    entities = _world_json(scene)["entities"]
+    assert [e["name"] for e in entities] == [n.name for n in scene.nodes]
+    body_names = {model.body(i).name for i in range(1, model.nbody)}
+    for entity in entities:
+        name = entity["name"]
+        if fmt == "urdf":
+            assert name in body_names  # every entity is a link, markers included
+        if entity["shape"] is None or (fmt == "urdf" and entity["role"] == "marker"):
+            continue
+        pose = np.asarray(entity["pose"])
+        pos, rot = geom_frame(model, data, name)
+        np.testing.assert_allclose(pos, pose[:3], atol=TOL, err_msg=f"{fmt} {name} position")
+        np.testing.assert_allclose(rot, rpy_matrix(*pose[3:]), atol=TOL, err_msg=f"{fmt} {name} orientation")
+        assert_same_shape(sdf_size(model, name), entity["shape"], f"{fmt} {name}")
+        if entity["shape"]["type"] in ("box", "mesh"):
+            np.testing.assert_allclose(world_aabb(model, data, name), entity["aabb"], atol=1e-4,
+                                       err_msg=f"{fmt} {name} aabb")
