@@ -110,7 +110,7 @@ def test_generate_writes_one_complete_folder_and_reports_it(tmp_path):
 
 
 def test_count_makes_consecutive_seeds(tmp_path):
-    r = run("generate", "cluttered", "--seed", 40, "--count", 3, *QUICK, "--out", tmp_path)
+    r = run("generate", "cluttered", "--seed", 40, "--count", 3, *QUICK, "--set", "density=none", "--out", tmp_path)
     assert r.returncode == 0, r.stderr
     folders = world_dirs(tmp_path)
     seeds = sorted(json.loads((f / "world.json").read_text())["seed"] for f in folders)
