@@ -55,7 +55,7 @@ import numpy as np
 from lxml import etree
 
 from worldgen.errors import ParameterError, WorldgenError
-from worldgen.export.xml import load_template, sub
+from worldgen.export.xml import load_template
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose
 from worldgen.scene.graph import Joint
@@ -70,10 +70,19 @@ TEMPLATE = "world.sdf"
 MIN_MOMENT = 1e-6
 
 
-def to_sdf(scene: Scene, version: str = "1.9", name: str = "world") -> etree._ElementTree:
-    """The SDFormat world of ``scene`` as an lxml tree (see the module docstring)."""
+def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> etree._ElementTree:
+    """The SDFormat world of ``scene`` as an lxml tree (see the module docstring).
+
+    ``name`` is the world's name; SDFormat 1.8+ reserves ``world`` and names
+    starting with ``__``, so the default is Gazebo's usual ``default``.
+    """
     if version not in SDF_VERSIONS:
         raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
+    if not name or name == "world" or name.startswith("__"):
+        raise ParameterError(f"parameter 'name' must be a non-empty SDF world name other than 'world' "
+                             f"and not starting with '__', got {name!r}")
+    if "world" in {n.name for n in scene.nodes}:
+        raise WorldgenError("no node may be named 'world': SDFormat reserves that name for the world frame")
     tree = load_template(TEMPLATE)
     root = tree.getroot()
     root.set("version", version)
@@ -113,6 +122,8 @@ class _ModelWriter:
             self.joint_of[joint.child] = joint
         # Every name a generated joint must avoid: links and joints share a model's name scope.
         self.taken = {n.name for n in scene.nodes} | {j.name for j in scene.joints}
+        self.surfaces: dict[float, etree._Element] = {}
+        self.materials: dict[tuple, etree._Element] = {}
 
     def subtree(self, root: Node) -> list[Node]:
         """``root`` and its descendants, depth first, children in scene order."""
@@ -126,8 +137,8 @@ class _ModelWriter:
     def write(self, world, root: Node) -> None:
         nodes = self.subtree(root)
         static = all(n.static for n in nodes)
-        model = sub(world, "model", name=root.name)
-        sub(model, "static", "true" if static else "false")
+        model = _el(world, "model", name=root.name)
+        _el(model, "static", "true" if static else "false")
         _pose(model, root.pose)
         names = {n.name for n in nodes}
         for node in nodes:
@@ -157,7 +168,7 @@ class _ModelWriter:
         return name
 
     def _link(self, model, node: Node, root: Node, with_inertial: bool) -> None:
-        link = sub(model, "link", name=node.name)
+        link = _el(model, "link", name=node.name)
         if node is not root:
             if self.frames:
                 _pose(link, node.pose, relative_to=node.parent)
@@ -168,20 +179,35 @@ class _ModelWriter:
             _inertial(link, node)
         if node.shape is None:
             return
+        geometry = _geometry(node.shape)
         if node.collision:
-            collision = sub(link, "collision", name="collision")
-            _geometry(collision, node.shape)
-            ode = sub(sub(sub(collision, "surface"), "friction"), "ode")
-            sub(ode, "mu", fmt(node.material.friction))
-            sub(ode, "mu2", fmt(node.material.friction))
-        visual = sub(link, "visual", name="visual")
-        _geometry(visual, node.shape)
-        rgba = node.material.rgba
-        material = sub(visual, "material")
-        sub(material, "ambient", fmt_seq(rgba))
-        sub(material, "diffuse", fmt_seq(rgba))
-        if rgba[3] < 1.0:
-            sub(visual, "transparency", fmt(1.0 - rgba[3]))
+            collision = _el(link, "collision", name="collision")
+            collision.append(_clone(geometry))
+            collision.append(_clone(self._surface(node.material.friction)))
+        visual = _el(link, "visual", name="visual")
+        visual.append(geometry)
+        visual.append(_clone(self._material(node.material.rgba)))
+        if node.material.rgba[3] < 1.0:
+            _el(visual, "transparency", fmt(1.0 - node.material.rgba[3]))
+
+    # Surfaces and colours repeat across many nodes: build each once, copy it after.
+    def _surface(self, friction: float):
+        if friction not in self.surfaces:
+            surface = etree.Element("surface")
+            ode = _el(_el(surface, "friction"), "ode")
+            _el(ode, "mu", fmt(friction))
+            _el(ode, "mu2", fmt(friction))
+            self.surfaces[friction] = surface
+        return self.surfaces[friction]
+
+    def _material(self, rgba: tuple):
+        if rgba not in self.materials:
+            material = etree.Element("material")
+            text = fmt_seq(rgba)
+            _el(material, "ambient", text)
+            _el(material, "diffuse", text)
+            self.materials[rgba] = material
+        return self.materials[rgba]
 
     def _joint(self, model, joint: Joint, names: set[str]) -> None:
         if joint.parent != "world" and joint.parent not in names:
@@ -193,26 +219,26 @@ class _ModelWriter:
             if not _is_identity(joint.pose):
                 element.insert(0, _pose_element(joint.pose))
             return
-        element = sub(model, "joint", name=joint.name, type="revolute")
+        element = _el(model, "joint", name=joint.name, type="revolute")
         if not _is_identity(joint.pose):
             _pose(element, joint.pose)
-        sub(element, "parent", joint.parent)
-        sub(element, "child", joint.child)
-        axis = sub(element, "axis")
-        sub(axis, "xyz", fmt_seq(joint.axis))
-        sub(sub(axis, "dynamics"), "damping", fmt(joint.damping))
-        limit = sub(axis, "limit")
+        _el(element, "parent", joint.parent)
+        _el(element, "child", joint.child)
+        axis = _el(element, "axis")
+        _el(axis, "xyz", fmt_seq(joint.axis))
+        _el(_el(axis, "dynamics"), "damping", fmt(joint.damping))
+        limit = _el(axis, "limit")
         # The written poses are the joint's zero: measure the limits from the initial angle.
-        sub(limit, "lower", fmt(joint.limits[0] - joint.initial))
-        sub(limit, "upper", fmt(joint.limits[1] - joint.initial))
-        sub(limit, "effort", fmt(joint.effort))
-        sub(limit, "velocity", fmt(joint.velocity))
+        _el(limit, "lower", fmt(joint.limits[0] - joint.initial))
+        _el(limit, "upper", fmt(joint.limits[1] - joint.initial))
+        _el(limit, "effort", fmt(joint.effort))
+        _el(limit, "velocity", fmt(joint.velocity))
 
     @staticmethod
     def _fixed(model, name: str, parent: str, child: str):
-        element = sub(model, "joint", name=name, type="fixed")
-        sub(element, "parent", parent)
-        sub(element, "child", child)
+        element = _el(model, "joint", name=name, type="fixed")
+        _el(element, "parent", parent)
+        _el(element, "child", child)
         return element
 
 
@@ -233,33 +259,48 @@ def _pose(parent, pose: Pose, relative_to: Optional[str] = None) -> None:
 
 
 def _inertial(link, node: Node) -> None:
-    inertial = sub(link, "inertial")
+    inertial = _el(link, "inertial")
     if isinstance(node.shape, Mesh):
         # The moments are those of the mesh's bounding box, about the box's centre.
         v = node.shape.scaled_vertices()
         centre = (v.min(axis=0) + v.max(axis=0)) / 2.0
         if any(fmt(c) != "0" for c in centre):
             _pose(inertial, Pose(*centre))
-    sub(inertial, "mass", fmt(node.mass))
+    _el(inertial, "mass", fmt(node.mass))
     ixx, iyy, izz = (max(i, MIN_MOMENT) for i in node.inertia)
-    inertia = sub(inertial, "inertia")
+    inertia = _el(inertial, "inertia")
     for tag, value in (("ixx", ixx), ("ixy", 0.0), ("ixz", 0.0), ("iyy", iyy), ("iyz", 0.0), ("izz", izz)):
-        sub(inertia, tag, fmt(value))
+        _el(inertia, tag, fmt(value))
 
 
-def _geometry(parent, shape) -> None:
-    geometry = sub(parent, "geometry")
+def _clone(element: etree._Element) -> etree._Element:
+    """A deep copy of a small cached subtree (lxml's own copy, without the copy module's dispatch)."""
+    return element.__deepcopy__(None)
+
+
+def _el(parent, tag: str, text: Optional[str] = None, **attrs) -> etree._Element:
+    """``sub`` without its per-attribute loop: this exporter's hot path."""
+    element = etree.SubElement(parent, tag, attrs) if attrs else etree.SubElement(parent, tag)
+    if text is not None:
+        element.text = text
+    return element
+
+
+def _geometry(shape) -> etree._Element:
+    """A detached ``<geometry>`` element for ``shape`` (SDF sizes: full extents, radius, length)."""
+    geometry = etree.Element("geometry")
     if isinstance(shape, Box):
-        sub(sub(geometry, "box"), "size", fmt_seq(shape.size))
+        _el(_el(geometry, "box"), "size", fmt_seq(shape.size))
     elif isinstance(shape, Cylinder):
-        cylinder = sub(geometry, "cylinder")
-        sub(cylinder, "radius", fmt(shape.radius))
-        sub(cylinder, "length", fmt(shape.length))
+        cylinder = _el(geometry, "cylinder")
+        _el(cylinder, "radius", fmt(shape.radius))
+        _el(cylinder, "length", fmt(shape.length))
     elif isinstance(shape, Sphere):
-        sub(sub(geometry, "sphere"), "radius", fmt(shape.radius))
+        _el(_el(geometry, "sphere"), "radius", fmt(shape.radius))
     elif isinstance(shape, Mesh):
-        mesh = sub(geometry, "mesh")
-        sub(mesh, "uri", shape.uri)
-        sub(mesh, "scale", fmt_seq(shape.scale))
+        mesh = _el(geometry, "mesh")
+        _el(mesh, "uri", shape.uri)
+        _el(mesh, "scale", fmt_seq(shape.scale))
     else:
         raise WorldgenError(f"the SDF exporter has no geometry for shape {shape!r}")
+    return geometry
