@@ -16,7 +16,7 @@ from worldgen.export.xml import parse_bytes, to_bytes
 from worldgen.scene import Box, Joint, Material, Node, Physics, Pose, Scene
 
 #: (seed, params): the default room, a crowded big room, boxes only, no walls, tall thin cylinders.
-CLUTTERED_CASES = [(seed, {}) for seed in range(20)] + [
+CLUTTERED_CASES = [(seed, {}) for seed in range(50)] + [
     (0, {"size": [20.0, 20.0], "n_obstacles": 200}),
     (3, {"size": [20.0, 20.0], "n_obstacles": 50, "obstacle_shapes": "box"}),
     (4, {"walls": False, "n_obstacles": 30}),

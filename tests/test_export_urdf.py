@@ -18,7 +18,7 @@ from worldgen.export import meshes, urdf
 from worldgen.export.xml import parse_bytes, to_bytes
 from worldgen.scene import Box, Mesh, Node, Pose, Scene
 
-CLUTTERED_CASES = [(seed, {}) for seed in range(12)] + [
+CLUTTERED_CASES = [(seed, {}) for seed in range(30)] + [
     (0, {"size": [20.0, 20.0], "n_obstacles": 200}),
     (4, {"walls": False, "n_obstacles": 30}),
     (6, {"n_obstacles": 0}),

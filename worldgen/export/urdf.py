@@ -147,44 +147,52 @@ def _first_link_index(robot) -> int:
     return len(robot)
 
 
-def _origin(parent_el, m: np.ndarray):
-    pose = matrix_to_pose(m)
-    return sub(parent_el, "origin", xyz=fmt_seq((pose.x, pose.y, pose.z)), rpy=fmt_seq((pose.roll, pose.pitch, pose.yaw)))
+#: The identity origin, by far the most common one: written without any matrix work.
+_IDENTITY = {"xyz": "0 0 0", "rpy": "0 0 0"}
+
+
+def _pose_attrs(pose) -> dict[str, str]:
+    return {"xyz": fmt_seq((pose.x, pose.y, pose.z)), "rpy": fmt_seq((pose.roll, pose.pitch, pose.yaw))}
+
+
+def _matrix_attrs(m: np.ndarray) -> dict[str, str]:
+    return _pose_attrs(matrix_to_pose(m))
 
 
 def _write_link(robot, node: Node, joint: Joint | None, materials) -> None:
     link = sub(robot, "link", name=node.name)
-    back = np.linalg.inv(link_offset(joint))  # the node frame in the link frame
+    offset = link_offset(joint) if joint is not None and joint.kind == "revolute" else None
+    back = _IDENTITY if offset is None else _matrix_attrs(np.linalg.inv(offset))  # node frame in link frame
     inertial = sub(link, "inertial")
-    _origin(inertial, back)
+    sub(inertial, "origin", **back)
     mass, (ixx, iyy, izz) = mass_properties(node)
     sub(inertial, "mass", value=mass)
     sub(inertial, "inertia", ixx=ixx, ixy="0", ixz="0", iyy=iyy, iyz="0", izz=izz)
     if node.shape is None:
         return
+    kind, attrs = _geometry_attrs(node)
     visual = sub(link, "visual", name=node.name)
-    _origin(visual, back)
-    _geometry(visual, node)
+    sub(visual, "origin", **back)
+    sub(sub(visual, "geometry"), kind, **attrs)
     sub(visual, "material", name=materials[node.name])
     if node.collision:
         collision = sub(link, "collision", name=node.name)
-        _origin(collision, back)
-        _geometry(collision, node)
+        sub(collision, "origin", **back)
+        sub(sub(collision, "geometry"), kind, **attrs)
 
 
-def _geometry(parent_el, node: Node) -> None:
-    geometry = sub(parent_el, "geometry")
+def _geometry_attrs(node: Node) -> tuple[str, dict[str, str]]:
+    """(element name, attributes) of the node's shape inside ``<geometry>``."""
     shape = node.shape
     if isinstance(shape, Box):
-        sub(geometry, "box", size=fmt_seq(shape.size))
-    elif isinstance(shape, Cylinder):
-        sub(geometry, "cylinder", radius=fmt(shape.radius), length=fmt(shape.length))
-    elif isinstance(shape, Sphere):
-        sub(geometry, "sphere", radius=fmt(shape.radius))
-    elif isinstance(shape, Mesh):
-        sub(geometry, "mesh", filename=shape.uri, scale=fmt_seq(shape.scale))
-    else:
-        raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
+        return "box", {"size": fmt_seq(shape.size)}
+    if isinstance(shape, Cylinder):
+        return "cylinder", {"radius": fmt(shape.radius), "length": fmt(shape.length)}
+    if isinstance(shape, Sphere):
+        return "sphere", {"radius": fmt(shape.radius)}
+    if isinstance(shape, Mesh):
+        return "mesh", {"filename": shape.uri, "scale": fmt_seq(shape.scale)}
+    raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
 
 
 def _write_joint(robot, scene: Scene, node: Node, joint: Joint | None, parent_joint: Joint | None) -> None:
@@ -197,7 +205,11 @@ def _write_joint(robot, scene: Scene, node: Node, joint: Joint | None, parent_jo
     el = sub(robot, "joint", name=_joint_name(node, joint), type=kind)
     sub(el, "parent", link=node.parent or RESERVED_NAME)
     sub(el, "child", link=node.name)
-    _origin(el, zero_angle_origin(scene, node, joint, parent_joint))
+    if kind != "revolute" and (parent_joint is None or parent_joint.kind != "revolute"):
+        origin = _pose_attrs(node.pose)  # link frames are node frames here: the pose as the scene has it
+    else:
+        origin = _matrix_attrs(zero_angle_origin(scene, node, joint, parent_joint))
+    sub(el, "origin", **origin)
     if kind == "revolute":
         sub(el, "axis", xyz=fmt_seq(joint.axis))
         lo, hi = joint.limits
