@@ -32,20 +32,23 @@ def _quat_matrix(q) -> np.ndarray:
 
 
 def compiled(scene, fmt: str):
-    """(model, data) after mj_forward, with every revolute joint at the scene's initial angle."""
+    """(model, data) after mj_forward from the model's own initial state."""
     if fmt == "mjcf":
         model = load(to_bytes(mjcf.to_mjcf(scene)))
     else:
         model = load(to_bytes(urdf.to_urdf(scene)), assets=meshes.mesh_files(scene))
     data = mujoco.MjData(model)
-    for joint in scene.joints:
-        if joint.kind == "revolute":
-            # MJCF starts there by itself (ref = initial); URDF cannot say it, so set it as a user would.
-            if fmt == "mjcf":
-                assert data.joint(joint.name).qpos[0] == pytest.approx(joint.initial)
-            data.joint(joint.name).qpos[0] = joint.initial
     mujoco.mj_forward(model, data)
     return model, data
+
+
+def joint_value(fmt: str, joint, angle: float) -> float:
+    """The joint position that puts ``joint`` at ``angle`` (the scene's measure) in a format.
+
+    MJCF measures the scene's angle (ref = initial); URDF, like SDF, has no initial
+    angle and counts from it.
+    """
+    return angle if fmt == "mjcf" else angle - joint.initial
 
 
 def geom_frame(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -140,20 +143,34 @@ def test_compiled_model_matches_the_scene(key, fmt):
                                        atol=1e-4, err_msg=f"{fmt} {node.name} aabb")
 
 
-def test_door_turns_the_same_way_in_mjcf_and_urdf():
-    """Same joint value, same leaf pose: axis, hinge point and zero angle agree between formats."""
+@pytest.mark.parametrize("fmt", ["mjcf", "urdf"])
+def test_door_starts_at_its_initial_angle_and_keeps_its_range(fmt):
     scene = showcase_scene()
+    joint = scene.joints[0]
+    model, data = compiled(scene, fmt)
+    assert data.joint(joint.name).qpos[0] == pytest.approx(joint_value(fmt, joint, joint.initial))
+    lo, hi = joint.limits
+    np.testing.assert_allclose(model.jnt_range[model.joint(joint.name).id],
+                               (joint_value(fmt, joint, lo), joint_value(fmt, joint, hi)), atol=1e-9)
+
+
+def test_door_turns_the_same_way_in_mjcf_and_urdf():
+    """Same angle, same leaf pose: axis, hinge point and angle offset agree between formats."""
+    scene = showcase_scene()
+    joint = scene.joints[0]
     poses = []
     for fmt in ("mjcf", "urdf"):
         model, data = compiled(scene, fmt)
-        data.joint("door_hinge").qpos[0] = 1.2
+        data.joint(joint.name).qpos[0] = joint_value(fmt, joint, 1.2)
         mujoco.mj_forward(model, data)
         poses.append((data.geom("door_leaf").xpos.copy(), data.geom("door_handle").xmat.copy()))
-        # The hinge line stays put while the leaf turns: the leaf's inner edge keeps its place.
+        # The hinge line stays put while the leaf turns: the leaf's centre keeps its distance.
         hinge_world = data.body("door_post").xpos + data.body("door_post").xmat.reshape(3, 3) @ (0.0, 0.1, -0.05)
         assert np.linalg.norm((data.geom("door_leaf").xpos - hinge_world)[:2]) == pytest.approx(0.45, abs=TOL)
     np.testing.assert_allclose(poses[0][0], poses[1][0], atol=TOL)
     np.testing.assert_allclose(poses[0][1], poses[1][1], atol=TOL)
+    # And the turn really happened: 1.2 rad is not where the door started.
+    assert np.linalg.norm(poses[0][0] - scene.world_matrix("door_leaf")[:3, 3]) > 0.1
 
 
 def _world_json(scene) -> dict:

@@ -61,7 +61,8 @@ def test_showcase_passes_check_urdf_and_loads_from_file_and_from_memory(tmp_path
     assert model.body("goal_marker").geomnum[0] == 0
     hinge = model.joint("door_hinge")
     assert hinge.type[0] == mujoco.mjtJoint.mjJNT_HINGE
-    np.testing.assert_allclose(model.jnt_range[hinge.id], (-1.5, 1.5))
+    # The written pose is the initial angle (0.4 rad): limits (-1.5, 1.5) are counted from it.
+    np.testing.assert_allclose(model.jnt_range[hinge.id], (-1.9, 1.1))
     assert model.dof_damping[model.jnt_dofadr[hinge.id]] == pytest.approx(2.0)
     free = {model.joint(i).name for i in range(model.njnt) if model.jnt_type[i] == mujoco.mjtJoint.mjJNT_FREE}
     assert free == {"crate", "pebble", "loose_rock"}
@@ -78,7 +79,7 @@ def test_revolute_joints_carry_limit_and_dynamics_and_friction_goes_to_gazebo_ta
     assert joint.get("type") == "revolute"
     limit = joint.find("limit")
     assert {k: float(limit.get(k)) for k in ("lower", "upper", "effort", "velocity")} == {
-        "lower": -1.5, "upper": 1.5, "effort": 100.0, "velocity": 2.0}
+        "lower": -1.9, "upper": 1.1, "effort": 100.0, "velocity": 2.0}
     assert float(joint.find("dynamics").get("damping")) == 2.0
     for node in scene.nodes:
         gz = root.find(f"gazebo[@reference='{node.name}']")

@@ -19,10 +19,13 @@ URDF describes one kinematic tree, so a world becomes one "robot":
 - URDF puts a child link's frame on its joint, so for a revolute child the
   link frame is the scene Joint's frame and the shapes are offset back by the
   inverse of ``joint.pose``.
-- Initial angle: URDF has no place for it, and its joint origin is the pose
-  at angle 0. ``node.pose`` is the pose at ``joint.initial`` (as in the MJCF),
-  so the origin is that pose turned back by ``-initial`` about the axis; a
-  test or simulator sets the joint to world.json's ``doors[].angle``.
+- Initial angle: URDF has no place for it. ``node.pose`` is the pose at
+  ``joint.initial`` (a door ajar) and is written as it is, so the URDF shows
+  the same geometry as the SDF, the MJCF and world.json; the joint's zero is
+  therefore the initial angle, and the limits are shifted to keep the same
+  physical range: ``lower = lo - initial``, ``upper = hi - initial`` (the SDF
+  exporter does the same). The joint position a URDF simulator reports is
+  ``angle - initial``; world.json's ``doors[].angle`` holds ``initial``.
 - Friction is not part of URDF. Each colliding link gets
   ``<gazebo reference=...><mu1/><mu2/></gazebo>`` (Gazebo's URDF extension,
   read when Gazebo converts the URDF; check_urdf and MuJoCo ignore it).
@@ -34,8 +37,6 @@ URDF describes one kinematic tree, so a world becomes one "robot":
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from lxml import etree
 
@@ -44,19 +45,9 @@ from worldgen.export.xml import load_template, sub
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose
 
-__all__ = ["to_urdf", "TEMPLATE", "link_offset", "zero_angle_origin"]
+__all__ = ["to_urdf", "TEMPLATE", "link_offset", "joint_origin"]
 
 TEMPLATE = "world.urdf"
-
-
-def rotation_about(axis, angle: float) -> np.ndarray:
-    """(4, 4) rotation by ``angle`` rad about ``axis`` (any non-zero length) through the origin."""
-    a = np.asarray(axis, dtype=float)
-    a = a / np.linalg.norm(a)
-    k = np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
-    m = np.eye(4)
-    m[:3, :3] = np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)  # Rodrigues
-    return m
 
 
 def link_offset(joint: Joint | None) -> np.ndarray:
@@ -70,12 +61,9 @@ def link_offset(joint: Joint | None) -> np.ndarray:
     return np.eye(4)
 
 
-def zero_angle_origin(scene: Scene, node: Node, joint: Joint | None, parent_joint: Joint | None) -> np.ndarray:
-    """(4, 4) URDF joint origin: the node's link frame in its parent's link frame, at angle 0."""
-    local = node.pose.matrix() @ link_offset(joint)  # link frame in the parent node's frame, at initial
-    if joint is not None and joint.kind == "revolute" and joint.initial != 0.0:
-        local = local @ rotation_about(joint.axis, -joint.initial)
-    return np.linalg.inv(link_offset(parent_joint)) @ local
+def joint_origin(node: Node, joint: Joint | None, parent_joint: Joint | None) -> np.ndarray:
+    """(4, 4) URDF joint origin: the node's link frame in its parent's link frame (at the initial angle)."""
+    return np.linalg.inv(link_offset(parent_joint)) @ node.pose.matrix() @ link_offset(joint)
 
 
 def to_urdf(scene: Scene, name: str = "world"):
@@ -90,7 +78,7 @@ def to_urdf(scene: Scene, name: str = "world"):
         joint = joints.get(node.name)
         parent_joint = joints.get(node.parent) if node.parent is not None else None
         _write_link(robot, node, joint, materials)
-        _write_joint(robot, scene, node, joint, parent_joint)
+        _write_joint(robot, node, joint, parent_joint)
         if node.shape is not None and node.collision:
             gz = sub(robot, "gazebo", reference=node.name)
             sub(gz, "mu1", fmt(node.material.friction))
@@ -195,7 +183,7 @@ def _geometry_attrs(node: Node) -> tuple[str, dict[str, str]]:
     raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
 
 
-def _write_joint(robot, scene: Scene, node: Node, joint: Joint | None, parent_joint: Joint | None) -> None:
+def _write_joint(robot, node: Node, joint: Joint | None, parent_joint: Joint | None) -> None:
     if joint is not None and joint.kind == "revolute":
         kind = "revolute"
     elif node.parent is None and not node.static and joint is None:
@@ -208,10 +196,12 @@ def _write_joint(robot, scene: Scene, node: Node, joint: Joint | None, parent_jo
     if kind != "revolute" and (parent_joint is None or parent_joint.kind != "revolute"):
         origin = _pose_attrs(node.pose)  # link frames are node frames here: the pose as the scene has it
     else:
-        origin = _matrix_attrs(zero_angle_origin(scene, node, joint, parent_joint))
+        origin = _matrix_attrs(joint_origin(node, joint, parent_joint))
     sub(el, "origin", **origin)
     if kind == "revolute":
         sub(el, "axis", xyz=fmt_seq(joint.axis))
         lo, hi = joint.limits
-        sub(el, "limit", lower=fmt(lo), upper=fmt(hi), effort=fmt(joint.effort), velocity=fmt(joint.velocity))
+        # The written pose is the joint's zero: measure the limits from the initial angle.
+        sub(el, "limit", lower=fmt(lo - joint.initial), upper=fmt(hi - joint.initial),
+            effort=fmt(joint.effort), velocity=fmt(joint.velocity))
         sub(el, "dynamics", damping=fmt(joint.damping))
