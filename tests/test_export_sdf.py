@@ -133,6 +133,9 @@ def assert_matches_scene(dump: dict, scene: Scene) -> None:
             assert link["mass"] == pytest.approx(node.mass, abs=TOL), key
             want = [max(i, MIN_MOMENT) for i in node.inertia]
             assert_same_values(link["inertia"], want, key)
+        if node.shape is None:  # a pure frame: a link with nothing in it
+            assert f"{key}::visual" not in dump["visuals"] and f"{key}::collision" not in dump["collisions"]
+            continue
         kind, values = shape_values(node.shape)
         visual = dump["visuals"][f"{key}::visual"]
         assert visual[0] == kind, key
@@ -215,6 +218,24 @@ def test_hand_scene_passes_and_reads_back(tmp_path, version):
     weld = dump["joints"]["door_post::door_post_world"]
     assert (weld["type"], weld["parent"], weld["child"]) == ("fixed", "world", "door_post")
     assert not dump["models"]["door_post"]["static"]
+
+
+@pytest.mark.parametrize("version", VERSIONS)
+def test_frames_and_a_root_hinged_to_the_world(tmp_path, version):
+    """A shape-less frame between two links, and a root swinging on a revolute joint to the world."""
+    nodes = (
+        Node("floor", "floor", Box((4.0, 4.0, 0.1)), Pose(0, 0, -0.05)),
+        Node("flap", "door", Box((0.6, 0.05, 0.4)), Pose(1.0, 0.0, 0.5, 0, 0, 0.7), static=False, mass=2.0),
+        Node("mount", "obstacle", None, Pose(0.2, 0.0, 0.1, 0.3, 0, 0), parent="flap"),
+        Node("knob", "obstacle", Cylinder(0.02, 0.05), Pose(0.0, 0.05, 0.0, 0, 1.2, 0), parent="mount", mass=0.05),
+    )
+    hinge = Joint("flap_hinge", "revolute", "world", "flap", Pose(-0.3, 0, 0), (0, 0, 1), (-1.0, 1.0), 0.0, 0.1)
+    scene = Scene(nodes, (hinge,))
+    dump = dump_sdf(write_world(scene, tmp_path, version))
+    assert_matches_scene(dump, scene)
+    assert dump["joints"]["flap::flap_hinge"]["parent"] == "world"
+    assert dump["joints"]["flap::knob_fixed"]["parent"] == "mount"
+    assert sorted(dump["joints"]) == ["flap::flap_hinge", "flap::knob_fixed", "flap::mount_fixed"]
 
 
 def test_16_and_19_describe_the_same_world(tmp_path):
