@@ -201,3 +201,25 @@ def test_compiled_model_matches_world_json(key, fmt):
         if entity["shape"]["type"] in ("box", "mesh"):
             np.testing.assert_allclose(world_aabb(model, data, name), entity["aabb"], atol=1e-4,
                                        err_msg=f"{fmt} {name} aabb")
+
+
+@pytest.mark.parametrize("seed", [0, 11])
+def test_written_world_files_agree_with_their_world_json(tmp_path, seed):
+    """End to end: generate, write, then load world.mjcf.xml and world.urdf from the folder."""
+    import worldgen
+
+    folder = worldgen.generate("cluttered", seed=seed, n_obstacles=25).write(tmp_path)
+    meta = json.loads((folder / "world.json").read_text())
+    for fmt in ("mjcf", "urdf"):
+        path = folder / meta["files"][fmt]["path"]
+        model = load(path)
+        data = mujoco.MjData(model)
+        mujoco.mj_forward(model, data)
+        assert model.names.split(b"\0")[0].decode() == meta["world_id"]
+        for entity in meta["entities"]:
+            if entity["shape"] is None or (fmt == "urdf" and entity["role"] == "marker"):
+                continue
+            pos, rot = geom_frame(model, data, entity["name"])
+            np.testing.assert_allclose(pos, entity["pose"][:3], atol=TOL, err_msg=f"{fmt} {entity['name']}")
+            np.testing.assert_allclose(rot, rpy_matrix(*entity["pose"][3:]), atol=TOL)
+            assert_same_shape(sdf_size(model, entity["name"]), entity["shape"], f"{fmt} {entity['name']}")
