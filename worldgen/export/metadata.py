@@ -91,7 +91,7 @@ def dumps(meta: Mapping[str, Any]) -> str:
     (a pose, a point, a size) stays on one line so a 1000-entity world stays
     readable. ``dumps(json.loads(dumps(m))) == dumps(m)``.
     """
-    return _emit(_plain(meta), "") + "\n"
+    return _emit(meta, "") + "\n"
 
 
 def time_limit(length: float, robot_speed: float) -> float:
@@ -113,18 +113,21 @@ def free_area_ratio(scene, height: float) -> float:
     if not prints:
         return 1.0
     discs = [fp for fp in prints if fp.is_disc]
-    polys = [fp.polygon for fp in prints if not fp.is_disc]
+    polys = np.array([fp.polygon for fp in prints if not fp.is_disc], dtype=object)
     centre = np.array([fp.centre for fp in discs], dtype=float).reshape(-1, 2)
     radius = np.array([fp.radius for fp in discs], dtype=float)
     inside_d = ((centre[:, 0] - radius >= x0) & (centre[:, 0] + radius <= x1)
                 & (centre[:, 1] - radius >= y0) & (centre[:, 1] + radius <= y1))
-    inside_p = np.array([shapely.contains_properly(area, p) for p in polys], dtype=bool)
+    inside_p = np.asarray(shapely.contains_properly(area, polys), dtype=bool).reshape(-1)
     lone_d, lone_p = inside_d.copy(), inside_p.copy()
     if len(discs) > 1:
-        gap = np.hypot(*(centre[:, None, :] - centre[None, :, :]).transpose(2, 0, 1)) - radius[:, None] - radius[None, :]
-        np.fill_diagonal(gap, np.inf)
-        lone_d &= ~(gap <= 0).any(axis=1)
-    if polys:
+        # Candidate pairs from a tree (near-linear in the count), then the exact disc test.
+        points = shapely.points(centre)
+        i, j = shapely.STRtree(points).query(points, predicate="dwithin", distance=radius + radius.max())
+        i, j = i[i != j], j[i != j]
+        touching = np.hypot(*(centre[i] - centre[j]).T) <= radius[i] + radius[j]
+        lone_d[i[touching]] = False
+    if len(polys):
         tree = shapely.STRtree(polys)
         a, b = tree.query(polys, predicate="intersects")
         lone_p[a[a != b]] = False
@@ -132,9 +135,9 @@ def free_area_ratio(scene, height: float) -> float:
             d, p = tree.query(shapely.points(centre), predicate="dwithin", distance=radius)
             lone_d[d] = False
             lone_p[p] = False
-    covered = float(np.pi * np.sum(radius[lone_d] ** 2)) + sum(polys[i].area for i in np.flatnonzero(lone_p))
-    rest = [shapely.Point(centre[i]).buffer(radius[i], quad_segs=_DISC_QUAD_SEGS) for i in np.flatnonzero(~lone_d)]
-    rest += [polys[i] for i in np.flatnonzero(~lone_p)]
+    covered = float(np.pi * np.sum(radius[lone_d] ** 2)) + float(np.sum(shapely.area(polys[lone_p])))
+    rest = list(shapely.buffer(shapely.points(centre[~lone_d]), radius[~lone_d], quad_segs=_DISC_QUAD_SEGS))
+    rest += list(polys[~lone_p])
     if rest:
         covered += shapely.intersection(shapely.union_all(rest), area).area
     return min(1.0, max(0.0, 1.0 - covered / area.area))
@@ -212,28 +215,38 @@ def _version() -> str:
     return worldgen.__version__
 
 
+_SCALARS = (float, int, bool, str, type(None))
+
+
 def _emit(obj, indent: str) -> str:
-    if isinstance(obj, dict):
+    """Canonical text of ``obj``, rounding floats as it goes; other types go through :func:`_plain`."""
+    kind = type(obj)
+    if kind is not dict and kind is not list and kind not in _SCALARS:
+        obj = _plain(obj)  # a tuple, a numpy value or array, a Mapping
+        kind = type(obj)
+    if kind is dict:
         if not obj:
             return "{}"
+        if any(type(k) is not str for k in obj):
+            raise TypeError(f"world.json keys must be strings, got {sorted(map(repr, obj))!r}")
         inner = indent + "  "
         items = [f"{inner}{_scalar(k)}: {_emit(obj[k], inner)}" for k in sorted(obj)]
         return "{\n" + ",\n".join(items) + "\n" + indent + "}"
-    if isinstance(obj, list):
+    if kind is list:
         if not obj:
             return "[]"
-        if not any(isinstance(v, (dict, list)) for v in obj):
-            return "[" + ", ".join(_scalar(v) for v in obj) + "]"
+        if all(type(v) in _SCALARS for v in obj):
+            return "[" + ", ".join([_scalar(v) for v in obj]) + "]"
         inner = indent + "  "
-        return "[\n" + ",\n".join(inner + _emit(v, inner) for v in obj) + "\n" + indent + "]"
+        return "[\n" + ",\n".join([inner + _emit(v, inner) for v in obj]) + "\n" + indent + "]"
     return _scalar(obj)
 
 
 def _scalar(value) -> str:
-    # Floats are already rounded; repr() is json's own float text, the shortest that reads back equal.
+    # repr() of a rounded float is json's own float text: the shortest that reads back equal.
     kind = type(value)
     if kind is float:
-        return repr(value)
+        return repr(round_float(value))
     if kind is bool:
         return "true" if value else "false"
     if kind is int:
