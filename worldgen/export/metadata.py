@@ -270,7 +270,8 @@ def _plain(obj):
     if isinstance(obj, (float, np.floating)):
         return round_float(obj)
     if kind is list or kind is tuple:
-        return [_plain(v) for v in obj]
+        # Poses, points and sizes are lists of floats: round them without a call per item to _plain.
+        return [round_float(v) if type(v) is float else _plain(v) for v in obj]
     if isinstance(obj, np.ndarray):
         return _plain(obj.tolist())
     if kind is dict or isinstance(obj, Mapping):
