@@ -68,26 +68,21 @@ def geom_frame(model, data, name: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def world_aabb(model, data, name: str) -> np.ndarray:
-    """(2, 3) world AABB of a box or mesh geom, as the scene defines it, from the compiled model.
+    """(2, 3) world AABB of a box or mesh geom, from the compiled model.
 
-    For a mesh that is the box around the mesh's own-frame bounding box (turned with the
-    entity), so the compiled vertices are first brought back into the entity's frame.
+    A box's is the box around its turned corners; a mesh's is tight around its
+    turned vertices, which MuJoCo stores in the geom's (re-centred) frame.
     """
     g = model.geom(name)
+    pos, rot = data.geom(name).xpos, data.geom(name).xmat.reshape(3, 3)
     if g.type[0] == mujoco.mjtGeom.mjGEOM_BOX:
-        half = g.size
+        signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)])
+        local = signs * g.size
     else:
         mesh = g.dataid[0]
         start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
-        local = model.mesh_vert[start:start + count] @ _quat_matrix(model.mesh_quat[mesh]).T + model.mesh_pos[mesh]
-        lo, hi = local.min(axis=0), local.max(axis=0)
-    pos, rot = geom_frame(model, data, name)
-    signs = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)])
-    if g.type[0] == mujoco.mjtGeom.mjGEOM_BOX:
-        corners = (2 * signs - 1) * half
-    else:
-        corners = lo + signs * (hi - lo)
-    pts = corners @ rot.T + pos
+        local = model.mesh_vert[start:start + count]
+    pts = local @ rot.T + pos
     return np.array([pts.min(axis=0), pts.max(axis=0)])
 
 

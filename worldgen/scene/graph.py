@@ -250,9 +250,12 @@ class Scene:
             p = self.world_matrix(name)[:3, 3]
             return np.array([p, p])
         m = self.world_matrix(name)
-        corners = node.shape.local_corners() @ m[:3, :3].T + m[:3, 3]
         if node.shape.kind in ("cylinder", "sphere"):
             corners = _tight_round_corners(node.shape, m)
+        elif node.shape.kind == "mesh":  # tight: the turned vertices, not a turned box
+            corners = node.shape.scaled_vertices() @ m[:3, :3].T + m[:3, 3]
+        else:
+            corners = node.shape.local_corners() @ m[:3, :3].T + m[:3, 3]
         return np.array([corners.min(axis=0), corners.max(axis=0)])
 
     def colliders(self) -> list[Node]:
