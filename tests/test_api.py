@@ -93,6 +93,33 @@ def test_unreachable_spawn_goal_distance_is_infeasible_not_a_hang():
     assert info.value.failures == {"task_placement": 2}
 
 
+#: Boxes too dense for a robot this wide: spawn and goal are free, the way between is not.
+BLOCKED = {"size": [6, 6], "robot_radius": 0.5, "n_obstacles": 12, "min_spawn_goal_distance": 3.0,
+           "box_size": [0.8, 1.5], "obstacle_shapes": "box", "min_gap": 0.0}
+
+
+def test_a_failed_feasibility_check_is_named_with_its_count():
+    with pytest.raises(InfeasibleError) as info:
+        worldgen.generate("cluttered", seed=1, max_attempts=2, **BLOCKED)
+    message = str(info.value)
+    assert message.startswith("no feasible 'cluttered' world for seed 1 within max_attempts=2: ")
+    assert "path_exists failed 2x" in message
+    assert info.value.failures["path_exists"] == 2
+
+
+def test_infeasible_on_purpose_is_returned_and_written_with_the_reason(tmp_path):
+    world = worldgen.generate("cluttered", seed=1, max_attempts=2, allow_infeasible=True, **BLOCKED)
+    assert not world.feasibility.feasible
+    assert world.attempts == 2
+    folder = world.write(tmp_path)
+    meta = json.loads((folder / "world.json").read_text())
+    metadata.validate(meta)
+    assert meta["feasibility"]["feasible"] is False
+    failed = {c["name"] for c in meta["feasibility"]["checks"] if not c["ok"]}
+    assert "path_exists" in failed
+    assert any(t["path"] is None and t["time_limit"] is None for t in meta["tasks"])
+
+
 # -- parameter mistakes -------------------------------------------------------------
 
 PARAMETER_MISTAKES = [

@@ -177,6 +177,10 @@ MISTAKES = {
                     "--set", "max_attempts=3", "--out", "{out}"],
                    r"error: no feasible 'cluttered' world for seed 5 within max_attempts=3: "
                    r"obstacle_placement failed 3x \(first obstacle_placement: could not place 400 obstacles .*\)"),
+    "no path": (["generate", "cluttered", "--seed", "1", "--set", "size=6,6", "--set", "robot_radius=0.5",
+                 "--set", "n_obstacles=12", "--set", "box_size=0.8,1.5", "--set", "obstacle_shapes=box",
+                 "--set", "min_gap=0", "--set", "max_attempts=2", "--out", "{out}"],
+                r"error: no feasible 'cluttered' world for seed 1 within max_attempts=2: .*path_exists failed 2x.*"),
 }
 
 
