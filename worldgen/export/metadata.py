@@ -104,7 +104,7 @@ def free_area_ratio(scene, height: float) -> float:
 
     Shadows that touch no other shadow are summed directly (a disc inside the
     bounds exactly as pi r^2); only those that overlap, or cross the bounds, are
-    unioned as polygons. A union of every shadow would be exact too, but costs
+    unioned as polygons. A union of every shadow gives the same figure, but costs
     milliseconds per world where this costs a fraction of one.
     """
     (x0, y0), (x1, y1) = scene.bounds
