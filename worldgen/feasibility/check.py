@@ -1,0 +1,175 @@
+"""Run every feasibility check for a scene's tasks and assemble the report.
+
+Per task: the spawn and goal discs lie inside the bounds; the footprint
+cylinder at spawn and goal keeps ``robot.clearance`` from every collider (FCL);
+a path exists for the disc of radius ``robot.inflation``; and that path, sampled
+every ``robot.radius / 4``, keeps the clearance everywhere (FCL). Results are
+aggregated over tasks: a check passes only if it passes for every task, its
+value is the worst figure, and its detail names the task that set it.
+
+The path is planned in the plane (clearance field, grid search, string-pulling,
+tightening; see the sibling modules) with a small safety margin
+:data:`SAFETY` on top of the inflation radius, so rounding the written
+waypoints to 6 decimals can never bring the footprint closer than required.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Optional, Sequence
+
+import numpy as np
+
+from worldgen.feasibility.collision import Colliders
+from worldgen.feasibility.field import distance_field, grid_for
+from worldgen.feasibility.geometry import Obstacles2D
+from worldgen.feasibility.passage import bottleneck_radius
+from worldgen.feasibility.planner import grid_path, string_pull
+from worldgen.feasibility.report import Check, FeasibilityReport, TaskPath
+from worldgen.feasibility.taut import tighten
+from worldgen.feasibility.verify import verify_path
+from worldgen.floats import DECIMALS
+from worldgen.footprint import scene_footprints
+from worldgen.scene import Robot, Scene, Task
+
+__all__ = ["check", "resolution_for", "SAFETY"]
+
+#: Extra margin (m) the planner keeps on top of the inflation radius: far above
+#: the 6-decimal rounding of waypoints and FCL's solver tolerance, far below any
+#: length that matters (it lengthens a path by well under 0.1 %).
+SAFETY = 1e-4
+#: Grid cell size as a fraction of the inflation radius, and its limits (m).
+RESOLUTION_FRACTION = 1.0 / 3.0
+RESOLUTION_LIMITS = (0.01, 0.25)
+#: Largest grid (cells); bigger floors get coarser cells instead.
+MAX_CELLS = 1_000_000
+
+
+def resolution_for(robot: Robot, bounds) -> float:
+    """The grid cell size (m) used for ``robot`` on a floor of ``bounds``."""
+    (x0, y0), (x1, y1) = bounds
+    h = min(max(robot.inflation * RESOLUTION_FRACTION, RESOLUTION_LIMITS[0]), RESOLUTION_LIMITS[1])
+    return max(h, math.sqrt((x1 - x0) * (y1 - y0) / MAX_CELLS))
+
+
+def _bounds_margin(bounds, xy: np.ndarray) -> np.ndarray:
+    """(n,) distance from each point to the nearest edge of the bounds (negative outside)."""
+    (x0, y0), (x1, y1) = bounds
+    return np.minimum(np.minimum(xy[:, 0] - x0, x1 - xy[:, 0]), np.minimum(xy[:, 1] - y0, y1 - xy[:, 1]))
+
+
+def _p(xy) -> str:
+    return f"({xy[0]:.3f}, {xy[1]:.3f})"
+
+
+def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityReport:
+    """Check every task of ``scene`` for ``robot``; never raises for an infeasible world."""
+    bounds = scene.bounds
+    colliders = Colliders(scene)
+    obstacles = Obstacles2D.from_footprints(scene_footprints(scene, robot.height + robot.clearance))
+    spawns = np.array([[t.spawn.x, t.spawn.y] for t in tasks], dtype=float).reshape(-1, 2)
+    goals = np.array([[t.goal.x, t.goal.y] for t in tasks], dtype=float).reshape(-1, 2)
+    radius = robot.inflation + SAFETY
+
+    # inside_bounds: the inflated disc at spawn and goal within the floor area.
+    margins = np.minimum(_bounds_margin(bounds, spawns), _bounds_margin(bounds, goals)) - robot.inflation
+    inside = _aggregate("inside_bounds", tasks, margins, margins >= 0,
+                        lambda i: f"{tasks[i].id}: spawn {_p(spawns[i])} / goal {_p(goals[i])} leave the "
+                                  f"{robot.inflation:g} m disc {-margins[i]:.4f} m outside the bounds",
+                        lambda v: f"smallest margin {v:.4f} m")
+
+    # spawn_free / goal_free with FCL.
+    free = {}
+    for label, pts in (("spawn", spawns), ("goal", goals)):
+        near = [colliders.nearest(robot, p[None, :]) for p in pts]
+        values = np.array([n.distance for n in near])
+        free[label] = _aggregate(
+            f"{label}_free", tasks, values, values >= robot.clearance,
+            lambda i, near=near, pts=pts, label=label: (
+                f"{tasks[i].id}: {label} {_p(pts[i])} is {near[i].distance:.4f} m from {near[i].name} "
+                f"(needs >= {robot.clearance:g} m)"),
+            lambda v: f"smallest clearance {v:.4f} m")
+
+    # Planning in the plane.
+    h = resolution_for(robot, bounds)
+    grid = grid_for(bounds, h)
+    ends = np.vstack([spawns, goals])
+    clear2d = np.minimum(obstacles.points_distance(ends)[0], _bounds_margin(bounds, ends))
+    start_clear, goal_clear = clear2d[: len(tasks)], clear2d[len(tasks):]
+    endpoint_clear = np.minimum(start_clear, goal_clear)
+    plannable = endpoint_clear > radius
+    cap = radius + 2.5 * h
+    if plannable.any():
+        cap = max(cap, float(endpoint_clear[plannable].max()))
+    field = distance_field(obstacles, bounds, grid, cap)
+
+    paths: list[Optional[TaskPath]] = []
+    passages: list[float] = []
+    no_path: list[str] = []
+    clearances = np.full(len(tasks), np.nan)
+    clearance_detail: dict[int, str] = {}
+    for i, task in enumerate(tasks):
+        s, g = spawns[i], goals[i]
+        if not plannable[i]:
+            paths.append(None)
+            which = "spawn" if start_clear[i] <= radius else "goal"
+            no_path.append(f"{task.id}: the {which} is not free for a {robot.inflation:g} m disc")
+            continue
+        raw = grid_path(field, s, g, radius)
+        if raw is None:
+            paths.append(None)
+            no_path.append(f"{task.id}: no path for a {robot.inflation:g} m disc from {_p(s)} to {_p(g)} "
+                           f"(grid {grid.hx:.3f} m)")
+            continue
+        ref = string_pull(field, raw, radius)
+        taut = tighten(obstacles, ref, radius, bounds, near=3 * h)
+        best = ref if taut is None or _length(taut) > _length(ref) else taut
+        waypoints = np.round(best, DECIMALS)
+        waypoints[0], waypoints[-1] = s, g
+        nearest, samples = verify_path(colliders, robot, waypoints)
+        clearance = nearest.distance
+        if not np.isfinite(clearance):  # nothing to hit: the floor's edge is the only limit
+            clearance = float(_bounds_margin(bounds, samples).min() - robot.radius)
+        clearances[i] = clearance
+        if clearance < robot.clearance:
+            at = samples[nearest.index]
+            clearance_detail[i] = (f"{task.id}: the path passes {clearance:.4f} m from {nearest.name} at {_p(at)} "
+                                   f"(needs >= {robot.clearance:g} m)")
+        paths.append(TaskPath(task.id, waypoints, _length(waypoints), clearance))
+        high = min(float(endpoint_clear[i]), field.cap)
+        passages.append(2.0 * bottleneck_radius(field, s, g, radius, high))
+
+    found = [p for p in paths if p is not None]
+    path_exists = Check("path_exists", not no_path,
+                        max(p.length for p in found) if found and not no_path else None,
+                        "; ".join(no_path) if no_path else f"{len(found)} path(s), longest {max(p.length for p in found):.3f} m"
+                        if found else "no tasks")
+    if no_path:
+        path_clearance = Check("path_clearance", False,
+                               float(np.nanmin(clearances)) if found else None,
+                               "no path to verify for " + ", ".join(d.split(":")[0] for d in no_path))
+    else:
+        path_clearance = _aggregate("path_clearance", tasks, clearances, clearances >= robot.clearance,
+                                    lambda i: clearance_detail.get(i, ""),
+                                    lambda v: f"smallest FCL clearance {v:.4f} m along the sampled paths")
+    checks = (inside, free["spawn"], free["goal"], path_exists, path_clearance)
+    narrowest = min(passages) if passages and not no_path else None
+    return FeasibilityReport(checks, tuple(paths), narrowest, "fcl", grid.hx)
+
+
+def _length(points: np.ndarray) -> float:
+    return float(np.hypot(*np.diff(points, axis=0).T).sum())
+
+
+def _aggregate(name: str, tasks, values: np.ndarray, ok: np.ndarray, fail_detail, ok_detail) -> Check:
+    """One check over all tasks: value = the worst figure, detail names the failing task."""
+    values = np.asarray(values, dtype=float)
+    finite = np.isfinite(values)
+    if not len(tasks):
+        return Check(name, False, None, "no tasks")
+    worst = int(np.argmin(np.where(finite, values, np.inf)))
+    value = float(values[worst]) if finite[worst] else None
+    if not np.all(ok):
+        first = int(np.argmin(ok))
+        return Check(name, False, value, fail_detail(first))
+    return Check(name, True, value, ok_detail(value) if value is not None else "nothing to hit")
