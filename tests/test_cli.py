@@ -134,6 +134,21 @@ def test_formats_subset_writes_only_those(tmp_path, formats, files):
         assert '<sdf version="1.6"' in (folder / "world.sdf").read_text()
 
 
+BLOCKED = ["--set", "size=6,6", "--set", "robot_radius=0.5", "--set", "n_obstacles=12", "--set", "box_size=0.8,1.5",
+           "--set", "obstacle_shapes=box", "--set", "min_gap=0", "--set", "max_attempts=2"]
+
+
+def test_allow_infeasible_writes_the_world_and_says_why(tmp_path):
+    r = run("generate", "cluttered", "--seed", 1, *BLOCKED, "--allow-infeasible", "--out", tmp_path)
+    assert r.returncode == 0, r.stderr
+    [folder] = world_dirs(tmp_path)
+    meta = json.loads((folder / "world.json").read_text())
+    assert meta["feasibility"]["feasible"] is False and meta["feasibility"]["attempts"] == 2
+    failed = [c["name"] for c in meta["feasibility"]["checks"] if not c["ok"]]
+    assert "path_exists" in failed
+    assert r.stdout.rstrip("\n").endswith(f"\tattempts 2\tinfeasible: {','.join(failed)}")
+
+
 # -- mistakes -----------------------------------------------------------------------
 
 MISTAKES = {
@@ -177,9 +192,7 @@ MISTAKES = {
                     "--set", "max_attempts=3", "--out", "{out}"],
                    r"error: no feasible 'cluttered' world for seed 5 within max_attempts=3: "
                    r"obstacle_placement failed 3x \(first obstacle_placement: could not place 400 obstacles .*\)"),
-    "no path": (["generate", "cluttered", "--seed", "1", "--set", "size=6,6", "--set", "robot_radius=0.5",
-                 "--set", "n_obstacles=12", "--set", "box_size=0.8,1.5", "--set", "obstacle_shapes=box",
-                 "--set", "min_gap=0", "--set", "max_attempts=2", "--out", "{out}"],
+    "no path": (["generate", "cluttered", "--seed", "1", *BLOCKED, "--out", "{out}"],
                 r"error: no feasible 'cluttered' world for seed 1 within max_attempts=2: .*path_exists failed 2x.*"),
 }
 

@@ -94,8 +94,11 @@ def list_command(as_json: bool) -> None:
               help="SDFormat version: 1.9 (Gazebo Fortress to Harmonic) or 1.6 (Gazebo classic).")
 @click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
               help="Number of worlds, one per consecutive seed.")
+@click.option("--allow-infeasible", is_flag=True,
+              help="For negative tests: where no draw passes, write the last checked one; "
+                   "its world.json says feasible false and which checks failed.")
 def generate_command(generator: str, seed: int, settings: Sequence[str], out: Path, formats: str,
-                     sdf_version: str, count: int) -> None:
+                     sdf_version: str, count: int, allow_infeasible: bool) -> None:
     """Generate, check and write worlds of GENERATOR.
 
     Prints one line per world: its folder, the reference path length of each
@@ -109,10 +112,12 @@ def generate_command(generator: str, seed: int, settings: Sequence[str], out: Pa
         raise ParameterError(f"parameter 'count' must be in [1, {MAX_SEED - seed + 1}] for seed {seed}, got {count}")
     _check_out(out)
     for s in range(seed, seed + count):
-        world = worldgen.generate(spec.name, seed=s, **params)
+        world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, **params)
         folder = world.write(out, formats=chosen, sdf_version=sdf_version)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
-        click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}")
+        failed = ",".join(c.name for c in world.feasibility.failed())
+        verdict = f"\tinfeasible: {failed}" if failed else ""
+        click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}{verdict}")
 
 
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
