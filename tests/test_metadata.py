@@ -11,6 +11,7 @@ import copy
 import hashlib
 import json
 import math
+import re
 
 import jsonschema
 import numpy as np
@@ -104,6 +105,25 @@ def test_every_schema_field_is_documented():
     undocumented = [path for path, sub in fields
                     if "description" not in sub and "description" not in _resolve(schema, sub)]
     assert undocumented == []
+
+
+_NUMERIC_REFS = {"#/$defs/finite", "#/$defs/nonneg", "#/$defs/positive", "#/$defs/pose", "#/$defs/floor_pose",
+                 "#/$defs/point2", "#/$defs/point3"}
+_UNIT = re.compile(r"\b(m|rad|s|kg|m/s|count|unitless)\b")
+
+
+def _numeric(sub) -> bool:
+    if sub.get("$ref") in _NUMERIC_REFS or sub.get("type") in ("number", "integer"):
+        return True
+    if sub.get("type") == "array":
+        return _numeric(sub.get("items", {}))
+    return any(_numeric(option) for option in sub.get("oneOf", []))
+
+
+def test_every_numeric_field_states_its_unit():
+    numeric = [(path, sub) for path, sub in _walk_properties(metadata.schema()) if _numeric(sub)]
+    assert len(numeric) > 40
+    assert [path for path, sub in numeric if not _UNIT.search(sub.get("description", ""))] == []
 
 
 def _resolve(schema, sub):
