@@ -37,9 +37,9 @@ def world_dirs(out: Path) -> list[Path]:
 
 # -- version, help, list ----------------------------------------------------------
 
-@pytest.mark.parametrize("how", ["script", "module"])
+@pytest.mark.parametrize("how", ["script", "worldgen", "worldgen.cli"])
 def test_version(how):
-    cmd = WORLDGEN if how == "script" else [sys.executable, "-m", "worldgen.cli"]
+    cmd = WORLDGEN if how == "script" else [sys.executable, "-m", how]
     r = run("--version", cmd=cmd)
     assert r.returncode == 0 and r.stdout == f"worldgen {worldgen.__version__}\n" and r.stderr == ""
 
