@@ -23,7 +23,7 @@ import numpy as np
 from worldgen.feasibility.collision import Colliders
 from worldgen.feasibility.field import distance_field, grid_for
 from worldgen.feasibility.geometry import Obstacles2D
-from worldgen.feasibility.passage import bottleneck_radius
+from worldgen.feasibility.passage import bottleneck_radius, extend_field
 from worldgen.feasibility.planner import grid_path, string_pull
 from worldgen.feasibility.report import Check, FeasibilityReport, TaskPath
 from worldgen.feasibility.taut import tighten
@@ -98,10 +98,11 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     start_clear, goal_clear = clear2d[: len(tasks)], clear2d[len(tasks):]
     endpoint_clear = np.minimum(start_clear, goal_clear)
     plannable = endpoint_clear > radius
+    # Exact values are needed only near the inflation radius (planning proves moves
+    # against it); the passage search reads farther out from a cheap extension.
     cap = radius + 2.5 * h
-    if plannable.any():
-        cap = max(cap, float(endpoint_clear[plannable].max()))
     field = distance_field(obstacles, bounds, grid, cap)
+    wide = None  # the field extended beyond cap, made on first need
 
     paths: list[Optional[TaskPath]] = []
     passages: list[float] = []
@@ -136,8 +137,10 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
             clearance_detail[i] = (f"{task.id}: the path passes {clearance:.4f} m from {nearest.name} at {_p(at)} "
                                    f"(needs >= {robot.clearance:g} m)")
         paths.append(TaskPath(task.id, waypoints, _length(waypoints), clearance))
-        high = min(float(endpoint_clear[i]), field.cap)
-        passages.append(2.0 * bottleneck_radius(field, s, g, radius, high))
+        high = float(endpoint_clear[i])
+        if high > field.cap and wide is None:
+            wide = extend_field(field)
+        passages.append(2.0 * bottleneck_radius(field if high <= field.cap else wide, s, g, radius, high))
 
     found = [p for p in paths if p is not None]
     path_exists = Check("path_exists", not no_path,

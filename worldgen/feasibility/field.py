@@ -80,7 +80,7 @@ def distance_field(obstacles: Obstacles2D, bounds, grid: Grid, cap: float) -> Di
     nd = obstacles.n_discs
     # Pad into one batch only windows of similar size: a long wall would blow every window up.
     span = np.maximum(windows[:, 1] - windows[:, 0], windows[:, 3] - windows[:, 2])
-    limit = np.percentile(span, _BATCH_PERCENTILE) if len(span) else 0
+    limit = min(np.percentile(span, _BATCH_PERCENTILE), 3 * np.median(span)) if len(span) else 0
     small = span <= limit
     ids = np.arange(len(obstacles))
     disc_small = ids[small & (ids < nd)]

@@ -20,9 +20,28 @@ from scipy import ndimage
 
 from worldgen.feasibility.field import DistanceField
 
-__all__ = ["bottleneck_radius"]
+__all__ = ["bottleneck_radius", "extend_field"]
 
 _EIGHT = np.ones((3, 3), dtype=bool)
+
+
+def extend_field(field: DistanceField) -> DistanceField:
+    """The field with the cells it capped filled in from a Euclidean distance transform.
+
+    A capped cell c gets D(q) + |c - q|, where q is the nearest cell of the exact
+    band (values below cap) and D(q) its exact clearance: an upper bound on c's
+    clearance (distance is 1-Lipschitz) that is tight when q lies on the way from
+    c to its nearest obstacle, as it does up to the grid's resolution. One C pass
+    over the grid instead of exact distances to every obstacle far out; the
+    passage figure stays accurate to about a grid cell.
+    """
+    g = field.grid
+    capped = field.values >= field.cap
+    if not capped.any() or capped.all():
+        return field
+    reach, (qi, qj) = ndimage.distance_transform_edt(capped, sampling=(g.hx, g.hy), return_indices=True)
+    values = np.where(capped, field.values[qi, qj] + reach, field.values)
+    return DistanceField(g, values, float(values.max()))
 
 
 def bottleneck_radius(field: DistanceField, start: np.ndarray, goal: np.ndarray, low: float, high: float) -> float:
