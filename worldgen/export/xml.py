@@ -33,9 +33,7 @@ def to_bytes(tree) -> bytes:
 
 def sub(parent, tag: str, text: str | None = None, **attrs) -> etree._Element:
     """Append ``<tag attrs>text</tag>`` to ``parent``; attribute order is as given."""
-    el = etree.SubElement(parent, tag)
-    for k, v in attrs.items():
-        el.set(k, v)
+    el = etree.SubElement(parent, tag, attrs)
     if text is not None:
         el.text = text
     return el

@@ -17,7 +17,6 @@ above the inflation radius.
 from __future__ import annotations
 
 import math
-from functools import lru_cache
 from typing import Optional
 
 import numpy as np
@@ -38,19 +37,6 @@ MOVES = np.array(
 
 #: Cells around the spawn and goal tried as the first/last grid cell.
 _LINK_REACH = 2
-
-
-@lru_cache(maxsize=8)
-def _lattice(nx: int, ny: int) -> tuple[np.ndarray, np.ndarray]:
-    """(n, 16) neighbour index per cell and move (-1 off the grid), and (n,) cell indices."""
-    i, j = np.meshgrid(np.arange(nx), np.arange(ny), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    ni = i[:, None] + MOVES[None, :, 0]
-    nj = j[:, None] + MOVES[None, :, 1]
-    inside = (ni >= 0) & (ni < nx) & (nj >= 0) & (nj < ny)
-    nbr = np.where(inside, ni * ny + nj, -1)
-    nbr.flags.writeable = False
-    return nbr, np.arange(nx * ny)
 
 
 def field_clear(field: DistanceField, a: np.ndarray, b: np.ndarray, radius: float) -> np.ndarray:
@@ -135,8 +121,6 @@ def _grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius
     """(points, grid length) of the shortest field-proven grid path, or None."""
     g = field.grid
     n = g.nx * g.ny
-    d = field.values.ravel()
-    nbr, cells = _lattice(g.nx, g.ny)
     steps = np.hypot(MOVES[:, 0] * g.hx, MOVES[:, 1] * g.hy)
     # Per move, on shifted views of the field (no gathers): is the move proven free?
     pad = np.full((g.nx + 4, g.ny + 4), -np.inf)
@@ -153,8 +137,12 @@ def _grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius
         return np.array([start, goal]), 0.0
     counts = np.r_[ok.sum(axis=1), len(links_s)]
     indptr = np.r_[0, np.cumsum(counts)]
-    indices = np.r_[nbr[ok], links_s]
-    data = np.r_[np.broadcast_to(steps, ok.shape)[ok], cost_s]
+    # Allowed moves in row-major (cell, move) order, as CSR wants them; a move's
+    # target is the cell index plus a constant offset (the padding kept every
+    # allowed move on the grid).
+    cell, move = np.nonzero(ok)
+    indices = np.r_[cell + (MOVES[:, 0] * g.ny + MOVES[:, 1])[move], links_s]
+    data = np.r_[steps[move], cost_s]
     graph = csr_matrix((data, indices, indptr), shape=(n + 1, n + 1))
     dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
     total = dist[links_g] + cost_g
