@@ -18,7 +18,7 @@ import shapely
 
 from worldgen.scene import Scene
 
-__all__ = ["Footprint", "FootprintIndex", "scene_footprints", "distances_to"]
+__all__ = ["Footprint", "FootprintIndex", "scene_footprints", "robot_footprints", "distances_to"]
 
 _VERTICAL = 1e-9
 
@@ -65,6 +65,15 @@ def scene_footprints(scene: Scene, height: float) -> list[Footprint]:
     if height not in per_scene:
         per_scene[height] = _footprints(scene, height)
     return list(per_scene[height])
+
+
+def robot_footprints(scene: Scene, robot) -> list[Footprint]:
+    """The footprints that matter to ``robot``: everything below its top plus its clearance.
+
+    The one height every layer uses (generator screening, feasibility, metrics),
+    so all of them share one cached computation per scene.
+    """
+    return scene_footprints(scene, robot.height + robot.clearance)
 
 
 def _footprints(scene: Scene, height: float) -> list[Footprint]:

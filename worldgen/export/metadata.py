@@ -76,7 +76,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         },
         "metrics": {
             "obstacle_count": sum(1 for n in scene.nodes if n.role == "obstacle"),
-            "free_area_ratio": free_area_ratio(scene, robot.height),
+            "free_area_ratio": free_area_ratio(scene, robot.height + robot.clearance),
             "narrowest_passage": narrowest,
         },
         "files": {key: {"path": path, "sha256": digest} for key, (path, digest) in sorted(files.items())},

@@ -17,7 +17,7 @@ import shapely
 
 from worldgen.errors import ParameterError
 from worldgen.floats import round_float
-from worldgen.footprint import FootprintIndex, scene_footprints
+from worldgen.footprint import FootprintIndex, robot_footprints
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.registry import register
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
@@ -91,7 +91,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     nodes += obstacles
     scene = Scene(tuple(nodes), (), bounds, Physics(params["step_size"], params["real_time_factor"]))
     robot = robot_from_params(params)
-    index = FootprintIndex(scene_footprints(scene, robot.height))
+    index = FootprintIndex(robot_footprints(scene, robot))
     tasks, reason = sample_tasks(task_rng, index, bounds, robot, params["n_tasks"],
                                  params["min_spawn_goal_distance"], params["goal_tolerance"])
     if reason:
