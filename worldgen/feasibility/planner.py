@@ -121,30 +121,27 @@ def _grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius
     """(points, grid length) of the shortest field-proven grid path, or None."""
     g = field.grid
     n = g.nx * g.ny
-    steps = np.hypot(MOVES[:, 0] * g.hx, MOVES[:, 1] * g.hy)
-    # Per move, on shifted views of the field (no gathers): is the move proven free?
-    pad = np.full((g.nx + 4, g.ny + 4), -np.inf)
-    pad[2:-2, 2:-2] = field.values
-    ok = np.empty((g.nx, g.ny, len(MOVES)), dtype=bool)
-    for k, (di, dj) in enumerate(MOVES):
-        np.greater(field.values + pad[2 + di:2 + di + g.nx, 2 + dj:2 + dj + g.ny], 2 * radius + steps[k], out=ok[:, :, k])
-    ok = ok.reshape(n, len(MOVES))
     links_s, cost_s = _links(field, start, radius)
     links_g, cost_g = _links(field, goal, radius)
     if not len(links_s) or not len(links_g):
         return None
     if np.hypot(*(goal - start)) <= 1e-12:
         return np.array([start, goal]), 0.0
-    counts = np.r_[ok.sum(axis=1), len(links_s)]
-    indptr = np.r_[0, np.cumsum(counts)]
-    # Allowed moves in row-major (cell, move) order, as CSR wants them; a move's
-    # target is the cell index plus a constant offset (the padding kept every
-    # allowed move on the grid).
-    cell, move = np.nonzero(ok)
-    indices = np.r_[cell + (MOVES[:, 0] * g.ny + MOVES[:, 1])[move], links_s]
-    data = np.r_[steps[move], cost_s]
-    graph = csr_matrix((data, indices, indptr), shape=(n + 1, n + 1))
-    dist, pred = dijkstra(graph, directed=True, indices=n, return_predecessors=True)
+    # The proof of a move is symmetric in its two cells, so the first half of
+    # MOVES (one direction of each) makes an undirected graph. Per move, on
+    # shifted views of the field (no gathers): which cells may take it?
+    half = MOVES[: len(MOVES) // 2]
+    steps = np.hypot(half[:, 0] * g.hx, half[:, 1] * g.hy)
+    pad = np.full((g.nx + 4, g.ny + 4), -np.inf)
+    pad[2:-2, 2:-2] = field.values
+    rows, cols, data = [links_s * 0 + n], [links_s], [cost_s]  # the virtual start node n
+    for k, (di, dj) in enumerate(half):
+        cells = np.flatnonzero(field.values + pad[2 + di:2 + di + g.nx, 2 + dj:2 + dj + g.ny] > 2 * radius + steps[k])
+        rows.append(cells)
+        cols.append(cells + (di * g.ny + dj))  # the padding kept every allowed move on the grid
+        data.append(np.full(len(cells), steps[k]))
+    graph = csr_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 1, n + 1))
+    dist, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
     total = dist[links_g] + cost_g
     best = int(np.argmin(total))
     if not np.isfinite(total[best]):
