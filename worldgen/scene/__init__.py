@@ -1,6 +1,7 @@
 """Scene graph: nodes, shapes, poses, joints. Plain data, no I/O, no file formats."""
 
 from worldgen.scene.graph import NAME_PATTERN, ROLES, Joint, Material, Node, Physics, Robot, Scene, Task
+from worldgen.scene.mover import Mover
 from worldgen.scene.pose import Pose, matrix_to_pose, rpy_matrix
 from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, Sphere, unit_inertia
 
@@ -8,4 +9,5 @@ __all__ = [
     "NAME_PATTERN", "ROLES", "Joint", "Material", "Node", "Physics", "Robot", "Scene", "Task",
     "Pose", "matrix_to_pose", "rpy_matrix",
     "Box", "Cylinder", "Mesh", "Shape", "Sphere", "unit_inertia",
+    "Mover",
 ]

@@ -20,8 +20,9 @@ import numpy as np
 from worldgen.floats import round_float
 from worldgen.scene.pose import Pose
 from worldgen.scene.shapes import Mesh, Shape, unit_inertia
+from worldgen.scene.mover import Mover
 
-__all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN"]
+__all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN", "Mover"]
 
 #: Every role a node may have. Markers carry no collision geometry.
 ROLES = ("floor", "wall", "obstacle", "door", "door_frame", "marker")
@@ -168,16 +169,20 @@ class Scene:
 
     ``bounds`` is ((minx, miny), (maxx, maxy)) in metres. Nodes keep the order
     the generator gave them; that order is part of the canonical form.
+    ``movers`` are dynamic obstacles on scripted paths (:class:`Mover`); their
+    names share one scope with the nodes' and joints'.
     """
 
     nodes: tuple[Node, ...]
     joints: tuple[Joint, ...] = ()
     bounds: tuple[tuple[float, float], tuple[float, float]] = ((-5.0, -5.0), (5.0, 5.0))
     physics: Physics = Physics()
+    movers: tuple[Mover, ...] = ()
 
     def __post_init__(self):
         object.__setattr__(self, "nodes", tuple(self.nodes))
         object.__setattr__(self, "joints", tuple(self.joints))
+        object.__setattr__(self, "movers", tuple(self.movers))
         names = [n.name for n in self.nodes]
         seen: set[str] = set()
         for name in names:
@@ -195,6 +200,11 @@ class Scene:
         if not (x1 > x0 and y1 > y0):
             raise ValueError(f"scene bounds must have min < max, got {self.bounds!r}")
         self._check_acyclic()
+        taken = seen | {j.name for j in self.joints}
+        for mover in self.movers:
+            if mover.name in taken:
+                raise ValueError(f"mover name {mover.name!r} is already used by a node, joint or mover")
+            taken.add(mover.name)
 
     def _check_acyclic(self):
         parents = {n.name: n.parent for n in self.nodes}
@@ -276,6 +286,8 @@ class Scene:
                 "real_time_factor": round_float(self.physics.real_time_factor),
                 "gravity": [round_float(g) for g in self.physics.gravity],
             },
+            # Only where there are movers, so that worlds without any keep their hashes.
+            **({"movers": [m.canonical() for m in self.movers]} if self.movers else {}),
         }
 
     def content_hash(self) -> str:
@@ -284,7 +296,10 @@ class Scene:
         return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
 
     def with_nodes(self, nodes: Iterable[Node]) -> "Scene":
-        return Scene(tuple(nodes), self.joints, self.bounds, self.physics)
+        return Scene(tuple(nodes), self.joints, self.bounds, self.physics, self.movers)
+
+    def with_movers(self, movers: Iterable[Mover]) -> "Scene":
+        return Scene(self.nodes, self.joints, self.bounds, self.physics, tuple(movers))
 
 
 def _tight_round_corners(shape, m: np.ndarray) -> np.ndarray:

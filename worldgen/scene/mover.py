@@ -1,0 +1,71 @@
+"""A dynamic obstacle on a scripted path: plain frozen data, like every other scene value.
+
+A mover is a vertical cylinder standing on the floor (a walking person, say)
+whose centre follows ``trajectory``: rows ``(t, x, y)`` in seconds and metres,
+visited in order and joined by straight lines walked at constant speed. The
+first row is at t = 0. When ``loop`` is true the script repeats after its last
+row; worldgen's movers end where they start, so the repetition is seamless.
+
+Movers are not nodes: they carry no static collision geometry, the static
+feasibility check ignores them, and each exporter writes them its own way
+(SDF actor, MJCF mocap body, left out of URDF).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from worldgen.floats import round_float
+
+__all__ = ["Mover", "MOVER_RGBA"]
+
+#: The colour movers are drawn in (a saturated red, unlike any static thing).
+MOVER_RGBA = (0.85, 0.20, 0.20, 1.0)
+
+
+@dataclass(frozen=True)
+class Mover:
+    """One mover. ``trajectory`` is a tuple of ``(t, x, y)`` rows, t strictly increasing from 0."""
+
+    name: str
+    radius: float
+    height: float
+    trajectory: tuple[tuple[float, float, float], ...]
+    loop: bool = True
+    friction: float = 1.0
+
+    def __post_init__(self):
+        from worldgen.scene.graph import NAME_PATTERN  # graph imports this module
+
+        if not NAME_PATTERN.match(self.name):
+            raise ValueError(f"mover name {self.name!r} must match {NAME_PATTERN.pattern}")
+        for what, value in (("radius", self.radius), ("height", self.height)):
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"mover {self.name!r}: {what} must be > 0 m, got {value!r}")
+        rows = tuple(tuple(float(v) for v in row) for row in self.trajectory)
+        if len(rows) < 2 or any(len(row) != 3 for row in rows):
+            raise ValueError(f"mover {self.name!r}: trajectory must be at least two (t, x, y) rows")
+        if not all(math.isfinite(v) for row in rows for v in row):
+            raise ValueError(f"mover {self.name!r}: trajectory values must be finite")
+        if rows[0][0] != 0.0:
+            raise ValueError(f"mover {self.name!r}: trajectory must start at t = 0, got t = {rows[0][0]!r}")
+        if any(b[0] <= a[0] for a, b in zip(rows, rows[1:])):
+            raise ValueError(f"mover {self.name!r}: trajectory times must strictly increase")
+        object.__setattr__(self, "trajectory", rows)
+        object.__setattr__(self, "loop", bool(self.loop))
+
+    @property
+    def period(self) -> float:
+        """Duration of one pass of the script, s."""
+        return self.trajectory[-1][0]
+
+    def canonical(self) -> dict:
+        return {
+            "name": self.name,
+            "radius": round_float(self.radius),
+            "height": round_float(self.height),
+            "trajectory": [[round_float(v) for v in row] for row in self.trajectory],
+            "loop": self.loop,
+            "friction": round_float(self.friction),
+        }
