@@ -15,7 +15,9 @@ from worldgen.errors import ParameterError
 
 __all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "describe_range"]
 
-_KINDS = ("float", "int", "bool", "choice", "pair", "range")
+_KINDS = ("float", "int", "bool", "choice", "pair", "range", "triple", "list", "words")
+#: Most items a ``list`` or ``words`` parameter may hold.
+MAX_ITEMS = 64
 
 
 @dataclass(frozen=True)
@@ -28,6 +30,10 @@ class Param:
       - ``choice``: one of ``choices``;
       - ``pair``: two floats, each in [low, high] (e.g. ``size`` = x, y extents);
       - ``range``: two floats lo <= hi, each in [low, high] (a size range to draw from).
+      - ``triple``: three floats, each in [low, high] (e.g. a spawn ``[x, y, yaw]``);
+      - ``list``: 1 to MAX_ITEMS floats, each in [low, high] (e.g. segment lengths);
+      - ``words``: 1 to MAX_ITEMS words, each one of ``choices``, kept as one
+        comma-joined string (``"left,right"``) so world.json's params stay plain.
     ``default`` None means "unset" and is allowed only where ``optional``.
     """
 
@@ -60,6 +66,16 @@ class Param:
             raise self._error(f"must be one of {', '.join(map(str, self.choices))}", value)
         if self.kind in ("float", "int"):
             return self._number(value)
+        if self.kind == "words":
+            return self._words(value)
+        if self.kind == "list":
+            if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or not 1 <= len(value) <= MAX_ITEMS:
+                raise self._error(f"must be a list of 1 to {MAX_ITEMS} numbers, each {describe_range(self)}", value)
+            return [self._number(v, whole=False) for v in value]
+        if self.kind == "triple":
+            if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or len(value) != 3:
+                raise self._error(f"must be three numbers, each {describe_range(self)}", value)
+            return [self._number(v, whole=False) for v in value]
         # pair / range
         if isinstance(value, (str, bytes)) or not isinstance(value, Sequence) or len(value) != 2:
             raise self._error(f"must be two numbers, each {describe_range(self)}", value)
@@ -86,6 +102,16 @@ class Param:
         ):
             raise self._error(f"must be {describe_range(self)}", value)
         return number
+
+    def _words(self, value: Any) -> str:
+        items = value.split(",") if isinstance(value, str) else value
+        rule = f"must be 1 to {MAX_ITEMS} comma-separated words, each one of {', '.join(map(str, self.choices))}"
+        if isinstance(items, bytes) or not isinstance(items, Sequence) or not 1 <= len(items) <= MAX_ITEMS:
+            raise self._error(rule, value)
+        words = [w.strip() if isinstance(w, str) else w for w in items]
+        if not all(w in self.choices for w in words):
+            raise self._error(rule, value)
+        return ",".join(words)
 
     def _error(self, rule: str, value: Any) -> ParameterError:
         return ParameterError(f"parameter '{self.name}' {rule}, got {value!r}")
@@ -133,6 +159,10 @@ def parse_value(p: Param, text: str) -> Any:
         if low in ("false", "no", "0", "off"):
             return False
         return t
+    if p.kind == "words":
+        return t
+    if p.kind in ("list", "triple"):
+        return [_maybe_number(s) for s in t.replace(" ", ",").strip("[]()").split(",") if s]
     if p.kind in ("pair", "range"):
         parts = [s for s in t.replace("x", ",").replace(" ", ",").strip("[]()").split(",") if s]
         return [_maybe_number(s) for s in parts]
@@ -163,4 +193,10 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("friction", "float", 1.0, "Coulomb friction of every surface", 0.0, 10.0),
     Param("step_size", "float", 0.002, "physics step in every format", 0.0001, 0.1, unit="s"),
     Param("real_time_factor", "float", 1.0, "Gazebo real-time factor; 0 runs as fast as possible", 0.0, 1000.0),
+    Param("n_movers", "int", 0, "person-sized movers walking scripted looping paths on free floor", 0, 64),
+    Param("mover_radius", "float", 0.25, "radius of each mover's cylinder", 0.05, 2.0, unit="m"),
+    Param("mover_height", "float", 1.7, "height of each mover's cylinder", 0.1, 5.0, unit="m"),
+    Param("mover_speed", "float", 1.0, "walking speed of every mover", 0.05, 10.0, unit="m/s"),
+    Param("mover_waypoints", "int", 4, "distinct waypoints of each mover's loop", 2, 32),
+    Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
 )
