@@ -144,6 +144,13 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
     for name in sorted(by_name):
         p = by_name[name]
         resolved[name] = p.check(given.get(name, p.default))
+    if "lidar_range_min" in resolved and "lidar_range_max" in resolved:
+        # The one rule between two common parameters: a lidar needs a non-empty range.
+        if resolved["lidar_range_min"] >= resolved["lidar_range_max"]:
+            raise ParameterError(
+                f"parameter 'lidar_range_min' must be below lidar_range_max = {resolved['lidar_range_max']!r}, "
+                f"got {resolved['lidar_range_min']!r}"
+            )
     return resolved
 
 
@@ -199,4 +206,13 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("mover_speed", "float", 1.0, "walking speed of every mover", 0.05, 10.0, unit="m/s"),
     Param("mover_waypoints", "int", 4, "distinct waypoints of each mover's loop", 2, 32),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
+    # Ground truth written with every world (worldgen.groundtruth).
+    Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn", 0.001, 50.0, unit="m"),
+    Param("lidar_fov", "float", 6.283185, "field of view of the ground-truth lidar, centred ahead (6.283185 = full circle)",
+          1e-3, 6.283185307179586, unit="rad"),
+    Param("lidar_samples", "int", 360, "rays of the ground-truth lidar", 1, 100000),
+    Param("lidar_range_min", "float", 0.05, "shortest range of the ground-truth lidar (rays start there)", 0.0, 100.0, unit="m"),
+    Param("lidar_range_max", "float", 30.0, "longest range of the ground-truth lidar, written where nothing is hit", 0.01, 10000.0, unit="m"),
+    Param("map_height", "float", 0.1, "height of the horizontal slice the occupancy map is made from", 0.0, 50.0, unit="m"),
+    Param("map_resolution", "float", 0.05, "edge of one occupancy map cell", 0.005, 10.0, unit="m"),
 )
