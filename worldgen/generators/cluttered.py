@@ -21,7 +21,7 @@ from worldgen.footprint import FootprintIndex, robot_footprints
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.registry import register
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
-from worldgen.generators.tasks import sample_tasks
+from worldgen.generators.tasks import TASK_PARAMS, check_task_params, sample_tasks
 from worldgen.params import Param
 from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene
 
@@ -50,7 +50,7 @@ PARAMS = (
     Param("wall_height", "float", 1.0, "height of the walls", 0.05, 50.0, unit="m"),
     Param("wall_thickness", "float", 0.1, "thickness of the walls", 0.01, 10.0, unit="m"),
     Param("min_spawn_goal_distance", "float", 3.0, "smallest straight-line distance from spawn to goal", 0.0, 1000.0, unit="m"),
-)
+) + TASK_PARAMS
 
 
 def check(params: Mapping[str, Any]) -> None:
@@ -67,6 +67,7 @@ def check(params: Mapping[str, Any]) -> None:
             f"parameter 'min_spawn_goal_distance' must be in [0, {reach:.3f}] for this room and robot "
             f"(the usable diagonal), got {params['min_spawn_goal_distance']!r}"
         )
+    check_task_params(params, room_bounds(params["size"]))
 
 
 def obstacle_count(params: Mapping[str, Any]) -> int:
@@ -93,7 +94,8 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     robot = robot_from_params(params)
     index = FootprintIndex(robot_footprints(scene, robot))
     tasks, reason = sample_tasks(task_rng, index, bounds, robot, params["n_tasks"],
-                                 params["min_spawn_goal_distance"], params["goal_tolerance"])
+                                 params["min_spawn_goal_distance"], params["goal_tolerance"],
+                                 params["spawn"], params["goal"], params["task_region"])
     if reason:
         return Draft(scene, rejected="task_placement", detail=reason)
     return Draft(scene, tuple(tasks))
@@ -110,6 +112,9 @@ def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
     max_reach = max(math.hypot(*[params["box_size"][1]] * 2) / 2, params["cylinder_radius"][1])
     cell = 2 * max_reach + gap
     nodes = []
+    # A fixed spawn or goal is kept free: obstacles stay off its disc (plus the gap).
+    keep_out = [(p[0], p[1]) for p in (params["spawn"], params["goal"]) if p is not None]
+    keep_reach = params["robot_radius"] + params["clearance"] + max(gap, 0.01)
     for i in range(count):
         kind = shapes if shapes != "mixed" else ("box" if rng.random() < 0.5 else "cylinder")
         height = round_float(rng.uniform(*params["obstacle_height"]))
@@ -125,6 +130,8 @@ def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
             y = round_float(rng.uniform(y0, y1))
             candidate = _Footprint(kind, shape, x, y, yaw)
             if not candidate.inside(bounds):
+                continue
+            if keep_out and any(candidate.point_distance(px, py) < keep_reach for px, py in keep_out):
                 continue
             if _clear_of_neighbours(candidate, gap, placed, grid, cell):
                 break
@@ -174,6 +181,11 @@ class _Footprint:
             hx, hy = self.half
             ex, ey = c * hx + s * hy, s * hx + c * hy
         return x0 + ex <= self.x <= x1 - ex and y0 + ey <= self.y <= y1 - ey
+
+    def point_distance(self, px: float, py: float) -> float:
+        if self.kind == "cylinder":
+            return math.hypot(self.x - px, self.y - py) - self.radius
+        return self.polygon.distance(shapely.Point(px, py))
 
     def distance(self, other: "_Footprint") -> float:
         a, b = self, other

@@ -8,15 +8,17 @@ screen; the feasibility layer proves the final choice with FCL.
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import Any, Mapping, Optional, Sequence
 
 import numpy as np
 
+from worldgen.errors import ParameterError
 from worldgen.floats import round_float
 from worldgen.footprint import FootprintIndex
+from worldgen.params import Param
 from worldgen.scene import Pose, Robot, Task
 
-__all__ = ["free_points", "sample_tasks"]
+__all__ = ["free_points", "sample_tasks", "region_bounds", "check_task_params", "TASK_PARAMS"]
 
 _BATCH = 256
 _BATCHES = 16
@@ -44,44 +46,135 @@ def sample_tasks(
     n_tasks: int,
     min_distance: float,
     goal_tolerance: float,
+    spawn: Optional[Sequence[float]] = None,
+    goal: Optional[Sequence[float]] = None,
+    region: Optional[float] = None,
 ) -> tuple[list[Task], Optional[str]]:
     """Draw ``n_tasks`` spawn/goal pairs; returns (tasks, None) or ([], reason).
 
     Goals lie at least ``min_distance`` from their spawn. Spawns (and goals) of
     different tasks are at least two footprint radii plus clearance apart, so
     many robots can start together without overlapping.
+
+    ``spawn`` ([x, y, yaw]) and ``goal`` ([x, y]) fix the first task's ends
+    instead of drawing them (a fixed pair skips ``min_distance``: the caller
+    chose it); ``region`` h restricts drawn points to [-h, h] x [-h, h].
     """
     separation = 2 * robot.inflation
     spawns: list[np.ndarray] = []
     goals: list[np.ndarray] = []
     tasks: list[Task] = []
+    for label, fixed in (("spawn", spawn), ("goal", goal)):
+        if fixed is not None and not _free(index, bounds, robot, fixed[:2]):
+            return [], f"the fixed {label} ({fixed[0]:g}, {fixed[1]:g}) is not free for a {robot.inflation:g} m disc"
+    fixed_goal = None if goal is None else np.array(goal[:2], dtype=float)
+    if spawn is not None:
+        spawns.append(np.array(spawn[:2], dtype=float))
+        spawn_yaw = round_float(spawn[2])
+        if fixed_goal is not None:
+            goals.append(fixed_goal)
+            tasks.append(_task(0, spawns[0], spawn_yaw, fixed_goal, 0.0, goal_tolerance))
+            fixed_goal = None
+    draw_bounds = region_bounds(bounds, region, robot)
     for _ in range(_BATCHES):
-        pts = free_points(rng, index, bounds, robot, _BATCH)
+        if len(tasks) == n_tasks:
+            return tasks, None
+        pts = free_points(rng, index, draw_bounds, robot, _BATCH)
         yaws = rng.uniform(-math.pi, math.pi, len(pts))
         for p, yaw in zip(pts, yaws):
             if len(tasks) == n_tasks:
                 break
             if len(spawns) == len(tasks):  # looking for a spawn
                 if all(np.hypot(*(p - q)) >= separation for q in spawns):
+                    if fixed_goal is not None:  # the first task's goal is given: its spawn is drawn
+                        if np.hypot(*(p - fixed_goal)) < min_distance:
+                            continue
+                        spawns.append(p)
+                        goals.append(fixed_goal)
+                        tasks.append(_task(0, p, round_float(yaw), fixed_goal, 0.0, goal_tolerance))
+                        fixed_goal = None
+                        continue
                     spawns.append(p)
                     spawn_yaw = round_float(yaw)
                 continue
-            spawn = spawns[-1]
-            if np.hypot(*(p - spawn)) < min_distance:
+            spawn_xy = spawns[-1]
+            if np.hypot(*(p - spawn_xy)) < min_distance:
                 continue
             if not all(np.hypot(*(p - q)) >= separation for q in goals + spawns[:-1]):
                 continue
             goals.append(p)
-            tasks.append(
-                Task(
-                    f"task_{len(tasks)}",
-                    Pose(float(spawn[0]), float(spawn[1]), 0.0, 0.0, 0.0, spawn_yaw),
-                    Pose(float(p[0]), float(p[1]), 0.0, 0.0, 0.0, round_float(yaw)),
-                    goal_tolerance,
-                )
-            )
+            tasks.append(_task(len(tasks), spawn_xy, spawn_yaw, p, round_float(yaw), goal_tolerance))
         if len(tasks) == n_tasks:
             return tasks, None
     return [], (
         f"found {len(tasks)} of {n_tasks} spawn/goal pairs at least {min_distance:g} m apart on free floor"
     )
+
+
+def _task(i: int, spawn, spawn_yaw: float, goal, goal_yaw: float, goal_tolerance: float) -> Task:
+    return Task(
+        f"task_{i}",
+        Pose(float(spawn[0]), float(spawn[1]), 0.0, 0.0, 0.0, spawn_yaw),
+        Pose(float(goal[0]), float(goal[1]), 0.0, 0.0, 0.0, goal_yaw),
+        goal_tolerance,
+    )
+
+
+def _free(index: FootprintIndex, bounds, robot: Robot, xy) -> bool:
+    (x0, y0), (x1, y1) = bounds
+    r = robot.inflation + _SLACK
+    x, y = float(xy[0]), float(xy[1])
+    inside = x0 + r <= x <= x1 - r and y0 + r <= y <= y1 - r
+    return inside and not bool(index.blocked(np.array([[x, y]]), r)[0])
+
+
+def region_bounds(bounds, region: Optional[float], robot: Robot):
+    """The bounds within which drawn points keep to [-region, region]^2 (the disc may reach past it).
+
+    ``free_points`` keeps the disc inside what it is given, so the region is
+    widened by the disc's radius before it is intersected with ``bounds``.
+    """
+    if region is None:
+        return bounds
+    (x0, y0), (x1, y1) = bounds
+    h = region + robot.inflation + _SLACK
+    return ((max(x0, -h), max(y0, -h)), (min(x1, h), min(y1, h)))
+
+
+def check_task_params(params: Mapping[str, Any], bounds) -> None:
+    """Reject a fixed spawn/goal whose footprint leaves the floor, or a region with no room in it.
+
+    Raises :class:`ParameterError` naming the parameter; whether the point is
+    free of obstacles is the draw's business (obstacles may be random).
+    """
+    (x0, y0), (x1, y1) = bounds
+    r = params["robot_radius"] + params["clearance"] + _SLACK
+    floor = f"[{x0:g}, {x1:g}] x [{y0:g}, {y1:g}]"
+    for name in ("spawn", "goal"):
+        value = params.get(name)
+        if value is None:
+            continue
+        x, y = value[0], value[1]
+        if not (x0 + r <= x <= x1 - r and y0 + r <= y <= y1 - r):
+            raise ParameterError(
+                f"parameter '{name}' must keep the robot's {r - _SLACK:g} m disc (robot_radius + clearance) on the floor "
+                f"{floor}, i.e. x in [{x0 + r:g}, {x1 - r:g}] and y in [{y0 + r:g}, {y1 - r:g}], got {value!r}")
+    spawn = params.get("spawn")
+    if spawn is not None and not -math.pi <= spawn[2] <= math.pi:
+        raise ParameterError(f"parameter 'spawn' yaw (third value) must be in [-pi, pi] rad, got {spawn!r}")
+    region = params.get("task_region")
+    if region is not None:
+        if min(region, x1 - r) < max(-region, x0 + r) or min(region, y1 - r) < max(-region, y0 + r):
+            raise ParameterError(
+                f"parameter 'task_region' must overlap the floor {floor} shrunk by the robot's disc, got {region!r}")
+
+
+#: The task parameters every generator that draws tasks may take, under these names.
+TASK_PARAMS = (
+    Param("spawn", "triple", None, "fix the first task's spawn pose [x, y, yaw] instead of drawing it",
+          -10000.0, 10000.0, optional=True, unit="m, m, rad"),
+    Param("goal", "pair", None, "fix the first task's goal [x, y] instead of drawing it",
+          -10000.0, 10000.0, optional=True, unit="m"),
+    Param("task_region", "float", None, "draw spawns and goals only within [-h, h] x [-h, h] of the origin",
+          0.0, 10000.0, optional=True, unit="m"),
+)
