@@ -16,7 +16,9 @@ import numpy as np
 
 from worldgen import feasibility
 from worldgen.errors import InfeasibleError, ParameterError
-from worldgen.generators import get, robot_from_params
+from worldgen.generators import Draft, get, robot_from_params
+from worldgen.infeasible import wall_in_goals
+from worldgen.movers import mover_rng, place_movers
 from worldgen.world import World
 
 __all__ = ["generate", "attempt_rng", "MAX_SEED"]
@@ -53,13 +55,15 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
     budget = resolved["max_attempts"]
     for attempt in range(budget):
         draft = spec.build(resolved, attempt_rng(seed, attempt))
+        if not draft.rejected:
+            draft = _with_common_extras(spec, resolved, draft, robot, seed, attempt)
         if draft.rejected:
             failures[draft.rejected] += 1
             details.setdefault(draft.rejected, draft.detail)
             continue
         report = feasibility.check(draft.scene, draft.tasks, robot)
         world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1)
-        if report.feasible:
+        if report.feasible or (resolved.get("infeasible") and _infeasible_on_purpose(report)):
             return world
         for failed in report.failed():
             failures[failed.name] += 1
@@ -74,3 +78,29 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
         f"no feasible '{name}' world for seed {seed} within max_attempts={budget}: {summary}{hint}",
         dict(failures),
     )
+
+
+def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt: int) -> Draft:
+    """The draft with what every generator offers through common parameters (see the modules).
+
+    ``infeasible``: every goal walled in (worldgen.infeasible), unless the generator
+    declares its own ``infeasible`` parameter; ``n_movers``: movers on their own
+    RNG stream (worldgen.movers), laid out after any goal walls so they avoid them.
+    """
+    scene = draft.scene
+    if resolved.get("infeasible") and "infeasible" not in {p.name for p in spec.params}:
+        scene, reason = wall_in_goals(scene, draft.tasks, robot, resolved["friction"])
+        if reason:
+            return Draft(scene, draft.tasks, rejected="infeasible_placement", detail=reason)
+    if resolved.get("n_movers"):
+        movers, reason = place_movers(scene, draft.tasks, robot, resolved, mover_rng(seed, attempt))
+        if reason:
+            return Draft(scene, draft.tasks, rejected="mover_placement", detail=reason)
+        scene = scene.with_movers(movers)
+    return draft if scene is draft.scene else Draft(scene, draft.tasks)
+
+
+def _infeasible_on_purpose(report) -> bool:
+    """A world asked to be infeasible: its start and goal are fine, and the route is what fails."""
+    failed = {c.name for c in report.failed()}
+    return bool(failed) and failed <= {"path_exists", "path_clearance"}
