@@ -1,0 +1,455 @@
+"""preview.png: a top-down picture of a world, drawn from its world.json alone.
+
+``render(meta)`` returns PNG bytes; ``draw(meta)`` the Pillow image. Only the
+metadata is read (entities, doors, dynamic obstacles, tasks, metrics), never the
+scene, so ``worldgen preview WORLD_DIR`` redraws it from a folder a user received.
+``files`` is ignored on purpose, and preview.png is not listed there: it is a
+derived picture, and its bytes depend on Pillow's version (its zlib and its
+font rasteriser), which world.json's bytes must not; nor does the in-memory
+``World.metadata`` pay for drawing it. ``worldgen check`` leaves it alone;
+``worldgen preview`` redraws it from world.json whenever wanted.
+
+What it shows, back to front: the floor slab and the usable bounds (with a 1 m
+or 5 m grid), the no-go zone (every collider below the robot's top, grown by
+robot radius + clearance, translucent), walls, obstacles and door frames in
+their true outlines (rotated boxes, circles; meshes and tilted shapes as their
+bounding boxes), door leaves with their swing arc, movers' trajectories, the
+reference paths, spawn and goal footprints with heading arrows; above the map a
+title with the id and key figures, below it a scale bar and a legend.
+
+Bytes are deterministic: no timestamps or text chunks (Pillow writes IHDR,
+IDAT and IEND only for a fresh image), the font is Pillow's built-in one, and
+every coordinate comes from the rounded metadata.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any, Mapping, Optional
+
+import numpy as np
+import shapely
+from PIL import Image, ImageDraw, ImageFont
+
+from worldgen.errors import ParameterError
+from worldgen.scene.pose import rpy_matrix
+
+__all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
+           "Layout", "layout", "draw", "render", "attach", "blocking"]
+
+PREVIEW_NAME = "preview.png"
+DEFAULT_WIDTH = 800
+MIN_WIDTH, MAX_WIDTH = 400, 4000
+
+#: RGB of each layer; tests sample pixels against these.
+COLOURS = {
+    "background": (255, 255, 255),
+    "slab": (214, 214, 210),        # floor slab outside the usable bounds
+    "floor": (248, 247, 242),       # the usable bounds
+    "grid": (228, 227, 220),
+    "nogo": (232, 72, 64),          # blended at NOGO_ALPHA over what lies beneath
+    "wall": (45, 45, 55),
+    "obstacle": (84, 104, 140),
+    "overhead": (176, 186, 204),    # colliders the robot passes under
+    "frame": (105, 80, 60),
+    "door": (176, 112, 48),
+    "marker": (120, 170, 120),
+    "mover": (150, 70, 200),
+    "path": (250, 140, 0),
+    "spawn": (28, 150, 70),
+    "spawn_fill": (206, 238, 214),
+    "goal": (30, 90, 220),
+    "goal_fill": (210, 224, 250),
+    "text": (20, 20, 25),
+    "alert": (200, 30, 30),
+}
+#: Opacity of the no-go zone: light enough that the floor grid still shows through.
+NOGO_ALPHA = 0.3
+
+_MARGIN = 16     # px left and right of the map
+_TITLE_H = 46    # px above the map: two lines of text
+_FOOTER_H = 40   # px below the map per legend row
+_SS = 2          # the map is drawn at twice the size and averaged down: smooth edges, no blur
+_SCALE_BAR_MAX = 130  # px: the longest round length (100, 50, 10, 5, 1, 0.5 m) below it
+_HIDDEN = ("floor", "marker")  # roles that never block the robot
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where the world lands in the image.
+
+    World point (x, y) -> pixel ``(left + (x - x0) * scale, top + (y1 - y) * scale)``:
+    +x to the right, +y up (REP 103 seen from above). ``scale`` is px per metre;
+    (x0, y1) is the top-left corner of the drawn extent.
+    """
+
+    width: int
+    height: int
+    scale: float
+    x0: float
+    y1: float
+    left: float
+    top: float
+    legend_rows: int
+
+    def px(self, x: float, y: float) -> tuple[float, float]:
+        return self.left + (x - self.x0) * self.scale, self.top + (self.y1 - y) * self.scale
+
+
+def layout(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Layout:
+    """The image size and world->pixel map for ``meta`` at ``width`` px.
+
+    The drawn extent covers the bounds, every entity's box, every mover's
+    trajectory and every spawn and goal, plus a small margin. The map is at
+    most as tall as it is wide, so a long corridor along y stays on screen.
+    """
+    if isinstance(width, bool) or not isinstance(width, int) or not MIN_WIDTH <= width <= MAX_WIDTH:
+        raise ParameterError(f"parameter 'width' must be an integer in [{MIN_WIDTH}, {MAX_WIDTH}] px, got {width!r}")
+    xs, ys = _extent_points(meta)
+    lo = np.array([min(xs), min(ys)])
+    hi = np.array([max(xs), max(ys)])
+    span = hi - lo
+    pad = 0.02 * float(span.max()) + 0.1
+    lo, hi = lo - pad, hi + pad
+    span = hi - lo
+    room = width - 2 * _MARGIN
+    scale = min(room / span[0], room / span[1])
+    map_w, map_h = span[0] * scale, span[1] * scale
+    rows = 1 if _LEGEND_START + _legend_width() + _MARGIN <= width else 2
+    height = int(math.ceil(_TITLE_H + map_h + _FOOTER_H * rows))
+    return Layout(width, height, float(scale), float(lo[0]), float(hi[1]),
+                  float((width - map_w) / 2), float(_TITLE_H), rows)
+
+
+def _extent_points(meta) -> tuple[list[float], list[float]]:
+    b = meta["bounds"]
+    xs, ys = [b["min"][0], b["max"][0]], [b["min"][1], b["max"][1]]
+    for e in meta.get("entities", []):
+        (x0, y0, _), (x1, y1, _) = e["aabb"]
+        xs += [x0, x1]
+        ys += [y0, y1]
+    for m in meta.get("dynamic_obstacles", []) or []:
+        for _, x, y in m["trajectory"]:
+            xs += [x - m["radius"], x + m["radius"]]
+            ys += [y - m["radius"], y + m["radius"]]
+    r = meta["robot"]["radius"]
+    for t in meta.get("tasks", []):
+        for p in (t["spawn"], t["goal"]):
+            xs += [p[0] - r, p[0] + r]
+            ys += [p[1] - r, p[1] + r]
+    return xs, ys
+
+
+# -- geometry from the metadata ------------------------------------------------
+
+def _outline(entity) -> tuple[str, Any]:
+    """The entity's floor shadow: ("circle", (cx, cy, r)) or ("poly", (k, 2) points).
+
+    Upright boxes and cylinders (their local z vertical) and spheres are exact;
+    anything else (a mesh, a tilted shape, no shape) falls back to its world box.
+    """
+    shape = entity.get("shape") or {}
+    x, y, _, roll, pitch, yaw = entity["pose"]
+    rot = rpy_matrix(roll, pitch, yaw)
+    upright = abs(abs(rot[2, 2]) - 1.0) < 1e-9
+    kind = shape.get("type")
+    if kind == "sphere" or (kind == "cylinder" and upright):
+        return "circle", (x, y, shape["radius"])
+    if kind == "box" and upright:
+        sx, sy, _ = shape["size"]
+        ex, ey = rot[:2, 0] * sx / 2, rot[:2, 1] * sy / 2
+        c = np.array([x, y])
+        return "poly", np.array([c - ex - ey, c + ex - ey, c + ex + ey, c - ex + ey])
+    (x0, y0, _), (x1, y1, _) = entity["aabb"]
+    return "poly", np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
+
+
+def blocking(entity, robot: Mapping[str, float]) -> bool:
+    """True where the entity is in the no-go zone: a collider that reaches into the robot's height.
+
+    Door leaves are left out: reference paths are planned with doors open.
+    """
+    if entity["role"] in _HIDDEN or entity["role"] == "door":
+        return False
+    (_, _, z0), (_, _, z1) = entity["aabb"]
+    return z1 > 0.0 and z0 < robot["height"] + robot["clearance"]
+
+
+def _inflated(kind: str, geo, grow: float):
+    if kind == "circle":
+        return "circle", (geo[0], geo[1], geo[2] + grow)
+    ring = shapely.Polygon(geo).buffer(grow, quad_segs=8)
+    return "poly", np.asarray(ring.exterior.coords)[:-1]
+
+
+# -- drawing -------------------------------------------------------------------
+
+class _Pen:
+    """Draws world-frame shapes on a supersampled image."""
+
+    def __init__(self, image: Image.Image, lay: Layout):
+        self.draw = ImageDraw.Draw(image)
+        self.lay = lay
+
+    def xy(self, pts) -> list[tuple[float, float]]:
+        out = []
+        for x, y in np.asarray(pts, dtype=float).reshape(-1, 2):
+            u, v = self.lay.px(x, y)
+            out.append((u * _SS, v * _SS))
+        return out
+
+    def m(self, metres: float) -> float:
+        return metres * self.lay.scale * _SS
+
+    def shape(self, kind, geo, fill=None, outline=None, width=1):
+        if kind == "circle":
+            (u, v), = self.xy([geo[:2]])
+            r = self.m(geo[2])
+            self.draw.ellipse([u - r, v - r, u + r, v + r], fill=fill, outline=outline, width=width * _SS)
+        else:
+            self.draw.polygon(self.xy(geo), fill=fill, outline=outline, width=width * _SS)
+
+    def line(self, pts, fill, width=1, dash: Optional[float] = None):
+        p = self.xy(pts)
+        if dash is None:
+            self.draw.line(p, fill=fill, width=width * _SS, joint="curve")
+            return
+        step, on = dash * _SS, True
+        for a, b in zip(p[:-1], p[1:]):  # the dash pattern restarts at each vertex: simple, and fine here
+            length = math.dist(a, b)
+            n = max(1, int(length // step))
+            for k in range(n):
+                if on:
+                    t0, t1 = k / n, (k + 1) / n
+                    self.draw.line([(a[0] + (b[0] - a[0]) * t0, a[1] + (b[1] - a[1]) * t0),
+                                    (a[0] + (b[0] - a[0]) * t1, a[1] + (b[1] - a[1]) * t1)],
+                                   fill=fill, width=width * _SS)
+                on = not on
+
+    def arrow(self, x, y, yaw, length, fill, width=2):
+        tip = np.array([x + length * math.cos(yaw), y + length * math.sin(yaw)])
+        self.line([(x, y), tip], fill, width)
+        head = min(length * 0.45, 0.35)
+        wings = [tip - head * np.array([math.cos(yaw + s), math.sin(yaw + s)]) for s in (0.45, -0.45)]
+        self.draw.polygon(self.xy([tip, wings[0], wings[1]]), fill=fill)
+
+
+@lru_cache(maxsize=None)
+def _font(size: int):
+    return ImageFont.load_default(size=size)
+
+
+def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
+    """The preview of ``meta`` (a world.json dict) as an RGB image ``width`` px wide."""
+    lay = layout(meta, width)
+    big = Image.new("RGB", (lay.width * _SS, lay.height * _SS), COLOURS["background"])
+    pen = _Pen(big, lay)
+    robot = meta["robot"]
+    entities = list(meta.get("entities", []))
+
+    for e in entities:  # the slab first: the usable bounds and the grid go on top of it
+        if e["role"] == "floor":
+            pen.shape(*_outline(e), fill=COLOURS["slab"])
+    (bx0, by0), (bx1, by1) = meta["bounds"]["min"], meta["bounds"]["max"]
+    pen.shape("poly", [(bx0, by0), (bx1, by0), (bx1, by1), (bx0, by1)], fill=COLOURS["floor"])
+    _grid(pen, (bx0, by0, bx1, by1), _grid_step(lay.scale))
+
+    # The no-go zone: one mask (so overlaps do not darken), blended once.
+    mask = Image.new("L", big.size, 0)
+    mask_pen = _Pen(mask, lay)
+    grow = robot["radius"] + robot["clearance"]
+    for e in entities:
+        if blocking(e, robot):
+            mask_pen.shape(*_inflated(*_outline(e), grow), fill=255)
+    big.paste(COLOURS["nogo"], mask=mask.point(lambda v: round(v * NOGO_ALPHA)))
+
+    layer_order = {"marker": 0, "obstacle": 1, "door_frame": 2, "wall": 3}
+    for e in sorted((e for e in entities if e["role"] in layer_order), key=lambda e: layer_order[e["role"]]):
+        kind, geo = _outline(e)
+        if e["role"] == "marker":
+            pen.shape(kind, geo, outline=COLOURS["marker"], width=1)
+        elif not blocking(e, robot):
+            pen.shape(kind, geo, fill=COLOURS["overhead"], outline=COLOURS["obstacle"], width=1)
+        else:
+            pen.shape(kind, geo, fill=COLOURS[{"obstacle": "obstacle", "door_frame": "frame", "wall": "wall"}[e["role"]]])
+    by_name = {e["name"]: e for e in entities}
+    for door in meta.get("doors", []) or []:
+        _door(pen, door, by_name.get(door["name"]))
+    for e in entities:  # leaves not named by doors[] (a hand-built scene): their outline alone
+        if e["role"] == "door" and not any(d["name"] == e["name"] for d in meta.get("doors", []) or []):
+            pen.shape(*_outline(e), fill=COLOURS["door"])
+
+    for mover in meta.get("dynamic_obstacles", []) or []:
+        traj = [(x, y) for _, x, y in mover["trajectory"]]
+        if mover.get("loop") and len(traj) > 2:
+            traj.append(traj[0])
+        pen.line(traj, COLOURS["mover"], width=2, dash=7)
+        x, y = traj[0]
+        pen.shape("circle", (x, y, mover["radius"]), outline=COLOURS["mover"], width=2)
+
+    tasks = list(meta.get("tasks", []))
+    for t in tasks:
+        if t.get("path"):
+            pen.line(t["path"]["waypoints"], COLOURS["path"], width=3)
+    for i, t in enumerate(tasks):
+        label = "" if len(tasks) == 1 else str(i + 1)
+        _pose_marker(pen, t["spawn"], robot["radius"], "spawn", "S" + label)
+        _pose_marker(pen, t["goal"], robot["radius"], "goal", "G" + label, t.get("goal_tolerance"))
+
+    image = big.reduce(_SS)
+    _title(image, meta, lay)
+    _footer(image, lay)
+    return image
+
+
+def _grid_step(scale: float) -> float:
+    """1 m lines unless they would be closer than 12 px, then 5 m, 10 m..."""
+    for step in (1.0, 5.0, 10.0, 50.0, 100.0):
+        if step * scale >= 12:
+            return step
+    return 500.0
+
+
+def _grid(pen: _Pen, box, step: float) -> None:
+    x0, y0, x1, y1 = box
+    for x in np.arange(math.ceil(x0 / step) * step, x1 + 1e-9, step):
+        pen.line([(x, y0), (x, y1)], COLOURS["grid"])
+    for y in np.arange(math.ceil(y0 / step) * step, y1 + 1e-9, step):
+        pen.line([(x0, y), (x1, y)], COLOURS["grid"])
+
+
+def _door(pen: _Pen, door, leaf) -> None:
+    """The leaf (its entity, where named), its swing arc from limit to limit, and the leaf at each limit."""
+    hx, hy = door["hinge"][0], door["hinge"][1]
+    width, angle = door["width"], door["angle"]
+    lo, hi = door["limits"]
+    sign = 1.0 if door["axis"][2] >= 0 else -1.0
+    if leaf is not None:
+        direction = math.atan2(leaf["pose"][1] - hy, leaf["pose"][0] - hx)
+    else:  # no leaf entity: take joint angle 0 as closed, across the doorway towards its centre
+        cx, cy = door["passage"]["center"]
+        direction = math.atan2(cy - hy, cx - hx) + sign * angle
+    if abs(door["axis"][2]) > 0.99:  # a vertical hinge: the swing is a circle arc on the floor
+        at = [direction + sign * (q - angle) for q in np.linspace(lo, hi, 48)]
+        arc = [(hx + width * math.cos(a), hy + width * math.sin(a)) for a in at]
+        pen.line(arc, COLOURS["door"], width=1, dash=5)
+        for a in (at[0], at[-1]):
+            pen.line([(hx, hy), (hx + width * math.cos(a), hy + width * math.sin(a))], COLOURS["door"], width=1)
+    if leaf is not None:
+        pen.shape(*_outline(leaf), fill=COLOURS["door"])
+    else:
+        pen.line([(hx, hy), (hx + width * math.cos(direction), hy + width * math.sin(direction))],
+                 COLOURS["door"], width=3)
+    pen.shape("circle", (hx, hy, 0.04), fill=COLOURS["frame"])
+
+
+def _pose_marker(pen: _Pen, pose, radius: float, kind: str, label: str, tolerance=None) -> None:
+    x, y, yaw = pose[0], pose[1], pose[5]
+    if tolerance:
+        pen.shape("circle", (x, y, tolerance), outline=COLOURS[kind], width=1)
+    pen.shape("circle", (x, y, radius), fill=COLOURS[kind + "_fill"], outline=COLOURS[kind], width=2)
+    pen.arrow(x, y, yaw, radius * 2.2, COLOURS[kind])
+    (u, v), = pen.xy([(x - radius * 0.75, y + radius * 0.75)])  # to the upper left, off the arrow's usual path
+    font = _font(15 * _SS)
+    pen.draw.text((u, v), label, fill=COLOURS[kind], font=font, anchor="rb")
+
+
+def _fmt_m(x) -> str:
+    return "-" if x is None else f"{x:.2f} m"
+
+
+def _title(image: Image.Image, meta, lay: Layout) -> None:
+    d = ImageDraw.Draw(image)
+    room = lay.width - 2 * _MARGIN
+    big, small = _font(16), _font(13)
+    world_id = str(meta.get("world_id", "?"))
+    d.text((_MARGIN, 6), world_id, fill=COLOURS["text"], font=big)
+    feas = meta.get("feasibility", {}) or {}
+    if feas and not feas.get("feasible", True):
+        failed = ", ".join(c["name"] for c in feas.get("checks", []) if not c.get("ok"))
+        x = _MARGIN + big.getlength(world_id) + 12
+        d.text((x, 6), _fit(f"INFEASIBLE: {failed}", big, _MARGIN + room - x), fill=COLOURS["alert"], font=big)
+    metrics = meta.get("metrics", {}) or {}
+    lengths = [t["path"]["length"] for t in meta.get("tasks", []) if t.get("path")]
+    parts = [
+        f"path {', '.join(f'{x:.2f}' for x in lengths)} m" if lengths else "no path",
+        f"narrowest passage {_fmt_m(metrics.get('narrowest_passage'))}",
+        f"{metrics.get('obstacle_count', '?')} obstacles",
+        f"robot r {meta['robot']['radius']:.2f} + {meta['robot']['clearance']:.2f} m",
+    ]
+    while len(parts) > 1 and small.getlength("   |   ".join(parts)) > room:  # narrow image: least important last
+        parts.pop()
+    d.text((_MARGIN, 26), _fit("   |   ".join(parts), small, room), fill=COLOURS["text"], font=small)
+
+
+def _fit(text: str, font, room: float) -> str:
+    """``text`` cut (with an ellipsis) to at most ``room`` px."""
+    if font.getlength(text) <= room:
+        return text
+    while text and font.getlength(text + "...") > room:
+        text = text[:-1]
+    return text + "..."
+
+
+_LEGEND = (("obstacle", "obstacle", "box"), ("wall", "wall", "box"), ("no-go zone", "nogo", "zone"),
+           ("path", "path", "line"), ("spawn", "spawn", "disc"), ("goal", "goal", "disc"),
+           ("door", "door", "box"), ("mover", "mover", "dash"))
+_LEGEND_START = _MARGIN + _SCALE_BAR_MAX + 28 + 40  # right of the longest scale bar and the axes
+_LEGEND_GAP = 12  # px between one entry's text and the next glyph
+
+
+def _legend_width() -> float:
+    font = _font(12)
+    return sum(19 + font.getlength(text) + _LEGEND_GAP for text, _, _ in _LEGEND)
+
+
+def _footer(image: Image.Image, lay: Layout) -> None:
+    d = ImageDraw.Draw(image)
+    font = _font(12)
+    top = lay.height - _FOOTER_H * lay.legend_rows
+    y = top + 14
+    length = next((s for s in (100.0, 50.0, 10.0, 5.0, 1.0, 0.5) if s * lay.scale <= _SCALE_BAR_MAX), 0.5)
+    x0, x1 = _MARGIN, _MARGIN + length * lay.scale
+    d.line([(x0, y), (x1, y)], fill=COLOURS["text"], width=3)
+    for x in (x0, x1):
+        d.line([(x, y - 5), (x, y + 5)], fill=COLOURS["text"], width=2)
+    d.text(((x0 + x1) / 2, y + 6), f"{length:g} m", fill=COLOURS["text"], font=font, anchor="ma")
+    # Axes: +x right, +y up.
+    ax, ay = x1 + 28, y + 8
+    d.line([(ax, ay), (ax + 18, ay)], fill=COLOURS["text"], width=2)
+    d.line([(ax, ay), (ax, ay - 18)], fill=COLOURS["text"], width=2)
+    d.text((ax + 20, ay), "x", fill=COLOURS["text"], font=font, anchor="lm")
+    d.text((ax, ay - 20), "y", fill=COLOURS["text"], font=font, anchor="mb")
+    # Legend, wrapped onto the rows the layout reserved.
+    per_row = math.ceil(len(_LEGEND) / lay.legend_rows)
+    gx = start = max(ax + 40, lay.width - _MARGIN - _legend_width() / lay.legend_rows)
+    for i, (text, colour, glyph) in enumerate(_LEGEND):
+        if i and i % per_row == 0:
+            gx = start
+        gy = top + 12 + (i // per_row) * _FOOTER_H
+        c = COLOURS[colour]
+        if glyph == "box":
+            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=c)
+        elif glyph == "zone":
+            blend = tuple(round(f + (n - f) * NOGO_ALPHA) for f, n in zip(COLOURS["floor"], c))
+            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=blend, outline=c)
+        elif glyph == "line":
+            d.line([(gx, gy), (gx + 14, gy)], fill=c, width=3)
+        elif glyph == "disc":
+            d.ellipse([gx + 1, gy - 6, gx + 13, gy + 6], fill=COLOURS[colour + "_fill"], outline=c, width=2)
+        else:
+            d.line([(gx, gy), (gx + 5, gy)], fill=c, width=2)
+            d.line([(gx + 9, gy), (gx + 14, gy)], fill=c, width=2)
+        d.text((gx + 19, gy), text, fill=COLOURS["text"], font=font, anchor="lm")
+        gx += 19 + font.getlength(text) + _LEGEND_GAP
+
+
+def render(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> bytes:
+    """preview.png of ``meta`` as PNG bytes (same metadata, same bytes)."""
+    meta = {k: v for k, v in meta.items() if k != "files"}
+    buf = io.BytesIO()
+    draw(meta, width).save(buf, format="PNG", compress_level=6)
+    return buf.getvalue()
