@@ -113,21 +113,32 @@ class World:
         return metadata.dumps(self.metadata_for(self.rendered_files(formats, sdf_version)))
 
     # -- disk --------------------------------------------------------------
-    def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> Path:
+    def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
+              preview: bool = True) -> Path:
         """Write ``out_dir/<world_id>/`` (the world's files and world.json); return that folder.
 
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
+        ``preview`` adds preview.png, a top-down picture (worldgen.preview).
         """
+        blobs = self.folder_blobs(formats, sdf_version, preview)
+        target = write_folder_atomically(Path(out_dir), self.world_id, blobs)
+        self.path = target
+        return target
+
+    def folder_blobs(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
+                     preview: bool = True) -> dict[str, bytes]:
+        """Every file :meth:`write` puts in the folder, world.json included: relative path -> bytes."""
         from worldgen.export import metadata
 
         files = self.rendered_files(formats, sdf_version)
         meta = self.metadata_for(files)
         blobs = {path: data for path, data in files.values()}
+        if preview:  # a picture of world.json, not listed in its `files` (see worldgen.preview)
+            from worldgen.preview import PREVIEW_NAME, render
+            blobs[PREVIEW_NAME] = render(meta)
         blobs[METADATA_NAME] = metadata.dumps(meta).encode()
-        target = write_folder_atomically(Path(out_dir), self.world_id, blobs)
-        self.path = target
-        return target
+        return blobs
 
     def file(self, fmt: str) -> Path:
         """Path of a written file (``sdf``, ``mjcf``, ``urdf`` or ``json``)."""
