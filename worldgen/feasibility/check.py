@@ -20,6 +20,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
+from worldgen.doors import door_joints, open_scene
 from worldgen.feasibility.collision import Colliders
 from worldgen.feasibility.field import distance_field, grid_for
 from worldgen.feasibility.geometry import Obstacles2D
@@ -63,9 +64,18 @@ def _p(xy) -> str:
 
 
 def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityReport:
-    """Check every task of ``scene`` for ``robot``; never raises for an infeasible world."""
+    """Check every task of ``scene`` for ``robot``; never raises for an infeasible world.
+
+    Doors (see :mod:`worldgen.doors`) are planned through at their open limit;
+    spawn and goal must be free both so and as the doors start, and the
+    informational ``reachable_initial_state`` says whether the goal can be
+    reached without opening any door.
+    """
+    initial = scene
+    scene = open_scene(initial)  # the scene itself when it has no door to open
     bounds = scene.bounds
     colliders = Colliders(scene)
+    initial_colliders = colliders if scene is initial else Colliders(initial)
     obstacles = Obstacles2D.from_footprints(scene_footprints(scene, robot.height + robot.clearance))
     spawns = np.array([[t.spawn.x, t.spawn.y] for t in tasks], dtype=float).reshape(-1, 2)
     goals = np.array([[t.goal.x, t.goal.y] for t in tasks], dtype=float).reshape(-1, 2)
@@ -82,6 +92,9 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     free = {}
     for label, pts in (("spawn", spawns), ("goal", goals)):
         near = [colliders.nearest(robot, p[None, :]) for p in pts]
+        if initial_colliders is not colliders:  # doors: free both as they start and opened
+            near = [min(n, initial_colliders.nearest(robot, p[None, :]), key=lambda m: m.distance)
+                    for n, p in zip(near, pts)]
         values = np.array([n.distance for n in near])
         free[label] = _aggregate(
             f"{label}_free", tasks, values, values >= robot.clearance,
@@ -157,7 +170,30 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
                                     lambda v: f"smallest FCL clearance {v:.4f} m along the sampled paths")
     checks = (inside, free["spawn"], free["goal"], path_exists, path_clearance)
     narrowest = min(passages) if passages and not no_path else None
-    return FeasibilityReport(checks, tuple(paths), narrowest, "fcl", grid.hx)
+    informational = ()
+    if door_joints(initial):
+        informational = (_reachable_initial(initial, tasks, robot, grid, cap, plannable, spawns, goals, radius),)
+    return FeasibilityReport(checks, tuple(paths), narrowest, "fcl", grid.hx, informational)
+
+
+def _reachable_initial(initial: Scene, tasks, robot: Robot, grid, cap: float, plannable, spawns, goals,
+                       radius: float) -> Check:
+    """Informational: can every task be driven with the doors as they start (closed ones shut)?
+
+    The same grid search as the reference path, on the initial scene; it never
+    makes a world infeasible (the reference path assumes the doors opened).
+    """
+    obstacles = Obstacles2D.from_footprints(scene_footprints(initial, robot.height + robot.clearance))
+    field = distance_field(obstacles, initial.bounds, grid, cap)
+    blocked = []
+    for i, task in enumerate(tasks):
+        if not plannable[i] or grid_path(field, spawns[i], goals[i], radius) is None:
+            blocked.append(task.id)
+    if blocked:
+        return Check("reachable_initial_state", False, None,
+                     f"{', '.join(blocked)}: no path for a {robot.inflation:g} m disc with the doors as they start "
+                     "(informational: the reference path opens them)")
+    return Check("reachable_initial_state", True, None, "every goal is reachable with the doors as they start")
 
 
 def _length(points: np.ndarray) -> float:

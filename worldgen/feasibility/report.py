@@ -53,6 +53,9 @@ class FeasibilityReport:
     narrowest_passage: Optional[float]
     checker: str = "fcl"
     resolution: Optional[float] = None
+    #: Checks that inform but never decide ``feasible`` (e.g. ``reachable_initial_state``
+    #: for doors: the reference path assumes them open).
+    informational: tuple[Check, ...] = ()
 
     @property
     def feasible(self) -> bool:
