@@ -19,6 +19,7 @@ from typing import Any, Mapping
 import numpy as np
 import shapely
 
+from worldgen.doors import door_records, requires_door_open
 from worldgen.floats import round_float
 from worldgen.footprint import scene_footprints
 from worldgen.params import COMMON_PARAMS
@@ -60,7 +61,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "bounds": {"min": [x0, y0], "max": [x1, y1]},
         "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
         "entities": [_entity(scene, node) for node in scene.nodes],
-        "doors": [],
+        "doors": door_records(scene),
         "dynamic_obstacles": [],
         "tasks": [_task(task, path, speed) for task, path in zip(world.tasks, paths)],
         "feasibility": {
@@ -73,6 +74,10 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
             "narrowest_passage": narrowest,
             "resolution": _finite_or_none(report.resolution),
             "attempts": int(world.attempts),
+            "informational": [
+                {"name": c.name, "ok": bool(c.ok), "value": _finite_or_none(c.value), "detail": c.detail}
+                for c in getattr(report, "informational", ())
+            ],
         },
         "metrics": {
             "obstacle_count": sum(1 for n in scene.nodes if n.role == "obstacle"),
@@ -81,6 +86,8 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         },
         "files": {key: {"path": path, "sha256": digest} for key, (path, digest) in sorted(files.items())},
     }
+    for task, path in zip(meta["tasks"], paths):
+        task["requires_door_open"] = requires_door_open(meta["doors"], None if path is None else path.waypoints)
     return _plain(meta)
 
 
