@@ -23,12 +23,17 @@ How the scene maps onto MJCF:
 - Friction: "slide torsional rolling" = node.material.friction and MuJoCo's own
   defaults for the two others. Colour: ``rgba``.
 - Nodes without collision (role ``marker``): ``contype="0" conaffinity="0"``.
+- Movers: mocap bodies named after the mover (:mod:`worldgen.export.movers`),
+  driven through ``data.mocap_pos`` (:func:`worldgen.movers.drive_mocap`).
+- Physics: ``<option timestep gravity>``; the real-time factor, which MuJoCo
+  does not know, as ``<custom><numeric name="real_time_factor">``.
 """
 
 from __future__ import annotations
 
 from typing import Optional
 
+from worldgen.export.movers import write_mjcf_mocap
 from worldgen.export.xml import load_template, sub
 from worldgen.floats import fmt, fmt_seq, round_float
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere
@@ -100,6 +105,10 @@ def to_mjcf(scene: Scene, name: str = "world"):
         children.setdefault(node.parent, []).append(node)
     for node in children.get(None, ()):
         _write_node(worldbody, node, joints, children, mesh_assets)
+    write_mjcf_mocap(worldbody, scene)
+    # MuJoCo has no pacing of its own: the real-time factor travels as a custom
+    # number (model.numeric("real_time_factor")) for a runner that wants it.
+    sub(sub(root, "custom"), "numeric", name="real_time_factor", data=fmt(scene.physics.real_time_factor))
     return tree
 
 

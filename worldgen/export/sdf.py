@@ -41,6 +41,12 @@ simulators' sources):
   up on its resource path, so add the world folder to ``GAZEBO_RESOURCE_PATH``.
 * No ``<plugin>``: Gazebo Sim loads its default systems (physics, scene
   broadcaster, user commands) when a world names none.
+* Movers (``scene.movers``) are ``<actor>``s with a looping scripted
+  trajectory and a link carrying their cylinder, the same element in 1.6 and
+  1.9 (:mod:`worldgen.export.movers`). Gazebo classic moves any actor link
+  along the script; Gazebo Sim accepts skin-less, trajectory-only actors only
+  since gz-sim pull request 1947 (2023) and may not draw their links (gz-sim
+  issue 418). Neither gives actors contacts: a mover is seen, not felt.
 
 A model is ``<static>`` only when all its nodes are static. A static root with a
 dynamic descendant (a door frame with its leaf) gives a dynamic model whose root
@@ -55,6 +61,7 @@ import numpy as np
 from lxml import etree
 
 from worldgen.errors import ParameterError, WorldgenError
+from worldgen.export.movers import write_sdf_actors
 from worldgen.export.xml import load_template
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose
@@ -93,6 +100,7 @@ def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> etree._
     for node in scene.nodes:
         if node.parent is None:
             writer.write(world, node)
+    write_sdf_actors(world, scene)
     return tree
 
 

@@ -32,7 +32,14 @@ URDF describes one kinematic tree, so a world becomes one "robot":
 - Meshes refer to ``shape.uri`` (relative to the world folder, written by
   :mod:`worldgen.export.meshes`) with ``scale``.
 - A ``<mujoco>`` element in the skeleton keeps MuJoCo from fusing the fixed
-  links into one body and from stripping ``meshes/`` off mesh paths.
+  links into one body and from stripping ``meshes/`` off mesh paths; its
+  ``<option timestep gravity>`` carries the world's physics step and gravity
+  (MuJoCo reads it; URDF itself has no world physics). The real-time factor has
+  no place in URDF, nor does friction for MuJoCo's importer (it reads only
+  ``compiler``/``option``/``size`` there), so a URDF loaded in MuJoCo keeps its
+  default friction; Gazebo reads the ``<gazebo>`` mu1/mu2 above.
+- Movers (``scene.movers``) cannot be expressed in URDF and are left out;
+  world.json's ``dynamic_obstacles[].formats.urdf`` is null to say so.
 """
 
 from __future__ import annotations
@@ -73,6 +80,8 @@ def to_urdf(scene: Scene, name: str = "world"):
     tree = load_template(TEMPLATE)
     robot = tree.getroot()
     robot.set("name", name)
+    # Only MuJoCo's importer reads physics from a URDF: step and gravity go in its extension.
+    sub(robot.find("mujoco"), "option", timestep=fmt(scene.physics.step_size), gravity=fmt_seq(scene.physics.gravity))
     materials = _write_materials(robot, scene)
     for node in scene.nodes:
         joint = joints.get(node.name)
