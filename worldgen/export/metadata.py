@@ -22,6 +22,7 @@ import shapely
 from worldgen.doors import door_records, requires_door_open
 from worldgen.floats import round_float
 from worldgen.footprint import scene_footprints
+from worldgen.movers import metadata_entry as mover_entry
 from worldgen.params import COMMON_PARAMS
 
 __all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "time_limit", "free_area_ratio"]
@@ -62,7 +63,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
         "entities": [_entity(scene, node) for node in scene.nodes],
         "doors": door_records(scene),
-        "dynamic_obstacles": [],
+        "dynamic_obstacles": [mover_entry(m) for m in scene.movers],
         "tasks": [_task(task, path, speed) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
