@@ -31,6 +31,8 @@ def register(spec: GeneratorSpec) -> GeneratorSpec:
 def _load_builtins() -> None:
     from worldgen.generators import cluttered  # noqa: F401  (registers itself)
     from worldgen.generators import door  # noqa: F401
+    from worldgen.generators import minimal  # noqa: F401
+    from worldgen.generators import corridor  # noqa: F401
 
 
 def _load_plugins() -> None:

@@ -1,0 +1,386 @@
+"""``corridor``: a walled corridor, straight or with 90 degree turns, spawn at one end, goal at the other.
+
+The centreline starts at the origin heading +x and runs through ``segments``
+(lengths, m), turning 90 degrees ``left`` or ``right`` between them:
+``straight`` is one segment, ``L`` two (one turn), ``U`` three (two turns the
+same way), ``zigzag`` any number (turns as given, alternating by default).
+Both ends are closed by a wall, so the robot cannot leave by the ends; side
+openings (gaps in the side walls) lead to the floor around the corridor,
+which lies inside the bounds where the corridor bends round it.
+
+Obstacles are boxes standing against a side wall. Each leaves at least
+``min_passage`` to the opposite wall, and obstacles on one leg are at least
+``min_passage`` apart along it (and as far from the leg's corners, openings,
+spawn and goal), so every gap on the way is at least ``min_passage`` wide.
+
+Width and the feasibility grid: a corridor narrower than
+2 x (robot_radius + clearance) cannot be driven, and :func:`check` says so
+with the numbers (:class:`~worldgen.errors.InfeasibleError`). The checker
+proves a path on a grid of cell size h (about (robot_radius + clearance) / 3,
+see :func:`worldgen.feasibility.check.resolution_for`), and proves a move only
+where the clearance exceeds the inflation radius by half the move, so it can
+show passable only corridors a little wider than that minimum: widths below
+:func:`proven_width` (the minimum plus :data:`GRID_MARGIN_CELLS` cells) are
+refused with that explanation rather than retried in vain. With the default
+robot (0.2 m + 0.05 m) the minimum is 0.5 m and the proven width about 0.67 m.
+``generate(..., allow_infeasible=True)`` still builds such a corridor, and its
+feasibility report then says which check failed.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping
+
+import numpy as np
+
+from worldgen.errors import InfeasibleError, ParameterError
+from worldgen.feasibility.check import SAFETY, resolution_for
+from worldgen.floats import round_float
+from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
+from worldgen.generators.registry import register
+from worldgen.generators.room import FLOOR_RGBA, FLOOR_THICKNESS, WALL_RGBA
+from worldgen.params import Param
+from worldgen.scene import Box, Material, Node, Physics, Pose, Scene, Task
+
+__all__ = ["SPEC", "build", "check", "layout", "proven_width", "GRID_MARGIN_CELLS", "Layout"]
+
+#: Grid cells on top of 2 x (radius + clearance) that a corridor needs to be proven passable.
+GRID_MARGIN_CELLS = 2.0
+#: Tries to place one obstacle or opening before the draw counts as too crowded.
+PLACEMENT_TRIES = 60
+#: Density (kg/m^3) for the obstacles' nominal mass: static, but inertia must be valid.
+OBSTACLE_DENSITY = 300.0
+OBSTACLE_RGBA = (0.80, 0.52, 0.25, 1.0)
+#: Unit vectors of the four headings (+x, +y, -x, -y): exact, so coordinates stay exact sums.
+_HEADINGS = ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))
+_SEGMENT_COUNT = {"straight": 1, "L": 2, "U": 3}
+#: Default number of segments of a zigzag given neither segments nor turns.
+ZIGZAG_SEGMENTS = 4
+
+PARAMS = (
+    Param("shape", "choice", "straight", "layout of the centreline", choices=("straight", "L", "U", "zigzag")),
+    Param("width", "float", 1.5, "free width between the side walls", 0.05, 50.0, unit="m"),
+    Param("length", "float", 10.0, "centreline length of every segment (unless 'segments' is given)",
+          0.5, 500.0, unit="m"),
+    Param("segments", "list", None, "centreline length of each segment: straight 1, L 2, U 3, zigzag 2 or more",
+          0.5, 500.0, optional=True, unit="m"),
+    Param("turns", "words", None, "direction of each turn (L 1, U 2 alike, zigzag one fewer than segments); "
+          "unset: left, left-left for U, alternating for zigzag", choices=("left", "right"), optional=True),
+    Param("wall_height", "float", 1.0, "height of the walls", 0.05, 50.0, unit="m"),
+    Param("wall_thickness", "float", 0.1, "thickness of the walls", 0.01, 10.0, unit="m"),
+    Param("n_obstacles", "int", 0, "boxes standing against the side walls", 0, 500),
+    Param("min_passage", "float", None, "smallest gap the obstacles leave; unset: 2 x (robot_radius + clearance) "
+          "+ 0.2", 0.01, 50.0, optional=True, unit="m"),
+    Param("obstacle_length", "range", [0.2, 0.6], "range of each obstacle's extent along the corridor",
+          0.01, 50.0, unit="m"),
+    Param("obstacle_height", "range", [0.5, 1.0], "range of obstacle heights", 0.01, 50.0, unit="m"),
+    Param("side_openings", "int", 0, "gaps in the side walls, on random sides and legs", 0, 100),
+    Param("opening_width", "float", 1.0, "width of each side opening", 0.05, 50.0, unit="m"),
+)
+
+
+class Layout:
+    """The corridor's centreline and derived frame, all exact for axis-aligned headings.
+
+    ``points`` (k+1, 2) centreline vertices, ``heads`` (k,) heading index of each
+    segment (0 +x, 1 +y, 2 -x, 3 -y), ``lengths`` (k,), ``turns`` (k-1,) +1 left / -1 right.
+    """
+
+    def __init__(self, lengths, turns, width: float):
+        self.lengths = [float(v) for v in lengths]
+        self.turns = list(turns)
+        self.width = width
+        heads, points = [0], [np.zeros(2)]
+        for i, length in enumerate(self.lengths):
+            points.append(points[-1] + length * np.array(_HEADINGS[heads[-1]]))
+            if i < len(self.turns):
+                heads.append((heads[-1] + self.turns[i]) % 4)
+        self.heads = heads
+        self.points = np.array(points)
+
+    def u(self, i: int) -> np.ndarray:
+        return np.array(_HEADINGS[self.heads[i]])
+
+    def n(self, i: int) -> np.ndarray:
+        """The left normal of segment i."""
+        return np.array(_HEADINGS[(self.heads[i] + 1) % 4])
+
+    def rects(self, extra: float = 0.0) -> list[tuple[float, float, float, float]]:
+        """(minx, miny, maxx, maxy) of each leg's floor (corner squares included), widened by ``extra``."""
+        out = []
+        half = self.width / 2 + extra
+        k = len(self.lengths)
+        for i in range(k):
+            u = self.u(i)
+            start = self.points[i] - (self.width / 2 + extra if i > 0 else extra) * u
+            end = self.points[i + 1] + (self.width / 2 + extra if i < k - 1 else extra) * u
+            n = self.n(i)
+            pts = np.array([start + half * n, start - half * n, end + half * n, end - half * n])
+            out.append((*pts.min(axis=0), *pts.max(axis=0)))
+        return out
+
+    def bounds(self):
+        r = np.array(self.rects())
+        return ((float(r[:, 0].min()), float(r[:, 1].min())), (float(r[:, 2].max()), float(r[:, 3].max())))
+
+    def straight_part(self, i: int) -> tuple[float, float]:
+        """Along-segment interval of leg i outside the corner squares (0 = its start vertex)."""
+        lo = self.width / 2 if i > 0 else 0.0
+        hi = self.lengths[i] - (self.width / 2 if i < len(self.lengths) - 1 else 0.0)
+        return lo, hi
+
+
+def _lengths_and_turns(params: Mapping[str, Any]) -> tuple[list[float], list[int]]:
+    shape = params["shape"]
+    segments, turns = params["segments"], params["turns"]
+    words = turns.split(",") if turns is not None else None
+    if shape == "zigzag":
+        count = len(segments) if segments is not None else (len(words) + 1 if words else ZIGZAG_SEGMENTS)
+        if count < 2:
+            raise ParameterError(f"parameter 'segments' must hold at least 2 lengths for a zigzag, got {segments!r}")
+        if words is None:
+            words = ["left" if i % 2 == 0 else "right" for i in range(count - 1)]
+        if len(words) != count - 1:
+            raise ParameterError(f"parameter 'turns' must name {count - 1} turns for {count} zigzag segments, got {turns!r}")
+    else:
+        count = _SEGMENT_COUNT[shape]
+        if segments is not None and len(segments) != count:
+            raise ParameterError(f"parameter 'segments' must hold {count} length(s) for a {shape} corridor, got {segments!r}")
+        if shape == "straight":
+            if words is not None:
+                raise ParameterError(f"parameter 'turns' does not apply to a straight corridor; leave it unset, got {turns!r}")
+            words = []
+        elif words is None:
+            words = ["left"] * (count - 1)
+        elif len(words) != count - 1 or len(set(words)) != 1:
+            need = "one turn" if shape == "L" else "two turns the same way (e.g. left,left)"
+            raise ParameterError(f"parameter 'turns' must be {need} for a {shape} corridor, got {turns!r}")
+    lengths = list(segments) if segments is not None else [params["length"]] * count
+    return lengths, [1 if w == "left" else -1 for w in words]
+
+
+def layout(params: Mapping[str, Any]) -> Layout:
+    """The centreline of validated ``params`` (raises :class:`ParameterError` for impossible ones)."""
+    lengths, turns = _lengths_and_turns(params)
+    return Layout(lengths, turns, params["width"])
+
+
+def proven_width(params: Mapping[str, Any], bounds) -> float:
+    """The narrowest corridor the feasibility checker can prove passable for this robot and floor."""
+    robot = robot_from_params(params)
+    return 2 * (robot.inflation + SAFETY) + GRID_MARGIN_CELLS * resolution_for(robot, bounds)
+
+
+def _end_offset(params: Mapping[str, Any]) -> float:
+    """Distance of spawn (goal) from the start (end) wall: half the width, at least the footprint + 0.05 m."""
+    return max(params["width"] / 2, params["robot_radius"] + params["clearance"] + 0.05)
+
+
+def _passage(params: Mapping[str, Any]) -> float:
+    if params["min_passage"] is not None:
+        return params["min_passage"]
+    return min(params["width"], 2 * (params["robot_radius"] + params["clearance"]) + 0.2)
+
+
+def check(params: Mapping[str, Any]) -> None:
+    """Reject parameters no corridor can satisfy; a too-narrow width is an InfeasibleError."""
+    lay = layout(params)
+    w, t = params["width"], params["wall_thickness"]
+    name = "segments" if params["segments"] is not None else "length"
+    k = len(lay.lengths)
+    e = _end_offset(params)
+    for i, length in enumerate(lay.lengths):
+        corners = (i > 0) + (i < k - 1)
+        ends = 2 - corners
+        need = corners * w / 2 + ends * e + (0.1 if k == 1 else 0.0)
+        if length <= need:
+            raise ParameterError(
+                f"parameter '{name}' must make each leg longer than its corner squares and spawn/goal room "
+                f"({need:g} m for leg {i} of this corridor), got {params[name]!r}")
+    rects = lay.rects(extra=t)
+    for i in range(k):
+        for j in range(i + 2, k):
+            a, b = rects[i], rects[j]
+            if a[0] < b[2] - 1e-9 and b[0] < a[2] - 1e-9 and a[1] < b[3] - 1e-9 and b[1] < a[3] - 1e-9:
+                raise ParameterError(
+                    f"parameter 'turns' makes leg {j} run into leg {i} (walls included); lengthen 'segments' or "
+                    f"change the turns, got turns={params['turns']!r}, segments={lay.lengths!r}")
+    r, c = params["robot_radius"], params["clearance"]
+    need = 2 * (r + c)
+    if w < need:
+        raise InfeasibleError(
+            f"corridor width {w:g} m cannot pass a {r:g} m radius robot with {c:g} m clearance (needs >= {need:g} m)")
+    proven = proven_width(params, lay.bounds())
+    if w < proven:
+        raise InfeasibleError(
+            f"corridor width {w:g} m is within the feasibility grid's resolution of the {need:g} m a {r:g} m radius "
+            f"robot with {c:g} m clearance needs; the checker proves corridors from {proven:.3f} m wide")
+    g = _passage(params)
+    if params["n_obstacles"]:
+        if g < proven:
+            raise ParameterError(
+                f"parameter 'min_passage' must be in [{proven:.3f}, {w:g}] (from the narrowest gap the checker "
+                f"proves passable for this robot to the width), got {params['min_passage']!r}")
+        if w - g < 0.05:
+            raise ParameterError(
+                f"parameter 'min_passage' must be at most width - 0.05 = {w - 0.05:g} m so obstacles have depth, "
+                f"got {g:g}")
+    if params["side_openings"] and params["opening_width"] > max(b - a for a, b in
+                                                                 (lay.straight_part(i) for i in range(k))):
+        raise ParameterError(f"parameter 'opening_width' must fit in a leg's straight part, got {params['opening_width']!r}")
+
+
+def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
+    opening_rng, obstacle_rng = rng.spawn(2)
+    lay = layout(params)
+    w, t, height = params["width"], params["wall_thickness"], params["wall_height"]
+    friction = params["friction"]
+    bounds = lay.bounds()
+    k = len(lay.lengths)
+    e = _end_offset(params)
+    g = _passage(params)
+    inflation = params["robot_radius"] + params["clearance"]
+    # Per leg: the along-leg intervals already taken (openings, obstacles) and where things may go.
+    usable = []
+    for i in range(k):
+        lo, hi = lay.straight_part(i)
+        if i == 0:
+            lo = e + inflation
+        if i == k - 1:
+            hi = lay.lengths[i] - e - inflation
+        usable.append((lo, hi))
+    taken: list[list[tuple[float, float]]] = [[] for _ in range(k)]
+
+    openings: list[list[tuple[float, float]]] = [[] for _ in range(2 * k)]  # per (leg, side)
+    ow = params["opening_width"]
+    for _ in range(params["side_openings"]):
+        spot = _place(opening_rng, usable, taken, lambda: ow, 0.2)
+        if spot is None:
+            return Draft(None, rejected="opening_placement",
+                         detail=f"could not fit {params['side_openings']} openings of {ow:g} m in the side walls")
+        leg, a, b = spot
+        side = int(opening_rng.integers(2))
+        openings[2 * leg + side].append((a, b))
+
+    nodes = [_floor(bounds, t, friction)]
+    nodes += _walls(lay, t, height, friction, openings)
+    lo_len, hi_len = params["obstacle_length"]
+    width_of = len(str(max(params["n_obstacles"] - 1, 0)))
+    mat = Material("obstacle_box", OBSTACLE_RGBA, friction)
+    for j in range(params["n_obstacles"]):
+        spot = _place(obstacle_rng, usable, taken, lambda: obstacle_rng.uniform(lo_len, hi_len), g)
+        if spot is None:
+            return Draft(None, rejected="obstacle_placement",
+                         detail=f"could not fit {params['n_obstacles']} obstacles {g:g} m apart along the corridor")
+        leg, a, b = spot
+        side = 1.0 if obstacle_rng.random() < 0.5 else -1.0
+        depth = round_float(obstacle_rng.uniform(min(0.1, w - g), w - g))
+        h = round_float(obstacle_rng.uniform(*params["obstacle_height"]))
+        along = round_float(b - a)
+        centre = lay.points[leg] + (a + b) / 2 * lay.u(leg) + side * (w / 2 - depth / 2) * lay.n(leg)
+        nodes.append(Node(f"obstacle_{j:0{width_of}d}", "obstacle", Box((along, depth, h)),
+                          _pose(centre, h / 2, lay.heads[leg]),
+                          mass=round_float(max(along * depth * h * OBSTACLE_DENSITY, 1e-3)), material=mat))
+    scene = Scene(tuple(nodes), (), bounds, Physics(params["step_size"], params["real_time_factor"]))
+    start = lay.points[0] + e * lay.u(0)
+    end = lay.points[-1] - e * lay.u(k - 1)
+    task = Task("task_0", Pose(round_float(start[0]), round_float(start[1]), 0.0, 0.0, 0.0, _yaw(lay.heads[0])),
+                Pose(round_float(end[0]), round_float(end[1]), 0.0, 0.0, 0.0, _yaw(lay.heads[-1])),
+                params["goal_tolerance"])
+    return Draft(scene, (task,))
+
+
+def _place(rng, usable, taken, draw_length, gap):
+    """(leg, a, b): a free along-leg interval of a drawn length, ``gap`` from every taken one; None if none."""
+    spans = np.array([max(hi - lo, 0.0) for lo, hi in usable])
+    if spans.sum() <= 0:
+        return None
+    weights = spans / spans.sum()
+    for _ in range(PLACEMENT_TRIES):
+        length = float(draw_length())
+        leg = int(rng.choice(len(usable), p=weights))
+        lo, hi = usable[leg]
+        lo, hi = lo + gap, hi - gap
+        if hi - lo < length:
+            continue
+        a = round_float(rng.uniform(lo, hi - length))
+        b = round_float(a + length)
+        if all(b + gap <= c or a >= d + gap for c, d in taken[leg]):
+            taken[leg].append((a, b))
+            return leg, a, b
+    return None
+
+
+def _yaw(head: int) -> float:
+    return round_float((0.0, math.pi / 2, math.pi, -math.pi / 2)[head])
+
+
+def _pose(centre, z: float, head: int) -> Pose:
+    """A box pose on a leg: boxes are symmetric, so -x/-y legs reuse the +x/+y yaw (exact)."""
+    return Pose(round_float(centre[0]), round_float(centre[1]), z, 0.0, 0.0, 0.0 if head % 2 == 0 else _yaw(1))
+
+
+def _floor(bounds, margin: float, friction: float) -> Node:
+    (x0, y0), (x1, y1) = bounds
+    return Node("floor", "floor", Box((x1 - x0 + 2 * margin, y1 - y0 + 2 * margin, FLOOR_THICKNESS)),
+                Pose(round_float((x0 + x1) / 2), round_float((y0 + y1) / 2), -FLOOR_THICKNESS / 2),
+                material=Material("floor", FLOOR_RGBA, friction))
+
+
+def _walls(lay: Layout, t: float, height: float, friction: float, openings) -> list[Node]:
+    """Side walls along both face lines (mitred at the corners) and a wall across each end.
+
+    A side wall is extended by ``t`` past an outer corner so the two legs' walls
+    overlap there and close the corner; at an inner corner they meet at the face.
+    """
+    mat = Material("wall", WALL_RGBA, friction)
+    w, k = lay.width, len(lay.lengths)
+    nodes = []
+    for side, label in ((1, "left"), (-1, "right")):
+        for i in range(k):
+            a, b = lay.straight_part(i)
+            # The face's corner: at an inner corner it is the straight part's end; at an outer one the
+            # face runs on across the corner square (w) plus the wall thickness.
+            if i > 0:
+                a = a if lay.turns[i - 1] == side else a - w - t
+            if i < k - 1:
+                b = b if lay.turns[i] == side else b + w + t
+            pieces = _cut(a, b, sorted(openings[2 * i + (0 if side == 1 else 1)]))
+            for p, (pa, pb) in enumerate(pieces):
+                centre = lay.points[i] + (pa + pb) / 2 * lay.u(i) + side * (w / 2 + t / 2) * lay.n(i)
+                nodes.append(Node(f"wall_{label}_{i}_{p}", "wall", Box((round_float(pb - pa), t, height)),
+                                  _pose(centre, height / 2, lay.heads[i]), material=mat))
+    for name, point, u, head in (("wall_start", lay.points[0], -lay.u(0), lay.heads[0]),
+                                 ("wall_end", lay.points[-1], lay.u(k - 1), lay.heads[-1])):
+        centre = point + (t / 2) * u
+        nodes.append(Node(name, "wall", Box((t, w + 2 * t, height)), _pose(centre, height / 2, head), material=mat))
+    return nodes
+
+
+def _cut(a: float, b: float, gaps) -> list[tuple[float, float]]:
+    """[a, b] with the (sorted, disjoint) gaps removed."""
+    out, cursor = [], a
+    for ga, gb in gaps:
+        if ga > cursor:
+            out.append((cursor, ga))
+        cursor = max(cursor, gb)
+    if b > cursor:
+        out.append((cursor, b))
+    return out
+
+
+SPEC = register(
+    GeneratorSpec(
+        name="corridor",
+        summary="a walled corridor (straight, L, U or zigzag) with optional obstacles and side openings",
+        params=PARAMS,
+        build=build,
+        check=check,
+        examples=(
+            "worldgen generate corridor --set width=0.8 --out worlds",
+            "worldgen generate corridor --set shape=zigzag --set segments=4,3,4 --set turns=left,right --out worlds",
+            "worldgen generate corridor --set shape=L --set n_obstacles=4 --set side_openings=2 --out worlds",
+        ),
+    )
+)
