@@ -1,0 +1,61 @@
+"""The ground truth of one World, as world.json and the files beside it want it.
+
+The one place that reads a World's parameters for lidar, map and metrics, so
+that world.json and the written map files always agree. A world's occupancy map
+is made once and remembered (worlds are written after their metadata is built).
+"""
+
+from __future__ import annotations
+
+import weakref
+
+from worldgen.groundtruth import lidar, metrics, occupancy
+from worldgen.params import COMMON_PARAMS
+
+__all__ = ["lidar_spec", "sensors", "occupancy_map", "occupancy_block", "map_files", "difficulty", "MAP_KEYS"]
+
+#: world.json ``files`` keys of the map's two files.
+MAP_KEYS = ("map_pgm", "map_yaml")
+
+_DEFAULTS = {p.name: p.default for p in COMMON_PARAMS}
+_MAPS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
+def _param(world, name: str):
+    return world.params.get(name, _DEFAULTS[name])
+
+
+def lidar_spec(world) -> lidar.LidarSpec:
+    """The world's lidar: at its first task's spawn, ``lidar_height`` up."""
+    params = {name: _param(world, name) for name in
+              ("lidar_height", "lidar_fov", "lidar_samples", "lidar_range_min", "lidar_range_max")}
+    return lidar.spec_from_params(params, world.tasks[0].spawn)
+
+
+def sensors(world) -> dict:
+    """world.json's ``sensors`` block."""
+    return {"lidar": lidar.describe(world.scene, lidar_spec(world))}
+
+
+def occupancy_map(world) -> occupancy.OccupancyMap:
+    if world not in _MAPS:
+        _MAPS[world] = occupancy.build(world.scene, float(_param(world, "map_height")),
+                                       float(_param(world, "map_resolution")))
+    return _MAPS[world]
+
+
+def occupancy_block(world) -> dict:
+    """world.json's ``occupancy`` block."""
+    return occupancy_map(world).describe(occupancy.IMAGE_NAME, occupancy.YAML_NAME)
+
+
+def map_files(world) -> dict[str, tuple[str, bytes]]:
+    """``{key: (relative path, bytes)}`` of the map's PGM and YAML files."""
+    grid = occupancy_map(world)
+    return {"map_pgm": (occupancy.IMAGE_NAME, grid.pgm()),
+            "map_yaml": (occupancy.YAML_NAME, grid.yaml(occupancy.IMAGE_NAME))}
+
+
+def difficulty(world) -> dict:
+    """The five BARN-style figures of world.json's ``metrics``."""
+    return metrics.difficulty(world.scene, world.robot, world.tasks, world.feasibility.paths)
