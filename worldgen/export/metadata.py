@@ -21,6 +21,7 @@ import shapely
 
 from worldgen.doors import door_records, requires_door_open
 from worldgen.floats import round_float
+from worldgen.groundtruth import truth
 from worldgen.footprint import scene_footprints
 from worldgen.movers import metadata_entry as mover_entry
 from worldgen.params import COMMON_PARAMS
@@ -84,7 +85,10 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
             "obstacle_count": sum(1 for n in scene.nodes if n.role == "obstacle"),
             "free_area_ratio": free_area_ratio(scene, robot.height + robot.clearance),
             "narrowest_passage": narrowest,
+            **truth.difficulty(world),
         },
+        "sensors": truth.sensors(world),
+        "occupancy": truth.occupancy_block(world),
         "files": {key: {"path": path, "sha256": digest} for key, (path, digest) in sorted(files.items())},
     }
     for task, path in zip(meta["tasks"], paths):
