@@ -101,6 +101,8 @@ class World:
         if "sdf" in formats or "urdf" in formats:
             for rel, data in self.mesh_files().items():
                 files[f"mesh:{rel}"] = (rel, data)
+        from worldgen.groundtruth import truth
+        files.update(truth.map_files(self))  # the occupancy map goes with every world
         return files
 
     @cached_property
