@@ -25,16 +25,19 @@ every coordinate comes from the rounded metadata.
 from __future__ import annotations
 
 import io
+import json
 import math
+import os
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 from typing import Any, Mapping, Optional
 
 import numpy as np
 import shapely
 from PIL import Image, ImageDraw, ImageFont
 
-from worldgen.errors import ParameterError
+from worldgen.errors import OutputError, ParameterError
 from worldgen.scene.pose import rpy_matrix
 
 __all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
@@ -53,7 +56,7 @@ COLOURS = {
     "nogo": (232, 72, 64),          # blended at NOGO_ALPHA over what lies beneath
     "wall": (45, 45, 55),
     "obstacle": (84, 104, 140),
-    "overhead": (176, 186, 204),    # colliders the robot passes under
+    "overhead": (150, 160, 180),    # outline of colliders the robot passes under
     "frame": (105, 80, 60),
     "door": (176, 112, 48),
     "marker": (120, 170, 120),
@@ -119,7 +122,7 @@ def layout(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Layout:
     scale = min(room / span[0], room / span[1])
     map_w, map_h = span[0] * scale, span[1] * scale
     rows = 1 if _LEGEND_START + _legend_width() + _MARGIN <= width else 2
-    height = int(math.ceil(_TITLE_H + map_h + _FOOTER_H * rows))
+    height = int(math.ceil(_TITLE_H + map_h + _FOOTER_H * rows - 1e-6))  # 768.0000001 px is 768
     return Layout(width, height, float(scale), float(lo[0]), float(hi[1]),
                   float((width - map_w) / 2), float(_TITLE_H), rows)
 
@@ -257,6 +260,10 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
     pen.shape("poly", [(bx0, by0), (bx1, by0), (bx1, by1), (bx0, by1)], fill=COLOURS["floor"])
     _grid(pen, (bx0, by0, bx1, by1), _grid_step(lay.scale))
 
+    for e in entities:  # colliders the robot passes under (a door head): a thin outline, beneath the rest
+        if e["role"] not in _HIDDEN and e["role"] != "door" and not blocking(e, robot):
+            pen.shape(*_outline(e), outline=COLOURS["overhead"], width=1)
+
     # The no-go zone: one mask (so overlaps do not darken), blended once.
     mask = Image.new("L", big.size, 0)
     mask_pen = _Pen(mask, lay)
@@ -271,9 +278,7 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
         kind, geo = _outline(e)
         if e["role"] == "marker":
             pen.shape(kind, geo, outline=COLOURS["marker"], width=1)
-        elif not blocking(e, robot):
-            pen.shape(kind, geo, fill=COLOURS["overhead"], outline=COLOURS["obstacle"], width=1)
-        else:
+        elif blocking(e, robot):
             pen.shape(kind, geo, fill=COLOURS[{"obstacle": "obstacle", "door_frame": "frame", "wall": "wall"}[e["role"]]])
     by_name = {e["name"]: e for e in entities}
     for door in meta.get("doors", []) or []:
@@ -340,9 +345,9 @@ def _door(pen: _Pen, door, leaf) -> None:
             pen.line([(hx, hy), (hx + width * math.cos(a), hy + width * math.sin(a))], COLOURS["door"], width=1)
     if leaf is not None:
         pen.shape(*_outline(leaf), fill=COLOURS["door"])
-    else:
-        pen.line([(hx, hy), (hx + width * math.cos(direction), hy + width * math.sin(direction))],
-                 COLOURS["door"], width=3)
+    # A leaf is a few cm thick: a 4 px stroke keeps it visible at any scale.
+    pen.line([(hx, hy), (hx + width * math.cos(direction), hy + width * math.sin(direction))],
+             COLOURS["door"], width=4)
     pen.shape("circle", (hx, hy, 0.04), fill=COLOURS["frame"])
 
 
@@ -378,6 +383,7 @@ def _title(image: Image.Image, meta, lay: Layout) -> None:
         f"path {', '.join(f'{x:.2f}' for x in lengths)} m" if lengths else "no path",
         f"narrowest passage {_fmt_m(metrics.get('narrowest_passage'))}",
         f"{metrics.get('obstacle_count', '?')} obstacles",
+        *([f"doors: {', '.join(d['state'] for d in meta['doors'])}"] if meta.get("doors") else []),
         f"robot r {meta['robot']['radius']:.2f} + {meta['robot']['clearance']:.2f} m",
     ]
     while len(parts) > 1 and small.getlength("   |   ".join(parts)) > room:  # narrow image: least important last
@@ -453,3 +459,35 @@ def render(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> bytes:
     buf = io.BytesIO()
     draw(meta, width).save(buf, format="PNG", compress_level=6)
     return buf.getvalue()
+
+
+def write_preview(folder, width: int = DEFAULT_WIDTH) -> Path:
+    """Redraw ``folder/preview.png`` from ``folder/world.json``; return the picture's path.
+
+    The file is replaced atomically (written beside it, then renamed), so a
+    reader never sees half a picture. world.json is only read.
+    """
+    folder = Path(folder)
+    source = folder / "world.json"
+    try:
+        meta = json.loads(source.read_bytes())
+    except FileNotFoundError:
+        raise ParameterError(f"argument WORLD_DIR '{folder}' has no world.json") from None
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"argument WORLD_DIR '{folder}': world.json cannot be read as JSON ({exc})") from None
+    try:
+        png = render(meta, width)
+    except (KeyError, TypeError, ValueError, IndexError) as exc:
+        if isinstance(exc, ParameterError):
+            raise
+        raise ParameterError(f"argument WORLD_DIR '{folder}': world.json cannot be drawn "
+                             f"({type(exc).__name__}: {exc})") from None
+    target = folder / PREVIEW_NAME
+    tmp = folder / f".{PREVIEW_NAME}.{os.getpid()}.tmp"
+    try:
+        tmp.write_bytes(png)
+        os.replace(tmp, target)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise OutputError(f"cannot write '{target}': {exc.strerror or exc}") from None
+    return target
