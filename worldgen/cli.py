@@ -120,6 +120,40 @@ def generate_command(generator: str, seed: int, settings: Sequence[str], out: Pa
         click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}{verdict}")
 
 
+@cli.command("preview", context_settings=_CONTEXT)
+@click.argument("world_dirs", nargs=-1, required=True, metavar="WORLD_DIR...",
+                type=click.Path(exists=True, file_okay=False, path_type=Path))
+@click.option("--width", type=int, default=800, show_default=True, help="Image width in px (400 to 4000).")
+def preview_command(world_dirs: Sequence[Path], width: int) -> None:
+    """Redraw preview.png of each world folder from its world.json.
+
+    The picture is not listed in world.json's files, so world.json is left as it is.
+    """
+    from worldgen.preview import write_preview
+
+    for folder in world_dirs:
+        click.echo(str(write_preview(folder, width)))
+
+
+@cli.command("check", context_settings=_CONTEXT)
+@click.argument("world_dirs", nargs=-1, required=True, metavar="WORLD_DIR...",
+                type=click.Path(exists=True, file_okay=False, path_type=Path))
+def check_command(world_dirs: Sequence[Path]) -> None:
+    """Re-verify received world folders: hashes, schema, regeneration, feasibility.
+
+    Prints "OK DIR" or "FAIL DIR: CHECK: DETAIL" per folder; exit status 1 if any failed.
+    """
+    from worldgen.verify import check_folder
+
+    failed = 0
+    for folder in world_dirs:
+        outcome = check_folder(folder)
+        failed += not outcome.ok
+        click.echo(outcome.line())
+    if failed:
+        raise click.exceptions.Exit(1)
+
+
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
     """``["key=value", ...]`` -> ``{key: value}``, each value parsed for its parameter's kind.
 
