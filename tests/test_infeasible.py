@@ -125,9 +125,18 @@ def test_api_rejects_a_bad_flag_value_in_one_line():
         worldgen.generate("cluttered", seed=0, infeasible=1)
 
 
-def test_every_registered_generator_takes_the_flag():
-    from worldgen.generators import all_specs
+def _generator_names():
+    from worldgen.generators import names
 
-    for spec in all_specs():
-        assert "infeasible" in {p.name for p in spec.all_params}, spec.name
-        assert "n_movers" in {p.name for p in spec.all_params}, spec.name
+    return names()
+
+
+@pytest.mark.parametrize("name", _generator_names())
+def test_every_registered_generator_can_be_asked_for_an_infeasible_world_with_movers(name):
+    world = worldgen.generate(name, seed=1, infeasible=True, n_movers=1)
+    meta = world.metadata
+    metadata.validate(meta)
+    assert meta["feasibility"]["feasible"] is False
+    failed = [c["name"] for c in meta["feasibility"]["checks"] if not c["ok"]]
+    assert failed and failed[0] == "path_exists", failed
+    assert len(meta["dynamic_obstacles"]) == 1
