@@ -20,7 +20,7 @@ import click
 
 import worldgen
 from worldgen.api import MAX_SEED
-from worldgen.errors import OutputError, ParameterError, WorldgenError
+from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
 from worldgen.world import FORMATS, SDF_VERSIONS, normalise_formats
@@ -81,7 +81,10 @@ def list_command(as_json: bool) -> None:
 
 
 @cli.command("generate", context_settings=_CONTEXT, epilog=_examples())
-@click.argument("generator")
+@click.argument("generator", required=False)
+@click.option("--preset", "preset_name", metavar="NAME",
+              help="Start from preset NAME (see 'worldgen presets') or a preset .yaml file instead of a "
+                   "GENERATOR; --set overrides its parameters.")
 @click.option("--seed", type=click.IntRange(0, MAX_SEED), default=0, show_default=True,
               help="Seed of the first world; --count K makes seeds N .. N+K-1.")
 @click.option("--set", "settings", multiple=True, metavar="KEY=VALUE",
@@ -97,16 +100,30 @@ def list_command(as_json: bool) -> None:
 @click.option("--allow-infeasible", is_flag=True,
               help="For negative tests: where no draw passes, write the last checked one; "
                    "its world.json says feasible false and which checks failed.")
-def generate_command(generator: str, seed: int, settings: Sequence[str], out: Path, formats: str,
-                     sdf_version: str, count: int, allow_infeasible: bool) -> None:
+def generate_command(generator: Optional[str], seed: int, settings: Sequence[str], out: Path, formats: str,
+                     sdf_version: str, count: int, allow_infeasible: bool, preset_name: Optional[str] = None) -> None:
     """Generate, check and write worlds of GENERATOR.
 
     Prints one line per world: its folder, the reference path length of each
     task and how many draws it took. Each folder appears complete or not at all.
     """
+    base: dict[str, Any] = {}
+    if preset_name is not None:
+        if generator is not None:
+            raise ParameterError(f"give either GENERATOR or --preset, not both (got '{generator}' and '{preset_name}')")
+        from worldgen.presets import load
+
+        preset = load(preset_name)
+        generator, base = preset.generator, dict(preset.params)
+    elif generator is None:
+        raise ParameterError("give a GENERATOR (see 'worldgen list') or --preset NAME (see 'worldgen presets')")
     spec = get(generator)
-    params = parse_settings(spec.all_params, settings, spec.name)
-    spec.resolve(params)  # every parameter mistake surfaces before any world is drawn
+    params = {**base, **parse_settings(spec.all_params, settings, spec.name)}
+    try:
+        spec.resolve(params)  # every parameter mistake surfaces before any world is drawn
+    except InfeasibleError:  # a request known to be undrivable: written anyway only when asked
+        if not allow_infeasible:
+            raise
     chosen = normalise_formats(formats)
     if seed + count - 1 > MAX_SEED:
         raise ParameterError(f"parameter 'count' must be in [1, {MAX_SEED - seed + 1}] for seed {seed}, got {count}")
@@ -154,6 +171,23 @@ def check_command(world_dirs: Sequence[Path]) -> None:
         raise click.exceptions.Exit(1)
 
 
+@cli.command("presets", context_settings=_CONTEXT)
+@click.option("--json", "as_json", is_flag=True, help="Print every preset in full as JSON (stable key order).")
+def presets_command(as_json: bool) -> None:
+    """List the shipped presets: name and description (use with 'generate --preset NAME')."""
+    from worldgen.presets import all_presets
+
+    found = all_presets()
+    if as_json:
+        click.echo(json.dumps([{"name": p.name, "description": p.description, "reproduces": p.reproduces,
+                                "generator": p.generator, "params": dict(p.params)} for p in found],
+                              indent=2, sort_keys=True))
+        return
+    width = max((len(p.name) for p in found), default=0)
+    for p in found:
+        click.echo(f"{p.name.ljust(width)}  {p.description}")
+
+
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
     """``["key=value", ...]`` -> ``{key: value}``, each value parsed for its parameter's kind.
 
@@ -181,8 +215,12 @@ def describe_param(p: Param) -> dict[str, Any]:
     """One parameter as ``worldgen list`` shows it (also its --json form)."""
     if p.kind == "range":
         allowed = f"min <= max, each {describe_range(p)}"
-    elif p.kind == "pair":
+    elif p.kind in ("pair", "triple"):
         allowed = f"each {describe_range(p)}"
+    elif p.kind == "list":
+        allowed = f"comma-separated numbers, each {describe_range(p)}"
+    elif p.kind == "words":
+        allowed = f"comma-separated, each {describe_range(p)}"
     elif p.kind == "int":
         allowed = f"integer {describe_range(p)}"
     else:
