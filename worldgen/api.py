@@ -19,6 +19,7 @@ from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.generators import Draft, get, robot_from_params
 from worldgen.infeasible import wall_in_goals
 from worldgen.movers import mover_rng, place_movers
+from worldgen.params import validate_params
 from worldgen.world import World
 
 __all__ = ["generate", "attempt_rng", "MAX_SEED"]
@@ -47,7 +48,15 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
     """
     spec = get(name)
     seed = check_seed(seed)
-    resolved = spec.resolve(params)
+    try:
+        resolved = spec.resolve(params)
+    except InfeasibleError:
+        # The generator knows the request can never be driven (e.g. a corridor narrower
+        # than the footprint). A negative test that asked for that still gets the world;
+        # its feasibility report then says which checks failed.
+        if not allow_infeasible:
+            raise
+        resolved = validate_params(spec.all_params, params)
     robot = robot_from_params(resolved)
     failures: Counter[str] = Counter()
     details: dict[str, str] = {}
