@@ -119,7 +119,7 @@ class Param:
 
 def describe_range(p: Param) -> str:
     """The allowed values of ``p`` in words, e.g. ``in [0, 2000]``."""
-    if p.kind == "choice":
+    if p.kind in ("choice", "words"):
         return "one of " + ", ".join(map(str, p.choices))
     if p.kind == "bool":
         return "true or false"
