@@ -14,11 +14,12 @@ except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
 from worldgen.api import generate
+from worldgen.presets import generate_preset
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, UnknownGeneratorError, WorldgenError
 from worldgen.generators import GeneratorSpec, register
 from worldgen.world import FORMATS, World
 
 __all__ = [
-    "__version__", "generate", "World", "FORMATS", "GeneratorSpec", "register",
+    "__version__", "generate", "generate_preset", "World", "FORMATS", "GeneratorSpec", "register",
     "WorldgenError", "ParameterError", "UnknownGeneratorError", "InfeasibleError", "OutputError",
 ]
