@@ -213,6 +213,6 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("lidar_samples", "int", 360, "rays of the ground-truth lidar", 1, 100000),
     Param("lidar_range_min", "float", 0.05, "shortest range of the ground-truth lidar (rays start there)", 0.0, 100.0, unit="m"),
     Param("lidar_range_max", "float", 30.0, "longest range of the ground-truth lidar, written where nothing is hit", 0.01, 10000.0, unit="m"),
-    Param("map_height", "float", 0.1, "height of the horizontal slice the occupancy map is made from", 0.0, 50.0, unit="m"),
+    Param("map_height", "float", 0.1, "height of the horizontal slice the occupancy map is made from (above the floor slab)", 0.001, 50.0, unit="m"),
     Param("map_resolution", "float", 0.05, "edge of one occupancy map cell", 0.005, 10.0, unit="m"),
 )
