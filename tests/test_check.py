@@ -1,0 +1,182 @@
+"""`worldgen check`: a fresh world passes; every kind of damage fails with the check named, exit 1."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import worldgen
+from worldgen.cli import main
+from worldgen.export.metadata import dumps
+from worldgen.verify import CHECKS, check_folder
+
+
+@pytest.fixture(scope="module")
+def fresh(tmp_path_factory):
+    """A written cluttered world (kept pristine) and a door world with a mover."""
+    out = tmp_path_factory.mktemp("fresh")
+    cluttered = worldgen.generate("cluttered", seed=11).write(out)
+    door = worldgen.generate("door", seed=2, n_movers=1).write(out)
+    return cluttered, door
+
+
+@pytest.fixture
+def world(fresh, tmp_path) -> Path:
+    """A copy of the cluttered world to damage."""
+    return Path(shutil.copytree(fresh[0], tmp_path / fresh[0].name))
+
+
+def _edit_json(folder: Path, change) -> None:
+    meta = json.loads((folder / "world.json").read_text())
+    change(meta)
+    (folder / "world.json").write_text(dumps(meta))
+
+
+def _check(capsys, *folders) -> tuple[int, list[str]]:
+    status = main(["check", *map(str, folders)])
+    return status, capsys.readouterr().out.splitlines()
+
+
+def _fails(capsys, folder: Path, check: str, *words: str) -> str:
+    status, lines = _check(capsys, folder)
+    assert status == 1 and len(lines) == 1, lines
+    prefix = f"FAIL {folder}: {check}: "
+    assert lines[0].startswith(prefix), lines
+    for w in words:
+        assert w in lines[0], lines
+    return lines[0]
+
+
+def test_fresh_worlds_pass_through_the_installed_script(fresh):
+    run = subprocess.run([sys.executable, "-m", "worldgen", "check", *map(str, fresh)],
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert run.stdout.splitlines() == [f"OK {f}" for f in fresh]
+
+
+def test_an_altered_file_fails_files(world, capsys):
+    with open(world / "world.sdf", "ab") as fh:
+        fh.write(b"\n")
+    _fails(capsys, world, "files", "world.sdf", "sha256")
+
+
+def test_a_missing_file_fails_files(world, capsys):
+    (world / "world.urdf").unlink()
+    _fails(capsys, world, "files", "world.urdf is missing")
+
+
+def test_a_changed_param_fails_regenerate_on_the_content_hash(world, capsys):
+    _edit_json(world, lambda m: m["params"].__setitem__("n_obstacles", m["params"]["n_obstacles"] + 1))
+    _fails(capsys, world, "regenerate", "content_hash")
+
+
+def test_an_unknown_param_fails_regenerate_with_the_generators_message(world, capsys):
+    _edit_json(world, lambda m: m["params"].__setitem__("n_obstacles", 10**6))
+    _fails(capsys, world, "regenerate", "n_obstacles")
+
+
+@pytest.mark.parametrize("path", ["../elsewhere/world.urdf", "/etc/passwd", "meshes/../../x", "C:/x", ""])
+def test_a_path_outside_the_folder_fails_paths_before_anything_is_read(world, capsys, path):
+    _edit_json(world, lambda m: m["files"]["urdf"].__setitem__("path", path))
+    _fails(capsys, world, "paths", "files.urdf")
+
+
+def test_a_symlink_out_of_the_folder_fails_paths(world, tmp_path, capsys):
+    outside = tmp_path / "outside.urdf"
+    outside.write_bytes((world / "world.urdf").read_bytes())  # same bytes: only the location is wrong
+    (world / "world.urdf").unlink()
+    os.symlink(outside, world / "world.urdf")
+    _fails(capsys, world, "paths", "leads outside")
+
+
+def test_a_schema_violation_fails_schema(world, capsys):
+    _edit_json(world, lambda m: m["robot"].__setitem__("radius", -1.0))
+    _fails(capsys, world, "schema", "robot/radius")
+
+
+def test_broken_or_missing_world_json_fails_metadata(world, capsys):
+    (world / "world.json").write_text("{")
+    _fails(capsys, world, "metadata", "JSON")
+    (world / "world.json").unlink()
+    _fails(capsys, world, "metadata", "no world.json")
+
+
+def test_a_moved_goal_fails_feasibility(world, capsys):
+    _edit_json(world, lambda m: m["tasks"][0]["goal"].__setitem__(0, m["tasks"][0]["goal"][0] + 0.5))
+    _fails(capsys, world, "feasibility", "task_0 goal")
+
+
+def test_a_changed_path_length_fails_feasibility(world, capsys):
+    _edit_json(world, lambda m: m["tasks"][0]["path"].__setitem__("length", m["tasks"][0]["path"]["length"] + 1e-5))
+    _fails(capsys, world, "feasibility", "path length")
+
+
+def test_a_recorded_path_through_an_obstacle_fails_feasibility(world, capsys):
+    meta = json.loads((world / "world.json").read_text())
+    obstacle = next(e for e in meta["entities"] if e["role"] == "obstacle")
+    # Same length as before, but a detour through an obstacle's centre.
+    def detour(m):
+        w = m["tasks"][0]["path"]["waypoints"]
+        m["tasks"][0]["path"]["waypoints"] = [w[0], obstacle["pose"][:2], w[-1]]
+    _edit_json(world, detour)
+    _fails(capsys, world, "feasibility", "recorded path", obstacle["name"])
+
+
+def test_a_changed_entity_fails_reproduce(world, capsys):
+    def grow(m):
+        box = next(e for e in m["entities"] if e["role"] == "obstacle" and e["shape"]["type"] == "box")
+        box["shape"]["size"][0] += 0.1
+    _edit_json(world, grow)
+    _fails(capsys, world, "reproduce", "entities[", "shape.size[0]")
+
+
+def test_a_replaced_file_with_its_hash_updated_fails_reproduce(world, capsys):
+    import hashlib
+
+    text = (world / "world.sdf").read_bytes().replace(b"</sdf>", b"<!-- edited --></sdf>")
+    (world / "world.sdf").write_bytes(text)
+    _edit_json(world, lambda m: m["files"]["sdf"].__setitem__("sha256", hashlib.sha256(text).hexdigest()))
+    _fails(capsys, world, "reproduce", "files.sdf.sha256")
+
+
+def test_a_redrawn_or_missing_preview_is_not_a_failure(world, capsys):
+    (world / "preview.png").unlink()
+    assert _check(capsys, world) == (0, [f"OK {world}"])
+
+
+def test_one_line_per_world_and_status_1_if_any_fails(fresh, world, capsys):
+    (world / "world.mjcf.xml").write_text("x")
+    status, lines = _check(capsys, fresh[0], world, fresh[1])
+    assert status == 1
+    assert lines[0] == f"OK {fresh[0]}" and lines[2] == f"OK {fresh[1]}"
+    assert lines[1].startswith(f"FAIL {world}: files: world.mjcf.xml")
+
+
+def test_usage_mistakes_are_status_2(tmp_path, capsys):
+    assert main(["check"]) == 2
+    assert main(["check", str(tmp_path / "nope")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("error: ") == 2 and "does not exist" in err
+
+
+def test_a_world_written_by_another_version_is_checked_but_not_byte_for_byte(world, capsys):
+    _edit_json(world, lambda m: m.__setitem__("worldgen_version", "0.0.1"))
+    status, lines = _check(capsys, world)
+    assert status == 0 and lines == [f"OK {world} (written by worldgen 0.0.1, not compared byte for byte)"]
+
+
+def test_an_infeasible_on_purpose_world_reproduces(tmp_path):
+    folder = worldgen.generate("cluttered", seed=3, infeasible=True, allow_infeasible=True).write(tmp_path)
+    assert json.loads((folder / "world.json").read_text())["feasibility"]["feasible"] is False
+    outcome = check_folder(folder)
+    assert outcome.ok, outcome.line()
+
+
+def test_the_checks_are_named_in_order():
+    assert CHECKS == ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "reproduce")
