@@ -99,7 +99,8 @@ def test_generate_writes_one_complete_folder_and_reports_it(tmp_path):
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""
     [folder] = world_dirs(out)
-    assert sorted(p.name for p in folder.iterdir()) == ["world.json", "world.mjcf.xml", "world.sdf", "world.urdf"]
+    assert sorted(p.name for p in folder.iterdir()) == ["map.pgm", "map.yaml", "preview.png", "world.json",
+                                                        "world.mjcf.xml", "world.sdf", "world.urdf"]
     meta = json.loads((folder / "world.json").read_text())
     assert folder.name == meta["world_id"] and meta["seed"] == 7
     assert meta["params"]["size"] == [6.0, 6.0] and meta["params"]["n_obstacles"] == 6
