@@ -9,7 +9,8 @@ openings (gaps in the side walls) lead to the floor around the corridor,
 which lies inside the bounds where the corridor bends round it.
 
 Obstacles are boxes standing against a side wall. Each leaves at least
-``min_passage`` to the opposite wall, and obstacles on one leg are at least
+``min_passage`` (unset: 2 x (robot_radius + clearance) + 0.2, and never less
+than :func:`proven_width`) to the opposite wall, and obstacles on one leg are at least
 ``min_passage`` apart along it (and as far from the leg's corners, openings,
 spawn and goal), so every gap on the way is at least ``min_passage`` wide.
 
@@ -72,7 +73,7 @@ PARAMS = (
     Param("wall_thickness", "float", 0.1, "thickness of the walls", 0.01, 10.0, unit="m"),
     Param("n_obstacles", "int", 0, "boxes standing against the side walls", 0, 500),
     Param("min_passage", "float", None, "smallest gap the obstacles leave; unset: 2 x (robot_radius + clearance) "
-          "+ 0.2", 0.01, 50.0, optional=True, unit="m"),
+          "+ 0.2 (at least the proven width)", 0.01, 50.0, optional=True, unit="m"),
     Param("obstacle_length", "range", [0.2, 0.6], "range of each obstacle's extent along the corridor",
           0.01, 50.0, unit="m"),
     Param("obstacle_height", "range", [0.5, 1.0], "range of obstacle heights", 0.01, 50.0, unit="m"),
@@ -178,10 +179,11 @@ def _end_offset(params: Mapping[str, Any]) -> float:
     return max(params["width"] / 2, params["robot_radius"] + params["clearance"] + 0.05)
 
 
-def _passage(params: Mapping[str, Any]) -> float:
+def _passage(params: Mapping[str, Any], proven: float) -> float:
+    """The gap obstacles must leave: ``min_passage``, or 0.2 m more than the footprint needs (at least ``proven``)."""
     if params["min_passage"] is not None:
         return params["min_passage"]
-    return min(params["width"], 2 * (params["robot_radius"] + params["clearance"]) + 0.2)
+    return max(proven, 2 * (params["robot_radius"] + params["clearance"]) + 0.2)
 
 
 def check(params: Mapping[str, Any]) -> None:
@@ -210,16 +212,20 @@ def check(params: Mapping[str, Any]) -> None:
     r, c = params["robot_radius"], params["clearance"]
     need = 2 * (r + c)
     proven = proven_width(params, lay.bounds())
-    g = _passage(params)
+    g = _passage(params, proven)
     if params["n_obstacles"] and w >= proven:
         if g < proven:
             raise ParameterError(
                 f"parameter 'min_passage' must be in [{proven:.3f}, {w:g}] (from the narrowest gap the checker "
                 f"proves passable for this robot to the width), got {params['min_passage']!r}")
-        if w - g < 0.05:
+        if w - g < 0.05 and params["min_passage"] is not None:
             raise ParameterError(
                 f"parameter 'min_passage' must be at most width - 0.05 = {w - 0.05:g} m so obstacles have depth, "
                 f"got {g:g}")
+        if w - g < 0.05:
+            raise ParameterError(
+                f"parameter 'n_obstacles' must be 0 in a corridor {w:g} m wide: obstacles need width >= passage + "
+                f"0.05 = {g + 0.05:.3f} m (or set 'min_passage' as low as {proven:.3f}), got {params['n_obstacles']!r}")
     if params["side_openings"] and params["opening_width"] > max(b - a for a, b in
                                                                  (lay.straight_part(i) for i in range(k))):
         raise ParameterError(f"parameter 'opening_width' must fit in a leg's straight part, got {params['opening_width']!r}")
@@ -241,7 +247,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     bounds = lay.bounds()
     k = len(lay.lengths)
     e = _end_offset(params)
-    g = _passage(params)
+    g = _passage(params, proven_width(params, bounds))
     inflation = params["robot_radius"] + params["clearance"]
     # Per leg: the along-leg intervals already taken (openings, obstacles) and where things may go.
     usable = []
