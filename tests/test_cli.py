@@ -128,7 +128,7 @@ def test_formats_subset_writes_only_those(tmp_path, formats, files):
     r = run("generate", "cluttered", *QUICK, "--formats", formats, "--sdf-version", "1.6", "--out", tmp_path)
     assert r.returncode == 0, r.stderr
     [folder] = world_dirs(tmp_path)
-    assert {p.name for p in folder.iterdir()} == files | {"world.json"}
+    assert {p.name for p in folder.iterdir()} == files | {"world.json", "preview.png", "map.pgm", "map.yaml"}
     meta = json.loads((folder / "world.json").read_text())
     assert {e["path"] for e in meta["files"].values()} == files
     if "world.sdf" in files:
@@ -253,4 +253,6 @@ def test_failure_on_world_3_of_5_leaves_worlds_1_2_complete(tmp_path):
     assert sorted(json.loads((f / "world.json").read_text())["seed"] for f in folders) == [start, start + 1]
     for folder in folders:
         meta = json.loads((folder / "world.json").read_text())
-        assert {p.name for p in folder.iterdir()} == {e["path"] for e in meta["files"].values()} | {"world.json"}
+        # preview.png is a picture of world.json, deliberately not listed in its files (worldgen.preview).
+        listed = {e["path"] for e in meta["files"].values()}
+        assert {p.name for p in folder.iterdir()} == listed | {"world.json", "preview.png"}
