@@ -15,7 +15,15 @@ point along the ray at ``spawn_yaw + target_bearing`` (counter-clockwise from +x
 
 The goal is ``goal`` when given; otherwise it stands beside the target, on the
 target's left of the ray (or its right when the left leaves the floor), level
-with the near face and one footprint plus 0.1 m clear of the target's side.
+with the near face (a cylinder's axis) and clear of the target's side by the
+footprint (robot_radius + clearance) plus :func:`margin` plus 0.05 m.
+
+The feasibility checker proves a disc free on a grid of cell size h (about
+(robot_radius + clearance) / 3) and needs room to spare for that: measured, a
+spawn 1.4 cells farther from the target than the footprint still fails. So
+the spawn, a given goal and the target keep :func:`margin` = 2 cells more than
+the footprint from the target and the floor's edge; closer requests are refused
+with the numbers instead of failing every attempt.
 """
 
 from __future__ import annotations
@@ -26,14 +34,15 @@ from typing import Any, Mapping
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.feasibility.check import resolution_for
 from worldgen.floats import round_float
-from worldgen.generators.base import Draft, GeneratorSpec
+from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.registry import register
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
 from worldgen.params import Param
 from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene, Task
 
-__all__ = ["SPEC", "build", "TARGET_DEFAULTS", "target_layout"]
+__all__ = ["SPEC", "build", "check", "margin", "TARGET_DEFAULTS", "target_layout"]
 
 #: Sizes used where a target size parameter is left unset, per target kind (m).
 TARGET_DEFAULTS = {
@@ -41,8 +50,13 @@ TARGET_DEFAULTS = {
     "box": {"target_width": 0.5, "target_depth": 0.5},
     "cylinder": {"target_radius": 0.25},
 }
-#: Extra room (m) between the default goal's footprint and the target's side.
-GOAL_GAP = 0.1
+#: Extra room (m) between the default goal's footprint plus margin and the target's side.
+GOAL_GAP = 0.05
+#: Angles are accepted up to pi written with 4 decimals: world.json rounds pi to 3.141593,
+#: and the params it records must generate the same world again.
+ANGLE_LIMIT = 3.1416
+#: Grid cells the checker needs beyond the footprint to prove a disc free (1.4 measured).
+MARGIN_CELLS = 2.0
 #: Density (kg/m^3) for the target's nominal mass: static, but inertia must be valid.
 TARGET_DENSITY = 300.0
 TARGET_RGBA = (0.85, 0.30, 0.25, 1.0)
@@ -57,7 +71,7 @@ PARAMS = (
           "from the spawn along the bearing to the target's near face (wall, box) or surface (cylinder)",
           0.01, 250.0, unit="m"),
     Param("target_bearing", "float", 0.0, "direction of the target, counter-clockwise from the robot's heading",
-          -math.pi, math.pi, unit="rad"),
+          -ANGLE_LIMIT, ANGLE_LIMIT, unit="rad"),
     Param("target_width", "float", None, "extent across the line of sight (wall, box); unset: 4.0 wall, 0.5 box",
           0.01, 500.0, optional=True, unit="m"),
     Param("target_depth", "float", None, "extent along the line of sight (wall, box); unset: 0.1 wall, 0.5 box",
@@ -66,12 +80,17 @@ PARAMS = (
           optional=True, unit="m"),
     Param("target_height", "float", 1.0, "height of the target", 0.01, 50.0, unit="m"),
     Param("spawn_yaw", "float", 0.0, "the robot's heading at the spawn (counter-clockwise from +x)",
-          -math.pi, math.pi, unit="rad"),
+          -ANGLE_LIMIT, ANGLE_LIMIT, unit="rad"),
     Param("spawn", "triple", None, "spawn pose [x, y, yaw] (default: the origin, heading spawn_yaw); "
           "its yaw replaces spawn_yaw", -10000.0, 10000.0, optional=True, unit="m, m, rad"),
     Param("goal", "pair", None, "goal [x, y] (default: beside the target, see the module docs)",
           -10000.0, 10000.0, optional=True, unit="m"),
 )
+
+
+def margin(params: Mapping[str, Any]) -> float:
+    """Room (m) beyond robot_radius + clearance that spawn and goal keep from the target and floor edge."""
+    return MARGIN_CELLS * resolution_for(robot_from_params(params), room_bounds(params["size"]))
 
 
 def _size(params: Mapping[str, Any], name: str) -> float:
@@ -128,17 +147,17 @@ def _target_reach(params) -> float:
 
 def _default_goal(params, spawn_xy, u):
     """Beside the target, level with its near face; None when neither side fits on the floor."""
-    inflation = params["robot_radius"] + params["clearance"]
+    keep = params["robot_radius"] + params["clearance"] + margin(params)
     (x0, y0), (x1, y1) = room_bounds(params["size"])
     left = np.array([-u[1], u[0]])
     near = spawn_xy + params["target_distance"] * u
-    offset = _target_half_width(params) + inflation + GOAL_GAP
+    offset = _target_half_width(params) + keep + GOAL_GAP
     if params["target"] == "cylinder":  # level with the axis, where the cylinder is widest
         near = near + _size(params, "target_radius") * u
     for side in (1.0, -1.0):
         g = near + side * offset * left
         g = np.array([round_float(g[0]), round_float(g[1])])
-        if x0 + inflation + 1e-3 <= g[0] <= x1 - inflation - 1e-3 and y0 + inflation + 1e-3 <= g[1] <= y1 - inflation - 1e-3:
+        if x0 + keep <= g[0] <= x1 - keep and y0 + keep <= g[1] <= y1 - keep:
             return g
     return None
 
@@ -146,28 +165,29 @@ def _default_goal(params, spawn_xy, u):
 def check(params: Mapping[str, Any]) -> None:
     """Reject layouts that cannot be driven or do not fit on the floor, naming the parameter."""
     inflation = params["robot_radius"] + params["clearance"]
+    keep = inflation + margin(params)
     if params["spawn"] is not None and params["spawn_yaw"] != 0.0:
         raise ParameterError("parameters 'spawn' and 'spawn_yaw' both set the heading; give the yaw as spawn's "
                              f"third value only, got spawn={params['spawn']!r}, spawn_yaw={params['spawn_yaw']!r}")
-    if params["spawn"] is not None and not -math.pi <= params["spawn"][2] <= math.pi:
-        raise ParameterError(f"parameter 'spawn' yaw (third value) must be in [-pi, pi] rad, got {params['spawn']!r}")
+    if params["spawn"] is not None and not -ANGLE_LIMIT <= params["spawn"][2] <= ANGLE_LIMIT:
+        raise ParameterError(f"parameter 'spawn' yaw (third value) must be in [-{ANGLE_LIMIT}, {ANGLE_LIMIT}] rad, "
+                             f"got {params['spawn']!r}")
     for name in ("target_width", "target_depth", "target_radius"):
         if params[name] is not None and name not in TARGET_DEFAULTS[params["target"]]:
             raise ParameterError(f"parameter '{name}' does not apply to a {params['target']} target; leave it unset "
                                  f"(applies: {', '.join(TARGET_DEFAULTS[params['target']])}), got {params[name]!r}")
-    # The robot at the spawn must keep its clearance from the target (+ a hair for rounding).
-    low = inflation + 1e-3
-    if params["target_distance"] < low:
+    # The robot at the spawn keeps its clearance from the target, with the checker's margin.
+    if params["target_distance"] < keep:
         raise ParameterError(
-            f"parameter 'target_distance' must be at least robot_radius + clearance + 0.001 = {low:g} m so the "
-            f"robot at the spawn keeps its clearance, got {params['target_distance']!r}")
+            f"parameter 'target_distance' must be at least robot_radius + clearance + 2 feasibility grid cells "
+            f"= {keep:.3f} m, got {params['target_distance']!r}")
     (sx, sy, _), _, u = target_layout(params)
     spawn_xy = np.array([sx, sy])
     (x0, y0), (x1, y1) = room_bounds(params["size"])
     floor = f"[{x0:g}, {x1:g}] x [{y0:g}, {y1:g}]"
-    if not (x0 + inflation < sx < x1 - inflation and y0 + inflation < sy < y1 - inflation):
-        raise ParameterError(f"parameter 'spawn' must keep the robot's {inflation:g} m disc on the floor {floor}, "
-                             f"got {params['spawn']!r}")
+    if not (x0 + keep <= sx <= x1 - keep and y0 + keep <= sy <= y1 - keep):
+        raise ParameterError(f"parameter 'spawn' must keep the robot's {inflation:g} m disc and 2 grid cells "
+                             f"({keep:.3f} m) inside the floor {floor}, got {params['spawn']!r}")
     left = np.array([-u[1], u[0]])
     half = _target_half_width(params)
     far = params["target_distance"] + _target_reach(params)
@@ -177,9 +197,9 @@ def check(params: Mapping[str, Any]) -> None:
             f"parameter 'target_distance' puts the {params['target']} (reaching {far:g} m out, {2 * half:g} m wide) "
             f"off the floor {floor}; enlarge 'size' or move the target, got {params['target_distance']!r}")
     goal = params["goal"]
-    if goal is not None and not (x0 + inflation < goal[0] < x1 - inflation and y0 + inflation < goal[1] < y1 - inflation):
-        raise ParameterError(f"parameter 'goal' must keep the robot's {inflation:g} m disc on the floor {floor}, "
-                             f"got {goal!r}")
+    if goal is not None and not (x0 + keep <= goal[0] <= x1 - keep and y0 + keep <= goal[1] <= y1 - keep):
+        raise ParameterError(f"parameter 'goal' must keep the robot's {inflation:g} m disc and 2 grid cells "
+                             f"({keep:.3f} m) inside the floor {floor}, got {goal!r}")
     if goal is None and _default_goal(params, spawn_xy, u) is None:
         raise ParameterError(f"parameter 'goal' must be given: neither side of the target leaves room for the "
                              f"default goal on the floor {floor}")

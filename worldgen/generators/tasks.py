@@ -160,8 +160,9 @@ def check_task_params(params: Mapping[str, Any], bounds) -> None:
                 f"parameter '{name}' must keep the robot's {r - _SLACK:g} m disc (robot_radius + clearance) on the floor "
                 f"{floor}, i.e. x in [{x0 + r:g}, {x1 - r:g}] and y in [{y0 + r:g}, {y1 - r:g}], got {value!r}")
     spawn = params.get("spawn")
-    if spawn is not None and not -math.pi <= spawn[2] <= math.pi:
-        raise ParameterError(f"parameter 'spawn' yaw (third value) must be in [-pi, pi] rad, got {spawn!r}")
+    # pi as world.json writes it (3.141593) must pass, so that recorded params regenerate the world.
+    if spawn is not None and not -3.1416 <= spawn[2] <= 3.1416:
+        raise ParameterError(f"parameter 'spawn' yaw (third value) must be in [-3.1416, 3.1416] rad, got {spawn!r}")
     region = params.get("task_region")
     if region is not None:
         if min(region, x1 - r) < max(-region, x0 + r) or min(region, y1 - r) < max(-region, y0 + r):
