@@ -11,6 +11,8 @@ times across runs). Stages:
   metadata     world.json from the rendered files
   pipeline     generate() + all three formats + metadata, in memory (what an RL loop pays)
   write        World.write to a temporary folder (files + fsync + rename)
+  lidar/occupancy/metrics  the ground truth parts (360 rays; the map as PGM + YAML; BARN metrics),
+               groundtruth their sum (all are also inside pipeline and metadata)
 Series "default" uses the generator's default obstacle sizes and robot; series
 "scaling" uses small obstacles and a small robot so that 1000 obstacles still
 fit in 20 x 20 m, to show how cost grows with the obstacle count.
@@ -44,7 +46,8 @@ SERIES = {
         (10, 50, 200, 1000),
     ),
 }
-STAGES = ("build", "feasibility", "sdf", "mjcf", "urdf", "metadata", "pipeline", "write")
+STAGES = ("build", "feasibility", "sdf", "mjcf", "urdf", "metadata", "pipeline", "write",
+          "lidar", "occupancy", "metrics", "groundtruth")
 
 
 def _ms(seconds: float) -> float:
@@ -75,6 +78,20 @@ def time_world(params: dict, seed: int, out_dir: Path) -> dict[str, float]:
     t0 = time.perf_counter()
     world.metadata_for(files)
     t["metadata"] = time.perf_counter() - t0
+    # Ground truth (worldgen.groundtruth), each part alone and all three as world.json adds them
+    # (map made and encoded as PGM + YAML): what issue 4 budgets at 15 ms for 50 obstacles.
+    from worldgen.groundtruth import lidar, metrics, occupancy, truth
+    t0 = time.perf_counter()
+    lidar.describe(world.scene, truth.lidar_spec(world))
+    t["lidar"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    grid = occupancy.build(world.scene, world.params["map_height"], world.params["map_resolution"])
+    grid.pgm(), grid.yaml()
+    t["occupancy"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    metrics.difficulty(world.scene, world.robot, world.tasks, world.feasibility.paths)
+    t["metrics"] = time.perf_counter() - t0
+    t["groundtruth"] = t["lidar"] + t["occupancy"] + t["metrics"]
     t0 = time.perf_counter()
     world.write(out_dir)
     t["write"] = time.perf_counter() - t0
