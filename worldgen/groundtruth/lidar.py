@@ -132,8 +132,9 @@ def _local_rays(items, origin, dirs):
     """Ray origin (m, 1, 3) and directions (m, n, 3) in each object's frame."""
     rot = np.array([m[:3, :3] for _, m in items])
     pos = np.array([m[:3, 3] for _, m in items])
-    o = np.einsum("mji,mj->mi", rot, origin - pos)[:, None, :]
-    d = np.einsum("mji,nj->mni", rot, dirs)
+    # Row vectors: v_local = R^T v is v_row @ R; one batched matmul for every object.
+    o = np.matmul((origin - pos)[:, None, :], rot)
+    d = np.matmul(dirs[None, :, :], rot)
     return o, d
 
 
