@@ -155,7 +155,7 @@ def test_allow_infeasible_writes_the_world_and_says_why(tmp_path):
 MISTAKES = {
     # name: (arguments after "generate" or a full command, regex of the one stderr line)
     "unknown generator": (["generate", "forest", "--out", "{out}"],
-                          r"error: unknown generator 'forest'; available: .*cluttered"),
+                          r"error: unknown generator 'forest'; available: .*cluttered.*"),
     "unknown parameter": (["generate", "cluttered", "--set", "n_trees=3", "--out", "{out}"],
                           r"error: unknown parameter 'n_trees' for generator 'cluttered'; known parameters: .*, n_obstacles, .*"),
     "out of range": (["generate", "cluttered", "--set", "n_obstacles=9000", "--out", "{out}"],
