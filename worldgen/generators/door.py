@@ -64,7 +64,7 @@ PARAMS = (
           choices=("left", "right", "random")),
     Param("swing", "choice", "push", "leaf opens away from the spawn side (push, towards +x) or towards it (pull), or drawn",
           choices=("push", "pull", "random")),
-    Param("limits", "range", [0.0, math.pi / 2], "opening range of the hinge (0 = closed; positive opens)",
+    Param("limits", "range", [0.0, 1.570796], "opening range of the hinge (0 = closed; positive opens; default about pi/2)",
           0.0, MAX_OPENING, unit="rad"),
     Param("state", "choice", "closed", "how every door starts (random: drawn per door)",
           choices=("closed", "open", "ajar", "random")),
