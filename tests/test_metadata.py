@@ -357,8 +357,9 @@ def test_written_world_json_is_valid_canonical_and_true(written):
         for key, entry in meta["files"].items():
             data = (folder / entry["path"]).read_bytes()
             assert hashlib.sha256(data).hexdigest() == entry["sha256"], (folder, key)
-        # Every file in the folder is listed (nothing stray, nothing unhashed).
-        listed = {e["path"] for e in meta["files"].values()} | {"world.json"}
+        # Every file in the folder is listed (nothing stray, nothing unhashed), but for
+        # preview.png: a picture of world.json, deliberately unlisted (worldgen.preview).
+        listed = {e["path"] for e in meta["files"].values()} | {"world.json", "preview.png"}
         on_disk = {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
         assert on_disk == listed
 
