@@ -30,7 +30,7 @@ def test_defaults_filled_and_sorted():
         ({"n": 2.5}, "parameter 'n' must be an integer in [0, 10], got 2.5"),
         ({"n": True}, "parameter 'n' must be an integer in [0, 10], got True"),
         ({"x": "far"}, "parameter 'x' must be a number in [0, 5], got 'far'"),
-        ({"x": float("nan")}, "parameter 'x' must be in [0, 5], got nan"),
+        ({"x": float("nan")}, "parameter 'x' must be a number in [0, 5], got nan"),
         ({"flag": "maybe"}, "parameter 'flag' must be true or false, got 'maybe'"),
         ({"mode": "c"}, "parameter 'mode' must be one of a, b, got 'c'"),
         ({"size": [1.0]}, "parameter 'size' must be two numbers, each in [0.5, 100], got [1.0]"),

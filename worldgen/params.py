@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from typing import Any, Mapping, Optional, Sequence
 
 from worldgen.errors import ParameterError
+from worldgen.floats import round_float
 
 __all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "describe_range"]
 
@@ -94,7 +95,9 @@ class Param:
                     raise ValueError
                 number = int(value)
             else:
-                number = float(value)
+                # Rounded as world.json writes it, so the parameters a world records
+                # regenerate exactly that world (pi/2 would not survive 6 decimals).
+                number = round_float(float(value))
         except (TypeError, ValueError, OverflowError):
             raise self._error(f"must be {'an integer' if whole else 'a number'} {describe_range(self)}", value) from None
         if not math.isfinite(number) or (self.low is not None and number < self.low) or (
