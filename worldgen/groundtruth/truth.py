@@ -11,6 +11,7 @@ import weakref
 
 from worldgen.groundtruth import lidar, metrics, occupancy
 from worldgen.params import COMMON_PARAMS
+from worldgen.scene import Pose
 
 __all__ = ["lidar_spec", "sensors", "occupancy_map", "occupancy_block", "map_files", "difficulty", "MAP_KEYS"]
 
@@ -26,10 +27,16 @@ def _param(world, name: str):
 
 
 def lidar_spec(world) -> lidar.LidarSpec:
-    """The world's lidar: at its first task's spawn, ``lidar_height`` up."""
+    """The world's lidar: at its first task's spawn, ``lidar_height`` up (a world without
+    tasks, made by hand, gets it at the centre of its bounds, facing +x)."""
     params = {name: _param(world, name) for name in
               ("lidar_height", "lidar_fov", "lidar_samples", "lidar_range_min", "lidar_range_max")}
-    return lidar.spec_from_params(params, world.tasks[0].spawn)
+    if world.tasks:
+        at = world.tasks[0].spawn
+    else:
+        (x0, y0), (x1, y1) = world.scene.bounds
+        at = Pose((x0 + x1) / 2, (y0 + y1) / 2)
+    return lidar.spec_from_params(params, at)
 
 
 def sensors(world) -> dict:
