@@ -126,7 +126,7 @@ PARAMETER_MISTAKES = [
     ({"n_obstacles": -1}, r"parameter 'n_obstacles' must be in \[0, 5000\], got -1"),
     ({"n_obstacles": 2.5}, r"parameter 'n_obstacles' must be an integer in \[0, 5000\], got 2\.5"),
     ({"n_obstacles": True}, r"parameter 'n_obstacles' must be an integer in \[0, 5000\], got True"),
-    ({"clearance": float("nan")}, r"parameter 'clearance' must be in \[0, 2\], got nan"),
+    ({"clearance": float("nan")}, r"parameter 'clearance' must be a number in \[0, 2\], got nan"),
     ({"size": [10]}, r"parameter 'size' must be two numbers, each in \[1, 500\], got \[10\]"),
     ({"size": "10x10"}, r"parameter 'size' must be two numbers, each in \[1, 500\], got '10x10'"),
     ({"box_size": [1.0, 0.5]}, r"parameter 'box_size' must be \[min, max\] with min <= max, got \[1\.0, 0\.5\]"),
