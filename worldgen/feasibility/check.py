@@ -7,8 +7,9 @@ every ``robot.radius / 4``, keeps the clearance everywhere (FCL). Results are
 aggregated over tasks: a check passes only if it passes for every task, its
 value is the worst figure, and its detail names the task that set it.
 
-The path is planned in the plane (clearance field, grid search, string-pulling,
-tightening; see the sibling modules) with a small safety margin
+The path is planned in the plane (clearance field, grid search with portals
+through narrow gaps, string-pulling, tightening, and where tightening fails an
+exact local visibility graph; see the sibling modules) with a small safety margin
 :data:`SAFETY` on top of the inflation radius, so rounding the written
 waypoints to 6 decimals can never bring the footprint closer than required.
 """
@@ -26,6 +27,8 @@ from worldgen.feasibility.field import distance_field, grid_for
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.passage import bottleneck_radius, extend_field
 from worldgen.feasibility.planner import grid_path, string_pull
+from worldgen.feasibility.portals import find_portals
+from worldgen.feasibility.visibility import encloses, local_shortest
 from worldgen.feasibility.report import Check, FeasibilityReport, TaskPath
 from worldgen.feasibility.taut import tighten
 from worldgen.feasibility.verify import verify_path
@@ -42,6 +45,8 @@ SAFETY = 1e-4
 #: Grid cell size as a fraction of the inflation radius, and its limits (m).
 RESOLUTION_FRACTION = 1.0 / 3.0
 RESOLUTION_LIMITS = (0.01, 0.25)
+#: How far from the reference path (m) the fallback visibility graph looks for obstacles.
+LOCAL_REACH = 0.5
 #: Largest grid (cells); bigger floors get coarser cells instead.
 MAX_CELLS = 1_000_000
 
@@ -116,6 +121,7 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     cap = radius + 2.5 * h
     field = distance_field(obstacles, bounds, grid, cap)
     wide = None  # the field extended beyond cap, made on first need
+    portals = find_portals(obstacles, bounds, radius, h)
 
     paths: list[Optional[TaskPath]] = []
     passages: list[float] = []
@@ -129,7 +135,7 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
             which = "spawn" if start_clear[i] <= radius else "goal"
             no_path.append(f"{task.id}: the {which} is not free for a {robot.inflation:g} m disc")
             continue
-        raw = grid_path(field, s, g, radius)
+        raw = grid_path(field, s, g, radius, obstacles, bounds, portals)
         if raw is None:
             paths.append(None)
             no_path.append(f"{task.id}: no path for a {robot.inflation:g} m disc from {_p(s)} to {_p(g)} "
@@ -137,6 +143,17 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
             continue
         ref = string_pull(field, raw, radius)
         taut = tighten(obstacles, ref, radius, bounds, near=3 * h)
+        if taut is None or _length(taut) >= _length(ref) or encloses(taut, ref, obstacles):
+            # Tightening gave up, went nowhere, or settled round the wrong side of an obstacle
+            # (then the grid's choice of way round is lost): search the obstacles around the
+            # path with an exact local visibility graph instead. Rare, and slower.
+            around = local_shortest(obstacles, ref, radius, bounds, reach=LOCAL_REACH)
+            if around is not None:
+                again = tighten(obstacles, around, radius, bounds, near=3 * h)
+                if again is not None and _length(again) < _length(around) and not encloses(again, around, obstacles):
+                    around = again
+                if taut is None or _length(around) < _length(taut):
+                    taut = around
         best = ref if taut is None or _length(taut) > _length(ref) else taut
         waypoints = np.round(best, DECIMALS)
         waypoints[0], waypoints[-1] = s, g
@@ -153,7 +170,11 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
         high = float(endpoint_clear[i])
         if high > field.cap and wide is None:
             wide = extend_field(field)
-        passages.append(2.0 * bottleneck_radius(field if high <= field.cap else wide, s, g, radius, high))
+        passage = 2.0 * bottleneck_radius(field if high <= field.cap else wide, s, g, radius, high)
+        # A gap the grid cannot see (a portal) on the path is measured exactly instead.
+        through = [p.width for p in portals if _passes(raw, p)]
+        passages.append(max(passage if passage > 2 * radius + 1e-9 else 0.0, min(through, default=0.0))
+                        or passage)
 
     found = [p for p in paths if p is not None]
     path_exists = Check("path_exists", not no_path,
@@ -185,15 +206,22 @@ def _reachable_initial(initial: Scene, tasks, robot: Robot, grid, cap: float, pl
     """
     obstacles = Obstacles2D.from_footprints(scene_footprints(initial, robot.height + robot.clearance))
     field = distance_field(obstacles, initial.bounds, grid, cap)
+    portals = find_portals(obstacles, initial.bounds, radius, grid.hx)
     blocked = []
     for i, task in enumerate(tasks):
-        if not plannable[i] or grid_path(field, spawns[i], goals[i], radius) is None:
+        if not plannable[i] or grid_path(field, spawns[i], goals[i], radius, obstacles, initial.bounds,
+                                         portals) is None:
             blocked.append(task.id)
     if blocked:
         return Check("reachable_initial_state", False, None,
                      f"{', '.join(blocked)}: no path for a {robot.inflation:g} m disc with the doors as they start "
                      "(informational: the reference path opens them)")
     return Check("reachable_initial_state", True, None, "every goal is reachable with the doors as they start")
+
+
+def _passes(points: np.ndarray, portal) -> bool:
+    """True when the grid path ``points`` runs through ``portal`` (holds both its ends)."""
+    return all(bool(np.any(np.all(points == end, axis=1))) for end in portal.ends)
 
 
 def _length(points: np.ndarray) -> float:

@@ -12,12 +12,17 @@ is allowed only when the field proves the whole move free:
 String-pulling keeps the path provably free the same way: a shortcut is taken
 only where samples along it, each bounded from its cell's exact value, stay
 above the inflation radius.
+
+That proof needs about two cells to spare, so gaps between obstacles that are
+only a little wider than the disc would be invisible to the search; the
+portals of :mod:`worldgen.feasibility.portals` (checked with exact distances)
+are added to the graph as extra nodes so that the search can use them.
 """
 
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import Optional, Sequence
 
 import numpy as np
 from scipy.sparse import csr_matrix
@@ -25,6 +30,7 @@ from scipy.sparse.csgraph import dijkstra
 
 from worldgen.feasibility.field import DistanceField, Grid
 from worldgen.feasibility.geometry import Obstacles2D
+from worldgen.feasibility.portals import LINK_CELLS, Portal, exact_links
 
 __all__ = ["MOVES", "grid_path", "field_clear", "string_pull"]
 
@@ -35,8 +41,6 @@ MOVES = np.array(
     dtype=np.int64,
 )
 
-#: Cells around the spawn and goal tried as the first/last grid cell.
-_LINK_REACH = 2
 
 
 def field_clear(field: DistanceField, a: np.ndarray, b: np.ndarray, radius: float) -> np.ndarray:
@@ -69,8 +73,13 @@ def field_clear(field: DistanceField, a: np.ndarray, b: np.ndarray, radius: floa
 ELLIPSE_FACTORS = (1.25, 1.8)
 
 
-def grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius: float) -> Optional[np.ndarray]:
-    """(k, 2) points: start, cell centres, goal; a path the field proves free; None if none.
+def grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius: float,
+              obstacles: Obstacles2D, bounds, portals: Sequence[Portal] = ()) -> Optional[np.ndarray]:
+    """(k, 2) points: start, cell centres (and portal ends), goal; a proven path; None if none.
+
+    Moves between cells are proven by the field; the links of the start, the
+    goal and the portal ends into the grid, and the portals themselves, by
+    exact distances (see :mod:`worldgen.feasibility.portals`).
 
     Every path of length <= L lies in the ellipse |p - start| + |p - goal| <= L,
     so the search first runs on the cells of such an ellipse (a fraction of the
@@ -79,16 +88,16 @@ def grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius:
     searched. In cluttered rooms the first ellipse almost always suffices.
     """
     straight = float(np.hypot(*(goal - start)))
-    slack = 2 * (_LINK_REACH + 1) * math.hypot(field.grid.hx, field.grid.hy)
+    slack = 2 * (LINK_CELLS + 1) * math.hypot(field.grid.hx, field.grid.hy)
     for factor in ELLIPSE_FACTORS:
         limit = factor * straight + slack
         sub = _ellipse_field(field, start, goal, limit)
         if sub is None:
             break  # the ellipse covers the whole grid anyway
-        found = _grid_path(sub, start, goal, radius)
+        found = _grid_path(sub, start, goal, radius, obstacles, bounds, portals)
         if found is not None and found[1] <= limit:
             return found[0]
-    found = _grid_path(field, start, goal, radius)
+    found = _grid_path(field, start, goal, radius, obstacles, bounds, portals)
     return None if found is None else found[0]
 
 
@@ -117,16 +126,20 @@ def _ellipse_field(field: DistanceField, start: np.ndarray, goal: np.ndarray, li
     return DistanceField(sub, values, field.cap)
 
 
-def _grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius: float):
-    """(points, grid length) of the shortest field-proven grid path, or None."""
+def _grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius: float,
+               obstacles: Obstacles2D, bounds, portals: Sequence[Portal]):
+    """(points, length) of the shortest proven path through the grid and the portals, or None.
+
+    Nodes: the cells (0 .. n-1), the start (n), the goal (n+1), then both ends
+    of every portal.
+    """
     g = field.grid
     n = g.nx * g.ny
-    links_s, cost_s = _links(field, start, radius)
-    links_g, cost_g = _links(field, goal, radius)
-    if not len(links_s) or not len(links_g):
-        return None
     if np.hypot(*(goal - start)) <= 1e-12:
         return np.array([start, goal]), 0.0
+    ends = np.array([e for p in portals for e in p.ends], dtype=float).reshape(-1, 2)
+    special = np.vstack([start, goal, ends])  # node n + k for special point k
+    rows, cols, data = [], [], []
     # The proof of a move is symmetric in its two cells, so the first half of
     # MOVES (one direction of each) makes an undirected graph. Per move, on
     # shifted views of the field (no gathers): which cells may take it?
@@ -134,39 +147,41 @@ def _grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius
     steps = np.hypot(half[:, 0] * g.hx, half[:, 1] * g.hy)
     pad = np.full((g.nx + 4, g.ny + 4), -np.inf)
     pad[2:-2, 2:-2] = field.values
-    rows, cols, data = [links_s * 0 + n], [links_s], [cost_s]  # the virtual start node n
     for k, (di, dj) in enumerate(half):
         cells = np.flatnonzero(field.values + pad[2 + di:2 + di + g.nx, 2 + dj:2 + dj + g.ny] > 2 * radius + steps[k])
         rows.append(cells)
         cols.append(cells + (di * g.ny + dj))  # the padding kept every allowed move on the grid
         data.append(np.full(len(cells), steps[k]))
-    graph = csr_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))), shape=(n + 1, n + 1))
+    which, cell, length = exact_links(field, obstacles, bounds, special, radius)
+    rows.append(n + which)
+    cols.append(cell)
+    data.append(length)
+    # Special points to each other: the portals themselves, and any short clear hop.
+    a, b = np.triu_indices(len(special), k=1)
+    span = np.hypot(*(special[b] - special[a]).T)
+    hop = span <= 2 * (LINK_CELLS + 1) * max(g.hx, g.hy)
+    hop |= (a >= 2) & (b == a + 1) & (a % 2 == 0)  # a portal's two ends
+    a, b, span = a[hop], b[hop], span[hop]
+    clear = obstacles.segments_distance(special[a], special[b], radius)[0] > radius
+    rows.append(n + a[clear])
+    cols.append(n + b[clear])
+    data.append(span[clear])
+    graph = csr_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))),
+                       shape=(n + len(special), n + len(special)))
     dist, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
-    total = dist[links_g] + cost_g
-    best = int(np.argmin(total))
-    if not np.isfinite(total[best]):
+    total = float(dist[n + 1])
+    if not np.isfinite(total):
         return None
-    chain = [int(links_g[best])]
+    chain = [n + 1]
     while pred[chain[-1]] != n:
         chain.append(int(pred[chain[-1]]))
-    chain.reverse()
-    idx = np.array(chain)
-    pts = g.centre_of(idx // g.ny, idx % g.ny)
-    return np.vstack([start, pts, goal]), float(total[best])
-
-
-def _links(field: DistanceField, p: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
-    """Cells near point ``p`` that a field-proven straight move reaches: (indices, lengths)."""
-    g = field.grid
-    (ci,), (cj,) = g.cell_of(p)
-    r = np.arange(-_LINK_REACH, _LINK_REACH + 1)
-    i = (ci + r[:, None] + 0 * r[None, :]).ravel()
-    j = (cj + 0 * r[:, None] + r[None, :]).ravel()
-    keep = (i >= 0) & (i < g.nx) & (j >= 0) & (j < g.ny)
-    i, j = i[keep], j[keep]
-    centres = g.centre_of(i, j)
-    clear = field_clear(field, np.broadcast_to(p, centres.shape), centres, radius)
-    return (i * g.ny + j)[clear], np.hypot(*(centres - p).T)[clear]
+    chain.append(n)
+    idx = np.array(chain[::-1])
+    pts = np.empty((len(idx), 2))
+    is_cell = idx < n
+    pts[is_cell] = g.centre_of(idx[is_cell] // g.ny, idx[is_cell] % g.ny)
+    pts[~is_cell] = special[idx[~is_cell] - n]
+    return pts, total
 
 
 def string_pull(field: DistanceField, path: np.ndarray, radius: float, window: int = 64) -> np.ndarray:
