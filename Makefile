@@ -20,7 +20,7 @@ $(TEST_STAMP): $(STAMP)
 ## demo: install, then generate worlds from the cluttered generator's defaults and say where they are
 demo: $(STAMP)
 	$(VENV)/bin/worldgen generate cluttered --seed 0 --count 3 --out $(DEMO_OUT)
-	@echo "worlds written under $(abspath $(DEMO_OUT))/ (world.sdf, world.mjcf.xml, world.urdf, world.json each)"
+	@echo "worlds written under $(abspath $(DEMO_OUT))/: each folder holds world.sdf, world.mjcf.xml, world.urdf, world.json, map.pgm + map.yaml and preview.png"
 
 ## test: install with the test extras and run the whole suite
 test: $(TEST_STAMP)

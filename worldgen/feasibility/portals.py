@@ -68,8 +68,10 @@ def find_portals(obstacles: Obstacles2D, bounds, radius: float, cell: float) -> 
     shapes = {}
     mids, dirs, widths = [], [], []
     for i, j in pairs:
-        gi, ri = shapes.setdefault(i, _shape(obstacles, i))
-        gj, rj = shapes.setdefault(j, _shape(obstacles, j))
+        for k in (i, j):
+            if k not in shapes:
+                shapes[k] = _shape(obstacles, k)
+        (gi, ri), (gj, rj) = shapes[i], shapes[j]
         line = np.asarray(shapely.shortest_line(gi, gj).coords)
         pa, pb = line[0], line[1]
         d = float(np.hypot(*(pb - pa)))
