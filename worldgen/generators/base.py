@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Optional
 
@@ -42,6 +44,11 @@ class GeneratorSpec:
     build: Callable[[Mapping[str, Any], np.random.Generator], Draft]
     check: Optional[Callable[[Mapping[str, Any]], None]] = None
     examples: tuple[str, ...] = field(default=())
+
+    def __post_init__(self):
+        # The name becomes part of every world_id, and so of folder names: keep it plain.
+        if not re.fullmatch(r"[a-z][a-z0-9_]{0,31}", self.name):
+            raise ValueError(f"generator name {self.name!r} must be 1-32 of a-z, 0-9, _ (starting with a letter)")
 
     @property
     def all_params(self) -> tuple[Param, ...]:
