@@ -302,3 +302,14 @@ def test_property_reports_are_consistent(seed, n, size, radius, clearance):
         assert (a is None) == (b is None)
         if a is not None:
             np.testing.assert_array_equal(a.waypoints, b.waypoints)
+
+
+@pytest.mark.parametrize("shape", ["straight", "L", "U", "zigzag"])
+@pytest.mark.parametrize("width", [0.8, 1.05, 1.3])
+def test_corridor_passage_is_the_exact_width(shape, width):
+    # The grid's bottleneck is only good to about a cell; it is snapped to the exact gap
+    # between the two walls that explains it.
+    import worldgen
+
+    world = worldgen.generate("corridor", 0, width=width, shape=shape)
+    assert world.feasibility.narrowest_passage == pytest.approx(width, abs=1e-5)

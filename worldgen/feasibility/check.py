@@ -25,7 +25,7 @@ from worldgen.doors import door_joints, open_scene
 from worldgen.feasibility.collision import Colliders
 from worldgen.feasibility.field import distance_field, grid_for
 from worldgen.feasibility.geometry import Obstacles2D
-from worldgen.feasibility.passage import bottleneck_radius, extend_field
+from worldgen.feasibility.passage import bottleneck_radius, exact_width, extend_field
 from worldgen.feasibility.planner import grid_path, string_pull
 from worldgen.feasibility.portals import find_portals
 from worldgen.feasibility.visibility import encloses, local_shortest
@@ -170,7 +170,8 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
         high = float(endpoint_clear[i])
         if high > field.cap and wide is None:
             wide = extend_field(field)
-        passage = 2.0 * bottleneck_radius(field if high <= field.cap else wide, s, g, radius, high)
+        on = field if high <= field.cap else wide
+        passage = exact_width(2.0 * bottleneck_radius(on, s, g, radius, high), on, obstacles, s, g)
         # A gap the grid cannot see (a portal) on the path is measured exactly instead.
         through = [p.width for p in portals if _passes(raw, p)]
         passages.append(max(passage if passage > 2 * radius + 1e-9 else 0.0, min(through, default=0.0))

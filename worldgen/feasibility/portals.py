@@ -25,7 +25,7 @@ import shapely
 from worldgen.feasibility.field import DistanceField
 from worldgen.feasibility.geometry import Obstacles2D
 
-__all__ = ["Portal", "find_portals", "exact_links"]
+__all__ = ["Portal", "gaps", "find_portals", "exact_links"]
 
 #: A gap counts as narrow (one the grid may miss) below the disc's diameter plus this many cells.
 NARROW_CELLS = 3.0
@@ -52,22 +52,22 @@ def _shape(obstacles: Obstacles2D, k: int):
     return shapely.Polygon(obstacles.corners(k)), 0.0
 
 
-def find_portals(obstacles: Obstacles2D, bounds, radius: float, cell: float) -> list[Portal]:
-    """Every gap between two obstacles in [2 radius, 2 radius + NARROW_CELLS cells) that a disc crosses."""
+def gaps(obstacles: Obstacles2D, below: float) -> list[tuple[float, np.ndarray, np.ndarray]]:
+    """Every gap narrower than ``below`` between two obstacles: (width, midpoint, unit normal to the gap).
+
+    The gap of two convex footprints is the segment between their closest points;
+    the normal runs along the gap, perpendicular to that segment.
+    """
     n = len(obstacles)
     if n < 2:
         return []
-    narrow = 2 * radius + NARROW_CELLS * cell
     b = obstacles.boxes
     gap_x = np.maximum(b[:, None, 0] - b[None, :, 2], b[None, :, 0] - b[:, None, 2])
     gap_y = np.maximum(b[:, None, 1] - b[None, :, 3], b[None, :, 1] - b[:, None, 3])
-    close = np.triu(np.hypot(np.maximum(gap_x, 0), np.maximum(gap_y, 0)) < narrow, k=1)
-    pairs = np.argwhere(close)
-    if not len(pairs):
-        return []
+    close = np.triu(np.hypot(np.maximum(gap_x, 0), np.maximum(gap_y, 0)) < below, k=1)
     shapes = {}
-    mids, dirs, widths = [], [], []
-    for i, j in pairs:
+    out = []
+    for i, j in np.argwhere(close):
         for k in (i, j):
             if k not in shapes:
                 shapes[k] = _shape(obstacles, k)
@@ -80,11 +80,20 @@ def find_portals(obstacles: Obstacles2D, bounds, radius: float, cell: float) -> 
         u = (pb - pa) / d
         pa, pb = pa + ri * u, pb - rj * u  # from a disc's centre to its rim
         width = d - ri - rj
-        if not 2 * radius < width < narrow:
-            continue
-        mids.append((pa + pb) / 2)
-        dirs.append(np.array([-u[1], u[0]]))
-        widths.append(width)
+        if 0 < width < below:
+            out.append((width, (pa + pb) / 2, np.array([-u[1], u[0]])))
+    return out
+
+
+def find_portals(obstacles: Obstacles2D, bounds, radius: float, cell: float) -> list[Portal]:
+    """Every gap between two obstacles in (2 radius, 2 radius + NARROW_CELLS cells) that a disc crosses."""
+    narrow = 2 * radius + NARROW_CELLS * cell
+    mids, dirs, widths = [], [], []
+    for width, mid, normal in gaps(obstacles, narrow):
+        if width > 2 * radius:
+            mids.append(mid)
+            dirs.append(normal)
+            widths.append(width)
     if not mids:
         return []
     mids, dirs = np.array(mids), np.array(dirs)
