@@ -1,0 +1,93 @@
+"""manifest.json and index.csv: what a pack holds, in job order, with every file's sha256.
+
+Both are pure functions of the build records, sorted by job index, so the same
+recipe gives the same bytes whatever --jobs and whatever order workers finish in.
+Nothing here has a timestamp or a host name.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import os
+import tempfile
+from pathlib import Path
+from typing import Any, Iterable, Mapping, Sequence
+
+__all__ = ["MANIFEST_NAME", "INDEX_NAME", "WORLDS_DIR", "SCHEMA_ID", "METRICS", "build_manifest",
+           "manifest_bytes", "index_bytes", "write_atomically"]
+
+MANIFEST_NAME = "manifest.json"
+INDEX_NAME = "index.csv"
+WORLDS_DIR = "worlds"
+SCHEMA_ID = "worldgen.pack/1"
+#: The key metrics copied from each world.json into the manifest and index.csv.
+METRICS = ("obstacle_count", "free_area_ratio", "narrowest_passage", "path_length",
+           "closest_obstacle_distance_mean", "average_visibility", "dispersion",
+           "characteristic_dimension", "tortuosity")
+
+
+def build_manifest(recipe, records: Iterable[Mapping[str, Any]], version: str) -> dict:
+    """The manifest: the recipe, the version, built worlds and rejected jobs, in job order."""
+    worlds, rejected = [], []
+    for rec in sorted(records, key=lambda r: r["job"]):
+        if rec.get("world_id"):
+            worlds.append({k: rec[k] for k in ("world_id", "generator", "seed", "params", "metrics", "files", "job")})
+        else:
+            rejected.append({k: rec[k] for k in ("job", "generator", "seed", "params", "reason")})
+    return {
+        "schema": SCHEMA_ID,
+        "name": recipe.name,
+        "worldgen_version": version,
+        "recipe": recipe.document,
+        "formats": list(recipe.formats),
+        "sdf_version": recipe.sdf_version,
+        "preview": recipe.preview,
+        "world_count": len(worlds),
+        "worlds": worlds,
+        "rejected": rejected,
+    }
+
+
+def manifest_bytes(manifest: Mapping[str, Any]) -> bytes:
+    return (json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True, allow_nan=False) + "\n").encode()
+
+
+def index_bytes(manifest: Mapping[str, Any]) -> bytes:
+    """index.csv: one row per world, its id, generator, seed, folder and key metrics."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(["index", "world_id", "generator", "seed", "folder", *METRICS])
+    for i, world in enumerate(manifest["worlds"]):
+        m = world["metrics"]
+        w.writerow([i, world["world_id"], world["generator"], world["seed"], f"{WORLDS_DIR}/{world['world_id']}",
+                    *("" if m.get(k) is None else repr(m[k]) for k in METRICS)])
+    return buf.getvalue().encode()
+
+
+def write_atomically(path: Path, data: bytes) -> None:
+    """Write ``path`` whole or not at all: a temporary file beside it, fsync, rename."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def key_metrics(meta: Mapping[str, Any]) -> dict[str, Any]:
+    """The manifest's metrics of one world.json: its metrics plus the first task's path length."""
+    m = dict(meta.get("metrics") or {})
+    tasks = meta.get("tasks") or []
+    path = tasks[0].get("path") if tasks else None
+    m["path_length"] = path.get("length") if path else None
+    return {k: m.get(k) for k in METRICS}

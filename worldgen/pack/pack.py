@@ -1,0 +1,149 @@
+"""``worldgen.Pack``: a built pack (folder or archive), read through its manifest.
+
+    >>> pack = worldgen.Pack.open("packs/small")          # or "packs/small.tar.gz"
+    >>> len(pack), pack[0].world_id, pack["cluttered-s3-1f3a9c0b"].seed
+    >>> hard = pack.filter("narrowest_passage < 1.0 and obstacle_count >= 5")
+    >>> meta = hard[0].metadata()                          # its world.json as a dict
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path, PurePosixPath
+from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
+
+from worldgen.errors import ParameterError
+from worldgen.pack.archive import ArchiveReader, is_archive
+from worldgen.pack.manifest import MANIFEST_NAME, METRICS, SCHEMA_ID, WORLDS_DIR
+from worldgen.pack.where import parse_where
+
+__all__ = ["Pack", "PackWorld", "open_source"]
+
+
+class _DirReader:
+    def __init__(self, root: Path):
+        self.root = Path(root)
+
+    def _path(self, rel: str) -> Path:
+        pure = PurePosixPath(rel)
+        if pure.is_absolute() or ".." in pure.parts:
+            raise ParameterError(f"pack path {rel!r} leaves the pack folder")
+        return self.root / pure
+
+    def exists(self, rel: str) -> bool:
+        p = self._path(rel)
+        return p.is_file() and not p.is_symlink()
+
+    def read(self, rel: str) -> bytes:
+        return self._path(rel).read_bytes()
+
+    def names(self) -> list[str]:
+        return sorted(p.relative_to(self.root).as_posix() for p in self.root.rglob("*")
+                      if p.is_file() and not any(s.startswith(".") for s in p.relative_to(self.root).parts))
+
+    def close(self) -> None:
+        pass
+
+
+def open_source(path):
+    """A reader (``exists``, ``read``, ``names``) over a pack folder or archive."""
+    path = Path(path)
+    if is_archive(path):
+        return ArchiveReader(path)
+    if not (path / MANIFEST_NAME).is_file():
+        raise ParameterError(f"'{path}' is not a pack: no {MANIFEST_NAME} (a build that has not finished has none)")
+    return _DirReader(path)
+
+
+@dataclass(frozen=True)
+class PackWorld:
+    """One world of a pack, as its manifest records it."""
+
+    index: int
+    world_id: str
+    generator: str
+    seed: int
+    params: Mapping[str, Any]
+    metrics: Mapping[str, Any]
+    files: Mapping[str, str]  # path relative to the pack -> sha256
+    pack: "Pack" = field(repr=False, compare=False)
+
+    @property
+    def folder(self) -> str:
+        return f"{WORLDS_DIR}/{self.world_id}"
+
+    @property
+    def path(self) -> Optional[Path]:
+        """The world's folder on disk; None when the pack is an archive."""
+        return None if self.pack.archive else self.pack.path / self.folder
+
+    def read(self, name: str) -> bytes:
+        """A file of this world by its name in the folder, e.g. ``world.sdf``."""
+        return self.pack.source.read(f"{self.folder}/{name}")
+
+    def metadata(self) -> dict:
+        return json.loads(self.read("world.json"))
+
+
+class Pack:
+    """A pack's worlds in manifest order: ``len``, iteration, ``pack[i]``, ``pack[world_id]``, ``filter``."""
+
+    def __init__(self, path: Path, source, manifest: dict, worlds: Optional[Sequence[PackWorld]] = None):
+        self.path = Path(path)
+        self.source = source
+        self.manifest = manifest
+        self.archive = isinstance(source, ArchiveReader)
+        if worlds is None:
+            worlds = [PackWorld(i, w["world_id"], w["generator"], w["seed"], w["params"], w["metrics"], w["files"], self)
+                      for i, w in enumerate(manifest["worlds"])]
+        self._worlds = list(worlds)
+        self._by_id = {w.world_id: w for w in self._worlds}
+
+    @classmethod
+    def open(cls, path) -> "Pack":
+        source = open_source(path)
+        try:
+            manifest = json.loads(source.read(MANIFEST_NAME))
+        except ValueError as exc:
+            raise ParameterError(f"'{path}': {MANIFEST_NAME} is not JSON: {exc}") from None
+        if not isinstance(manifest, dict) or manifest.get("schema") != SCHEMA_ID:
+            raise ParameterError(f"'{path}': {MANIFEST_NAME} is not a {SCHEMA_ID} manifest")
+        return cls(Path(path), source, manifest)
+
+    @property
+    def name(self) -> str:
+        return self.manifest["name"]
+
+    def __repr__(self) -> str:
+        try:
+            return f"<Pack {self.name!r} {len(self)} worlds at {self.path}>"
+        except Exception:  # a repr must never raise
+            return "<Pack>"
+
+    def __len__(self) -> int:
+        return len(self._worlds)
+
+    def __iter__(self) -> Iterator[PackWorld]:
+        return iter(self._worlds)
+
+    def __getitem__(self, key: Union[int, str]) -> PackWorld:
+        if isinstance(key, str):
+            if key not in self._by_id:
+                raise KeyError(f"no world '{key}' in pack '{self.name}'")
+            return self._by_id[key]
+        return self._worlds[key]
+
+    def __contains__(self, world_id: str) -> bool:
+        return world_id in self._by_id
+
+    def ids(self) -> list[str]:
+        return [w.world_id for w in self._worlds]
+
+    def filter(self, where: Union[str, Callable[[Mapping[str, Any]], bool]]) -> "Pack":
+        """The worlds whose metrics satisfy ``where`` (a --where string or a predicate on metrics)."""
+        predicate = parse_where(where, METRICS) if isinstance(where, str) else where
+        return Pack(self.path, self.source, self.manifest, [w for w in self._worlds if predicate(w.metrics)])
+
+    def close(self) -> None:
+        self.source.close()
