@@ -188,6 +188,12 @@ def presets_command(as_json: bool) -> None:
         click.echo(f"{p.name.ljust(width)}  {p.description}")
 
 
+# `worldgen pack ...` lives in worldgen/pack/commands.py; only wired in here.
+from worldgen.pack.commands import pack_group  # noqa: E402
+
+cli.add_command(pack_group)
+
+
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
     """``["key=value", ...]`` -> ``{key: value}``, each value parsed for its parameter's kind.
 
