@@ -18,8 +18,10 @@ from worldgen.presets import generate_preset
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, UnknownGeneratorError, WorldgenError
 from worldgen.generators import GeneratorSpec, register
 from worldgen.world import FORMATS, World
+from worldgen.pack import Pack
 
 __all__ = [
     "__version__", "generate", "generate_preset", "World", "FORMATS", "GeneratorSpec", "register",
     "WorldgenError", "ParameterError", "UnknownGeneratorError", "InfeasibleError", "OutputError",
+    "Pack",
 ]
