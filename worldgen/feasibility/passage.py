@@ -117,7 +117,8 @@ def exact_width(width: float, field: DistanceField, obstacles, start: np.ndarray
               & (probes[:, 1] > y0) & (probes[:, 1] < y0 + g.ny * g.hy))
     on_route = inside & np.isin(labels[pi, pj], route) & (labels[pi, pj] > 0)
     # A third obstacle nearer the probe than half the gap closes the gap there.
-    free = obstacles.points_distance(probes)[0] >= widths[owner] / 2 - 1e-9
+    # (A bounded query: only obstacles within half the widest gap can close one.)
+    free = obstacles.segments_distance(probes, probes, float(widths.max()) / 2)[0] >= widths[owner] / 2 - 1e-9
     keep = np.zeros(len(found), dtype=bool)
     np.logical_or.at(keep, owner, on_route & free)
     if not keep.any():

@@ -17,6 +17,7 @@ grid search as extra nodes, linked to nearby cells by exactly checked segments.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -52,12 +53,25 @@ def _shape(obstacles: Obstacles2D, k: int):
     return shapely.Polygon(obstacles.corners(k)), 0.0
 
 
+_GAPS: "weakref.WeakKeyDictionary[Obstacles2D, tuple[float, list]]" = weakref.WeakKeyDictionary()
+
+
 def gaps(obstacles: Obstacles2D, below: float) -> list[tuple[float, np.ndarray, np.ndarray]]:
     """Every gap narrower than ``below`` between two obstacles: (width, midpoint, unit normal to the gap).
 
     The gap of two convex footprints is the segment between their closest points;
-    the normal runs along the gap, perpendicular to that segment.
+    the normal runs along the gap, perpendicular to that segment. Remembered per
+    obstacle set (portals and the passage width both ask), for the widest
+    ``below`` asked so far.
     """
+    known = _GAPS.get(obstacles)
+    if known is None or known[0] < below:
+        known = (below, _gaps(obstacles, below))
+        _GAPS[obstacles] = known
+    return [gap for gap in known[1] if gap[0] < below]
+
+
+def _gaps(obstacles: Obstacles2D, below: float) -> list[tuple[float, np.ndarray, np.ndarray]]:
     n = len(obstacles)
     if n < 2:
         return []
