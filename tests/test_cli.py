@@ -99,7 +99,7 @@ def test_generate_writes_one_complete_folder_and_reports_it(tmp_path):
     assert r.returncode == 0, r.stderr
     assert r.stderr == ""
     [folder] = world_dirs(out)
-    assert sorted(p.name for p in folder.iterdir()) == ["map.pgm", "map.yaml", "preview.png", "world.json",
+    assert sorted(p.name for p in folder.iterdir()) == ["map.pgm", "map.yaml", "preview.png", "scenario.yaml", "world.json",
                                                         "world.mjcf.xml", "world.sdf", "world.urdf"]
     meta = json.loads((folder / "world.json").read_text())
     assert folder.name == meta["world_id"] and meta["seed"] == 7
@@ -128,9 +128,9 @@ def test_formats_subset_writes_only_those(tmp_path, formats, files):
     r = run("generate", "cluttered", *QUICK, "--formats", formats, "--sdf-version", "1.6", "--out", tmp_path)
     assert r.returncode == 0, r.stderr
     [folder] = world_dirs(tmp_path)
-    assert {p.name for p in folder.iterdir()} == files | {"world.json", "preview.png", "map.pgm", "map.yaml"}
+    assert {p.name for p in folder.iterdir()} == files | {"world.json", "preview.png", "map.pgm", "map.yaml", "scenario.yaml"}
     meta = json.loads((folder / "world.json").read_text())
-    assert {e["path"] for e in meta["files"].values()} == files | {"map.pgm", "map.yaml"}  # the map goes with every world
+    assert {e["path"] for e in meta["files"].values()} == files | {"map.pgm", "map.yaml", "scenario.yaml"}  # the map (and scenario.yaml) go with every world
     if "world.sdf" in files:
         assert '<sdf version="1.6"' in (folder / "world.sdf").read_text()
 

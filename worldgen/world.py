@@ -103,6 +103,8 @@ class World:
                 files[f"mesh:{rel}"] = (rel, data)
         from worldgen.groundtruth import truth
         files.update(truth.map_files(self))  # the occupancy map goes with every world
+        from worldgen import scenario
+        files.update(scenario.files(self, formats))  # scenario.yaml: the tasks as a scenario spec (worldgen.scenario)
         return files
 
     @cached_property
