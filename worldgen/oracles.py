@@ -1,0 +1,307 @@
+"""Test oracles: a recorded run plus a world's ground truth in, navigation figures out.
+
+    >>> from worldgen import oracles
+    >>> oracles.path_efficiency(trajectory, world)      # recorded length / task path length
+    >>> oracles.collisions(trajectory, "worlds/cluttered-s7-1f3a9c0b")
+
+A trajectory is an (n, 3) array-like of ``t, x, y`` rows (seconds, metres), or
+(n, 4) with a yaw column, which is accepted and ignored: every figure here is
+about the footprint, a vertical cylinder, which looks the same at every yaw.
+Times must not decrease.
+
+A world is a :class:`~worldgen.World` or a written world folder (its world.json
+is read). Figures are for the world's first task unless ``task`` names another.
+
+Clearances and contacts are FCL distances between the footprint cylinder
+(world.json ``robot``) and every collider, measured at the recorded samples and
+between them no further apart than a quarter of the robot radius (the same
+spacing the feasibility check proves reference paths at), so a run that cuts
+through a thin obstacle between two recorded samples is still caught.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Optional, Sequence
+
+import numpy as np
+
+from worldgen.errors import ParameterError
+
+__all__ = [
+    "Ground", "Contact", "Run", "load", "as_trajectory",
+    "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
+    "collisions", "min_separation", "run", "evaluate",
+]
+
+
+@dataclass(frozen=True)
+class Contact:
+    """The footprint touches ``entity`` from time ``time`` (s) on (the first sample of each contact)."""
+
+    time: float
+    entity: str
+
+
+class Ground:
+    """What the oracles need of one world: world.json, and FCL colliders built once (on first use)."""
+
+    def __init__(self, meta: dict, scene=None, folder: Optional[Path] = None):
+        self.meta = meta
+        self._scene = scene
+        self._folder = folder
+        self._colliders = None
+
+    @property
+    def robot(self):
+        from worldgen.scene import Robot
+        r = self.meta["robot"]
+        return Robot(float(r["radius"]), float(r["height"]), float(r["clearance"]))
+
+    def task(self, task: Optional[str] = None) -> dict:
+        tasks = self.meta["tasks"]
+        if task is None:
+            return tasks[0]
+        for t in tasks:
+            if t["id"] == task:
+                return t
+        raise ParameterError(f"parameter 'task' must be one of {', '.join(t['id'] for t in tasks)}, got {task!r}")
+
+    @property
+    def colliders(self):
+        if self._colliders is None:
+            from worldgen.feasibility.collision import Colliders
+            self._colliders = Colliders(self._scene) if self._scene is not None else _entity_colliders(self.meta, self._folder)
+        return self._colliders
+
+
+def load(world) -> Ground:
+    """A :class:`Ground` for a World, a world folder (str/Path) or a Ground (returned as is)."""
+    if isinstance(world, Ground):
+        return world
+    if hasattr(world, "scene") and hasattr(world, "metadata"):
+        return Ground(world.metadata, scene=world.scene)
+    if isinstance(world, (str, Path)):
+        folder = Path(world)
+        path = folder / "world.json" if folder.is_dir() else folder
+        try:
+            meta = json.loads(path.read_text())
+        except (OSError, ValueError) as exc:
+            raise ParameterError(f"parameter 'world' must be a World or a world folder with world.json, got {str(world)!r} ({exc})") from None
+        return Ground(meta, folder=path.parent)
+    raise ParameterError(f"parameter 'world' must be a World or a world folder, got {type(world).__name__}")
+
+
+def as_trajectory(trajectory) -> np.ndarray:
+    """(n, 3) float array ``t, x, y`` of a recorded run; ParameterError with one line otherwise."""
+    try:
+        a = np.asarray(trajectory, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError("parameter 'trajectory' must be an (n, 3) or (n, 4) array of numbers (t, x, y[, yaw])") from None
+    if a.ndim != 2 or a.shape[1] not in (3, 4) or len(a) < 1:
+        raise ParameterError(f"parameter 'trajectory' must be an (n, 3) or (n, 4) array (t, x, y[, yaw]) with n >= 1, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ParameterError("parameter 'trajectory' must hold finite numbers only, got NaN or inf")
+    if np.any(np.diff(a[:, 0]) < 0):
+        raise ParameterError("parameter 'trajectory' must have non-decreasing times (column 0)")
+    return a[:, :3].copy()
+
+
+# -- figures -------------------------------------------------------------------
+
+def path_length(trajectory) -> float:
+    """Length (m) of the recorded polyline."""
+    xy = as_trajectory(trajectory)[:, 1:]
+    return float(np.hypot(*np.diff(xy, axis=0).T).sum()) if len(xy) > 1 else 0.0
+
+
+def path_efficiency(trajectory, world, task: Optional[str] = None) -> float:
+    """Recorded length / the task's reference path length (1.0 = as short as the best path; > 1 = longer)."""
+    ref = load(world).task(task)["path"]["length"]
+    if ref is None or ref <= 0:
+        raise ParameterError(f"task {load(world).task(task)['id']!r} has no reference path length to compare with")
+    return path_length(trajectory) / float(ref)
+
+
+def _goal_index(traj: np.ndarray, task: dict) -> Optional[int]:
+    goal = np.asarray(task["goal"][:2], dtype=float)
+    d = np.hypot(*(traj[:, 1:] - goal).T)
+    hits = np.nonzero(d <= float(task["goal_tolerance"]))[0]
+    return int(hits[0]) if len(hits) else None
+
+
+def reached_goal(trajectory, world, task: Optional[str] = None) -> bool:
+    """True when some recorded sample lies within the task's goal_tolerance of its goal point."""
+    return _goal_index(as_trajectory(trajectory), load(world).task(task)) is not None
+
+
+def time_to_goal(trajectory, world, task: Optional[str] = None) -> Optional[float]:
+    """Seconds from the first sample to the first sample within goal_tolerance; None if never reached."""
+    traj = as_trajectory(trajectory)
+    k = _goal_index(traj, load(world).task(task))
+    return None if k is None else float(traj[k, 0] - traj[0, 0])
+
+
+def _dense(traj: np.ndarray, spacing: float) -> np.ndarray:
+    """(m, 3) ``t, x, y``: the recorded samples plus interpolated ones, no gap wider than ``spacing``."""
+    if len(traj) < 2:
+        return traj
+    seg = np.diff(traj, axis=0)
+    n = np.maximum(np.ceil(np.hypot(seg[:, 1], seg[:, 2]) / spacing).astype(np.int64), 1)
+    owner = np.repeat(np.arange(len(seg)), n)
+    frac = (np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)) / np.repeat(n, n)
+    return np.vstack([traj[:-1][owner] + frac[:, None] * seg[owner], traj[-1:]])
+
+
+def _samples(traj: np.ndarray, ground: Ground) -> np.ndarray:
+    return _dense(traj, ground.robot.radius / 4.0)
+
+
+def min_clearance(trajectory, world) -> float:
+    """Smallest FCL distance (m) from the footprint to any collider along the run; negative = FCL contact depth."""
+    ground = load(world)
+    pts = _samples(as_trajectory(trajectory), ground)
+    best = float(ground.colliders.nearest(ground.robot, pts[:, 1:], expect=ground.robot.clearance).distance)
+    if best > 0:
+        return best
+    # FCL's signed distance reads ~0 for a cylinder inside a box: take its contact depth instead.
+    return min(best, -max((depth for _, _, depth in _touching(pts, ground)), default=0.0))
+
+
+def collisions(trajectory, world) -> list[Contact]:
+    """Every contact of the footprint with a collider along the run, in time order.
+
+    A contact is reported once, at the first sample where it begins; the same
+    entity touched again after a gap is a second contact.
+    """
+    ground = load(world)
+    pts = _samples(as_trajectory(trajectory), ground)
+    col = ground.colliders
+    touching = np.zeros((len(pts), len(col)), dtype=bool)
+    for p, c, _ in _touching(pts, ground):
+        touching[p, c] = True
+    starts = touching & ~np.vstack([np.zeros((1, touching.shape[1]), dtype=bool), touching[:-1]])
+    out = [Contact(float(pts[p, 0]), col.names[c]) for p, c in zip(*np.nonzero(starts))]
+    return sorted(out, key=lambda k: (k.time, k.entity))
+
+
+def _touching(pts: np.ndarray, ground: Ground):
+    """(sample index, collider index, FCL penetration depth) of every touching pair."""
+    import fcl
+
+    col, robot = ground.colliders, ground.robot
+    if len(col) == 0:
+        return
+    # Only pairs whose box bound says they could touch are asked of FCL.
+    candidates = col.lower_bounds(robot, pts[:, 1:]) <= 1e-9
+    body = fcl.CollisionObject(fcl.Cylinder(robot.radius, robot.height), fcl.Transform())
+    request = fcl.CollisionRequest(num_max_contacts=1, enable_contact=True)
+    for p, c in zip(*np.nonzero(candidates)):
+        body.setTranslation(np.array([pts[p, 1], pts[p, 2], robot.height / 2]))
+        result = fcl.CollisionResult()
+        if fcl.collide(body, col.objects[c], request, result) > 0:
+            depth = max((k.penetration_depth for k in result.contacts), default=0.0)
+            yield int(p), int(c), float(depth)
+
+
+def min_separation(trajectory, world) -> Optional[float]:
+    """Smallest gap (m) between the footprint's edge and any mover's disc over the run's times.
+
+    Movers are where world.json's ``dynamic_obstacles`` scripts have them at each
+    sample time (:func:`worldgen.movers.mover_positions`); None without movers.
+    """
+    from worldgen.movers import mover_positions
+
+    ground = load(world)
+    movers = ground.meta.get("dynamic_obstacles") or []
+    if not movers:
+        return None
+    radii = np.array([float(m["radius"]) for m in movers])
+    # Movers walk at about a metre a second: sample time no coarser than the footprint spacing allows.
+    pts = _samples(as_trajectory(trajectory), ground)
+    best = math.inf
+    for t, x, y in pts:
+        centres = mover_positions(ground.meta, float(t))
+        gap = np.hypot(centres[:, 0] - x, centres[:, 1] - y) - radii - ground.robot.radius
+        best = min(best, float(gap.min()))
+    return best
+
+
+@dataclass(frozen=True)
+class Run:
+    """Every figure of one run in one world, as :func:`worldgen.oracles_eval.evaluate` tabulates them."""
+
+    world_id: str
+    task: str
+    reached_goal: bool
+    time_to_goal: Optional[float]
+    duration: float
+    path_length: float
+    path_efficiency: Optional[float]
+    min_clearance: float
+    collisions: tuple[Contact, ...]
+    min_separation: Optional[float]
+    max_velocity: float
+
+    def as_dict(self) -> dict[str, Any]:
+        d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        d["collisions"] = [{"time": c.time, "entity": c.entity} for c in self.collisions]
+        return d
+
+
+def run(trajectory, world, task: Optional[str] = None) -> Run:
+    """All figures of one run at once (colliders built once)."""
+    ground = load(world)
+    traj = as_trajectory(trajectory)
+    t = ground.task(task)
+    length = path_length(traj)
+    ref = t["path"]["length"]
+    dt = np.diff(traj[:, 0])
+    step = np.hypot(*np.diff(traj[:, 1:], axis=0).T)
+    moving = dt > 0
+    vmax = float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0
+    return Run(
+        world_id=str(ground.meta.get("world_id", "")), task=t["id"],
+        reached_goal=reached_goal(traj, ground, task), time_to_goal=time_to_goal(traj, ground, task),
+        duration=float(traj[-1, 0] - traj[0, 0]), path_length=length,
+        path_efficiency=(length / float(ref)) if ref else None,
+        min_clearance=min_clearance(traj, ground), collisions=tuple(collisions(traj, ground)),
+        min_separation=min_separation(traj, ground), max_velocity=vmax,
+    )
+
+
+# -- colliders from world.json (a folder has no Scene) ------------------------------
+
+def _entity_colliders(meta: dict, folder: Optional[Path]):
+    """The same Colliders the feasibility check uses, rebuilt from world.json's entities."""
+    from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere
+
+    nodes = []
+    for e in meta["entities"]:
+        if e["role"] in ("floor", "marker"):
+            continue
+        s = e["shape"]
+        if s["type"] == "box":
+            shape = Box(tuple(s["size"]))
+        elif s["type"] == "cylinder":
+            shape = Cylinder(s["radius"], s["length"])
+        elif s["type"] == "sphere":
+            shape = Sphere(s["radius"])
+        else:
+            import trimesh
+            mesh = trimesh.load(Path(folder) / s["uri"], force="mesh")
+            shape = Mesh(s["uri"], np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64),
+                         tuple(s.get("scale", (1.0, 1.0, 1.0))))
+        # world.json poses are world-frame, so every node becomes a root node here.
+        nodes.append(Node(e["name"], e["role"], shape, Pose(*e["pose"])))
+    from worldgen.feasibility.collision import Colliders
+    return Colliders(Scene(tuple(nodes)))
+
+
+def evaluate(runs, criteria):
+    """Many runs judged against acceptance criteria: see :func:`worldgen.oracles_eval.evaluate`."""
+    from worldgen.oracles_eval import evaluate as _evaluate
+    return _evaluate(runs, criteria)
