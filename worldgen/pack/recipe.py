@@ -103,7 +103,8 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         line = f":{mark.line + 1}" if mark is not None else ""
-        raise RecipeError(f"{source}{line}: not valid YAML: {getattr(exc, 'problem', None) or exc}") from None
+        what = " ".join(str(getattr(exc, "problem", None) or exc).split())
+        raise RecipeError(f"{source}{line}: not valid YAML: {what}") from None
     r = _Reader(source)
     if root is None:
         raise RecipeError(f"{source}:1: the recipe is empty; it needs at least 'worlds'")
@@ -158,8 +159,9 @@ class _Reader:
     def value(self, node) -> Any:
         try:
             return self._constructor.construct_object(node, deep=True)
-        except yaml.YAMLError as exc:
-            raise RecipeError(f"{self.source}:{node.start_mark.line + 1}: {exc}") from None
+        except yaml.YAMLError as exc:  # e.g. a !!python tag: safe loading refuses it
+            what = " ".join(str(getattr(exc, "problem", None) or exc).split())
+            raise RecipeError(f"{self.source}:{node.start_mark.line + 1}: {what}") from None
 
     def mapping(self, node, what: str, allowed) -> dict[str, Any]:
         if not isinstance(node, yaml.MappingNode):
