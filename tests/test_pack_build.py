@@ -243,3 +243,17 @@ def test_pack_open_api(built):
     assert regenerated.world_id == first.world_id
     with pytest.raises(worldgen.ParameterError, match="not a pack"):
         worldgen.Pack.open(pack / "worlds")
+
+
+def test_jobs_rejected_as_infeasible_are_listed_with_why_and_not_retried(tmp_path):
+    recipe = parse_recipe("seeds: 6\nworlds:\n  - generator: cluttered\n"
+                          "    params: {size: [4, 4], n_obstacles: 12, max_attempts: 1}\n", "x.yaml", "x")
+    summary = build_pack(recipe, tmp_path / "p", jobs=2)
+    manifest = json.loads((tmp_path / "p" / "manifest.json").read_text())
+    assert summary.rejected_jobs == len(manifest["rejected"]) >= 1
+    assert summary.built == manifest["world_count"] == 6 - summary.rejected_jobs
+    assert all("within max_attempts=1" in r["reason"] for r in manifest["rejected"])
+    assert "jobs rejected as infeasible: " + str(summary.rejected_jobs) in summary.lines()[1]
+    assert sum(summary.rejected_draws.values()) >= summary.rejected_jobs
+    again = build_pack(recipe, tmp_path / "p", jobs=1)
+    assert again.built == again.rejected_jobs == 0 and again.skipped == 6
