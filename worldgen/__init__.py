@@ -13,12 +13,32 @@ try:
 except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
-from worldgen.api import generate
-from worldgen.presets import generate_preset
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, UnknownGeneratorError, WorldgenError
-from worldgen.generators import GeneratorSpec, register
-from worldgen.world import FORMATS, World
-from worldgen.pack import Pack
+
+# The rest is imported on first use (PEP 562): the pytest plugin (worldgen.pytest_plugin) is
+# loaded by every pytest run in an environment with worldgen installed, and importing the
+# package must not drag numpy, FCL and scipy into runs that never ask for a world.
+_LAZY = {
+    "generate": "worldgen.api", "generate_preset": "worldgen.presets", "GeneratorSpec": "worldgen.generators",
+    "register": "worldgen.generators", "FORMATS": "worldgen.world", "World": "worldgen.world",
+    "Pack": "worldgen.pack",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    if not name.startswith("_"):  # ``worldgen.generators.get(...)`` after a bare ``import worldgen``
+        import importlib
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as exc:
+            if exc.name != f"{__name__}.{name}":
+                raise
+    raise AttributeError(f"module 'worldgen' has no attribute {name!r}")
 
 __all__ = [
     "__version__", "generate", "generate_preset", "World", "FORMATS", "GeneratorSpec", "register",
