@@ -14,6 +14,9 @@ except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, UnknownGeneratorError, WorldgenError
+# Imported now (it is light): bound after the submodule, the name stays the function even
+# once ``import worldgen.shrink`` has run elsewhere.
+from worldgen.shrink import shrink
 
 # The rest is imported on first use (PEP 562): the pytest plugin (worldgen.pytest_plugin) is
 # loaded by every pytest run in an environment with worldgen installed, and importing the
@@ -43,5 +46,5 @@ def __getattr__(name):
 __all__ = [
     "__version__", "generate", "generate_preset", "World", "FORMATS", "GeneratorSpec", "register",
     "WorldgenError", "ParameterError", "UnknownGeneratorError", "InfeasibleError", "OutputError",
-    "Pack",
+    "Pack", "shrink",
 ]
