@@ -33,7 +33,7 @@ from worldgen.pack.manifest import (INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, build
                                     key_metrics, manifest_bytes, write_atomically)
 from worldgen.pack.recipe import Job, Recipe
 
-__all__ = ["build_pack", "BuildSummary", "STATE_DIR", "build_job"]
+__all__ = ["build_pack", "BuildSummary", "STATE_DIR", "build_job", "render_job"]
 
 STATE_DIR = ".build"
 MAX_JOBS = 256
@@ -63,37 +63,50 @@ class BuildSummary:
         ]
 
 
-def build_job(job: Job, worlds_dir: str, formats, sdf_version: str, preview: bool) -> dict:
-    """Build and write one world; return its record (runs in a worker process)."""
+def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict, dict[str, bytes]]:
+    """Generate one world: its record and its folder's files (no disk; runs in any worker)."""
+    import hashlib
+
     import worldgen
-    from worldgen.world import write_folder_atomically
 
     params = {k: _thaw(v) for k, v in job.params}
-    rec: dict[str, Any] = {"job": job.index, "key": job.key, "generator": job.generator, "seed": job.seed}
+    rec: dict[str, Any] = {"job": job.index, "key": job.key, "generator": job.generator, "seed": job.seed,
+                           "worldgen_version": worldgen.__version__}
     try:
         world = worldgen.generate(job.generator, seed=job.seed, **params)
     except InfeasibleError as exc:
         rec.update(params=params, reason=str(exc), failures=dict(sorted(exc.failures.items())))
-        return rec
+        return rec, {}
     blobs = world.folder_blobs(formats, sdf_version, preview)
-    write_folder_atomically(Path(worlds_dir), world.world_id, blobs)
     meta = json.loads(blobs["world.json"])
-    import hashlib
-
     folder = f"{WORLDS_DIR}/{world.world_id}"
     rec.update(world_id=world.world_id, params=meta["params"], metrics=key_metrics(meta),
                attempts=world.attempts,
                files={f"{folder}/{rel}": hashlib.sha256(data).hexdigest() for rel, data in sorted(blobs.items())})
+    return rec, blobs
+
+
+def build_job(job: Job, worlds_dir: str, formats, sdf_version: str, preview: bool) -> dict:
+    """Build and write one world; return its record (runs in a local worker process)."""
+    from worldgen.world import write_folder_atomically
+
+    rec, blobs = render_job(job, formats, sdf_version, preview)
+    if blobs:
+        write_folder_atomically(Path(worlds_dir), rec["world_id"], blobs)
     return rec
 
 
 def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = None,
-               version: Optional[str] = None) -> BuildSummary:
+               version: Optional[str] = None, executor: str = "local",
+               scheduler: Optional[str] = None) -> BuildSummary:
     """Build (or finish building) ``recipe`` into ``out``; return the summary.
 
-    ``progress``: a stream for the progress line, or None (quiet).
+    ``progress``: a stream for the progress line, or None (quiet). ``executor``
+    "local" (a process pool of ``jobs``) or "dask" (the dask.distributed cluster
+    at ``scheduler``; see :mod:`worldgen.pack.dask`).
     """
     import worldgen
+    from worldgen.world import write_folder_atomically
 
     if not 1 <= jobs <= MAX_JOBS:
         raise ParameterError(f"parameter 'jobs' must be in [1, {MAX_JOBS}], got {jobs}")
@@ -125,7 +138,16 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
             summary.rejected_draws.update(rec["failures"])
         bar.step()
 
-    if jobs == 1 or len(todo) <= 1:
+    if executor not in ("local", "dask"):
+        raise ParameterError(f"parameter 'executor' must be one of local, dask, got {executor!r}")
+    if executor == "dask":
+        from worldgen.pack.dask import run_on_dask
+
+        for rec, blobs in run_on_dask(todo, scheduler, args[1:], version or worldgen.__version__):
+            if blobs:  # the folder is written here, so workers need no access to the pack's disk
+                write_folder_atomically(worlds_dir, rec["world_id"], blobs)
+            finished(rec)
+    elif jobs == 1 or len(todo) <= 1:
         for job in todo:
             finished(build_job(job, *args))
     else:

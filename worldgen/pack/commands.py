@@ -27,7 +27,10 @@ def pack_group() -> None:
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="PACK",
               help="Pack folder (created; an unfinished build there is resumed).")
 @click.option("--jobs", type=click.IntRange(1, 256), default=1, show_default=True, help="Worker processes.")
-def build_command(recipe: Path, out: Path, jobs: int) -> None:
+@click.option("--executor", type=click.Choice(["local", "dask"]), default="local", show_default=True,
+              help="local: a process pool of --jobs; dask: a dask.distributed cluster (optional extra).")
+@click.option("--scheduler", default=None, metavar="ADDRESS", help="The dask scheduler, e.g. tcp://host:8786.")
+def build_command(recipe: Path, out: Path, jobs: int, executor: str, scheduler: Optional[str]) -> None:
     """Build every world of RECIPE into PACK; rerun the same command to finish a killed build.
 
     A progress line (count, rate, ETA) is drawn on stderr when it is a terminal.
@@ -37,7 +40,7 @@ def build_command(recipe: Path, out: Path, jobs: int) -> None:
 
     parsed = load_recipe(recipe)
     stream = sys.stderr if sys.stderr.isatty() else None
-    summary = build_pack(parsed, out, jobs=jobs, progress=stream)
+    summary = build_pack(parsed, out, jobs=jobs, progress=stream, executor=executor, scheduler=scheduler)
     for line in summary.lines():
         click.echo(line)
     click.echo(f"pack: {out}")
