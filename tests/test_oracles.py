@@ -175,3 +175,26 @@ def test_scenario_yaml_is_listed_and_matches_the_task(wall, wall_folder):
                                            "tolerance": task["goal_tolerance"]}
     assert {"type": "max_time", "seconds": task["time_limit"]} in spec["success_criteria"]
     assert spec["failure_conditions"] == [{"type": "collision"}, {"type": "timeout", "seconds": task["time_limit"]}]
+
+
+def test_folder_colliders_match_the_scene_for_every_shape(tmp_path):
+    """world.json entities (tilted boxes and cylinders, spheres, STL meshes, a hinged leaf) rebuild the same FCL world."""
+    from export_scenes import showcase_scene
+    from worldgen import feasibility
+    from worldgen.generators import get, robot_from_params
+    from worldgen.scene import Pose, Task
+    from worldgen.world import World
+
+    resolved = get("cluttered").resolve({})
+    tasks = (Task("task_0", Pose(-3.5, -3.2, 0.0), Pose(3.5, -3.2, 0.0)),)
+    robot = robot_from_params(resolved)
+    scene = showcase_scene()
+    world = World("cluttered", 0, resolved, scene, tasks, robot, feasibility.check(scene, tasks, robot), 1)
+    folder = world.write(tmp_path, preview=False)
+    for y in np.linspace(-2.6, 3.0, 8):  # sweeps across the room, through every kind of shape
+        run = line((-3.5, y), (3.5, y + 0.3), 0.0, 7.0)
+        a, b = oracles.run(run, world), oracles.run(run, folder)
+        assert [(c.entity, c.time) for c in a.collisions] == [(c.entity, c.time) for c in b.collisions]
+        # world.json keeps poses to 6 decimals: tilted shapes move by ~1e-5 m, contact depths as much.
+        assert a.min_clearance == pytest.approx(b.min_clearance, abs=1e-4)
+    assert {c.entity for y in (-2.0, -1.0, 1.0) for c in oracles.collisions(line((-3.5, y), (3.5, y), 0, 7), folder)} >= {"ball", "rock"}

@@ -120,7 +120,7 @@ def path_length(trajectory) -> float:
 
 def path_efficiency(trajectory, world, task: Optional[str] = None) -> float:
     """Recorded length / the task's reference path length (1.0 = as short as the best path; > 1 = longer)."""
-    ref = load(world).task(task)["path"]["length"]
+    ref = (load(world).task(task)["path"] or {}).get("length")
     if ref is None or ref <= 0:
         raise ParameterError(f"task {load(world).task(task)['id']!r} has no reference path length to compare with")
     return path_length(trajectory) / float(ref)
@@ -258,7 +258,7 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
     traj = as_trajectory(trajectory)
     t = ground.task(task)
     length = path_length(traj)
-    ref = t["path"]["length"]
+    ref = (t["path"] or {}).get("length")  # None where the world has no proven path (infeasible on purpose)
     dt = np.diff(traj[:, 0])
     step = np.hypot(*np.diff(traj[:, 1:], axis=0).T)
     moving = dt > 0
