@@ -257,3 +257,18 @@ def test_jobs_rejected_as_infeasible_are_listed_with_why_and_not_retried(tmp_pat
     assert sum(summary.rejected_draws.values()) >= summary.rejected_jobs
     again = build_pack(recipe, tmp_path / "p", jobs=1)
     assert again.built == again.rejected_jobs == 0 and again.skipped == 6
+
+
+def test_progress_line_has_count_rate_and_eta_and_is_quiet_off_a_terminal(tmp_path, capsys):
+    import io
+
+    recipe = parse_recipe("seeds: 3\nworlds:\n  - generator: minimal\n", "m.yaml", "m")
+    stream = io.StringIO()
+    build_pack(recipe, tmp_path / "a", jobs=1, progress=stream)
+    frames = stream.getvalue().split("\r")[1:]
+    assert frames and frames[-1].startswith("[3/3]") and "worlds/s" in frames[-1] and "ETA" in frames[-1]
+    (tmp_path / "m.yaml").write_text("seeds: 3\nworlds:\n  - generator: minimal\n")
+    capsys.readouterr()
+    assert cli("pack", "build", tmp_path / "m.yaml", "--out", tmp_path / "b") == 0
+    captured = capsys.readouterr()
+    assert captured.err == "" and "worlds built: 3" in captured.out  # stderr is not a terminal here
