@@ -94,3 +94,17 @@ def test_pack_parametrisation(pytester, tmp_path):
     result.stdout.fnmatch_lines(["*test_pack?cluttered-s0-*? PASSED*", "*test_pack?cluttered-s1-*? PASSED*"])
     result.assert_outcomes(passed=2)
     pytester.runpytest_subprocess("-v", "--worldgen-seed", "1").assert_outcomes(passed=1)
+
+
+def test_out_option_keeps_the_worlds(pytester, tmp_path):
+    pytester.makepyfile(f"""
+        import pytest
+
+        @pytest.mark.worldgen("cluttered", seeds=[4], {QUICK})
+        def test_nav(world):
+            assert world.path.parent == __import__("pathlib").Path({str(tmp_path / "kept")!r})
+    """)
+    pytester.runpytest_subprocess("--worldgen-out", str(tmp_path / "kept"), "--worldgen-formats", "mjcf").assert_outcomes(passed=1)
+    [folder] = (tmp_path / "kept").iterdir()
+    assert folder.name.startswith("cluttered-s4-") and (folder / "world.mjcf.xml").is_file()
+    assert not (folder / "world.sdf").exists()
