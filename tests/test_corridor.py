@@ -123,7 +123,9 @@ def test_every_corridor_is_drivable_by_an_independent_recheck(params, seed):
     report = world.feasibility
     h = report.resolution
     width = params["width"]
-    assert report.narrowest_passage <= width + 1e-6
+    # Wall poses and sizes are kept to 6 decimals, so the gap between two walls may differ
+    # from the width asked for by a few 1e-7 m; the passage is measured on the walls.
+    assert report.narrowest_passage <= width + 5e-6
     inflation = params["robot_radius"] + params["clearance"]
     floor = max(3 * inflation + 2e-4, 2 * inflation + 0.2) if params["n_obstacles"] else width
     assert report.narrowest_passage >= floor - PASSAGE_CELLS * h - 1e-6
@@ -174,7 +176,8 @@ def test_the_0_8_m_corridor_reports_its_narrowest_passage():
     world = worldgen.generate("corridor", width=0.8)
     recheck(world)
     h = world.feasibility.resolution
-    assert 0.8 - PASSAGE_CELLS * h - 1e-6 <= world.feasibility.narrowest_passage <= 0.8 + 1e-6
+    assert 0.8 - PASSAGE_CELLS * h - 1e-6 <= world.feasibility.narrowest_passage <= 0.8 + 5e-6
+    assert world.feasibility.narrowest_passage == pytest.approx(0.8, abs=5e-6)  # the exact gap
     # The walls' inner faces really are 0.8 m apart.
     left = world.scene.node("wall_left_0_0")
     right = world.scene.node("wall_right_0_0")
