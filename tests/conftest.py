@@ -11,8 +11,16 @@ import os
 
 import numpy as np
 import pytest
+from hypothesis import settings
 
 ON_CI = bool(os.environ.get("CI"))
+
+# On CI, Hypothesis replays the same examples every run (a red CI must mean a change broke
+# something, not that a new random draw turned up an old bug) and never times out an
+# example on a loaded machine; on a laptop it keeps exploring fresh examples.
+settings.register_profile("ci", derandomize=True, deadline=None, print_blob=True)
+if ON_CI:
+    settings.load_profile("ci")
 
 
 def missing_tool(what: str):
