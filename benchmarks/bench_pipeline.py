@@ -127,7 +127,6 @@ def print_table(results: dict) -> None:
         print(f"{'obstacles':>9} " + " ".join(f"{s:>11}" for s in STAGES) + f" {'attempts':>8} {'x per obst.':>11}")
         first = None
         for n, row in rows.items():
-            per = row["pipeline"] / int(n)
             first = first or (row["pipeline"], int(n))
             growth = (row["pipeline"] / first[0]) / (int(n) / first[1])
             print(f"{n:>9} " + " ".join(f"{row[s]:>11.2f}" for s in STAGES)

@@ -13,7 +13,7 @@ from export_scenes import DOOR_INITIAL, showcase_scene
 from reftools_mujoco import load_and_step
 from worldgen.export import mjcf
 from worldgen.export.xml import parse_bytes, to_bytes
-from worldgen.scene import Box, Joint, Material, Node, Physics, Pose, Scene
+from worldgen.scene import Box, Joint, Node, Physics, Pose, Scene
 
 #: (seed, params): the default room, a crowded big room, boxes only, no walls, tall thin cylinders.
 CLUTTERED_CASES = [(seed, {}) for seed in range(50)] + [

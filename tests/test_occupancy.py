@@ -10,7 +10,6 @@ import shapely
 import yaml
 
 import worldgen
-from conftest import draft
 from export_scenes import showcase_scene
 from worldgen.errors import ParameterError
 from worldgen.groundtruth import occupancy

@@ -8,13 +8,10 @@ negative zero.
 
 from __future__ import annotations
 
-import math
-
 __all__ = ["DECIMALS", "round_float", "fmt", "fmt_seq"]
 
 #: Decimals kept in every written float: 1e-6 m is far below any simulator's tolerance.
 DECIMALS = 6
-_ZERO = 0.5 * 10.0**-DECIMALS
 
 
 def round_float(x: float) -> float:

@@ -18,7 +18,7 @@ import shapely
 
 from worldgen.scene import Scene
 
-__all__ = ["Footprint", "FootprintIndex", "scene_footprints", "robot_footprints", "distances_to"]
+__all__ = ["Footprint", "FootprintIndex", "scene_footprints", "robot_footprints"]
 
 _VERTICAL = 1e-9
 
@@ -43,13 +43,6 @@ class Footprint:
             cx, cy = self.centre
             return (cx - self.radius, cy - self.radius, cx + self.radius, cy + self.radius)
         return tuple(self.polygon.bounds)
-
-    def distance(self, xy: np.ndarray) -> np.ndarray:
-        """(n,) distance from each of the (n, 2) points to this footprint, 0 inside."""
-        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-        if self.is_disc:
-            return np.maximum(np.hypot(xy[:, 0] - self.centre[0], xy[:, 1] - self.centre[1]) - self.radius, 0.0)
-        return shapely.distance(self.polygon, shapely.points(xy))
 
 
 _CACHE: "weakref.WeakKeyDictionary[Scene, dict[float, list[Footprint]]]" = weakref.WeakKeyDictionary()
@@ -120,17 +113,8 @@ def _footprints(scene: Scene, height: float) -> list[Footprint]:
     return out
 
 
-def distances_to(footprints: list[Footprint], xy: np.ndarray) -> np.ndarray:
-    """(n,) distance from each of the (n, 2) points to the nearest footprint (inf if none)."""
-    xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-    best = np.full(len(xy), np.inf)
-    for fp in footprints:
-        np.minimum(best, fp.distance(xy), out=best)
-    return best
-
-
 class FootprintIndex:
-    """Nearest-footprint distances for many points at once.
+    """Which of many points have a footprint within a radius, in one pass.
 
     Discs are kept as arrays, polygons in a shapely STRtree, so a query costs
     one vectorised pass however many obstacles there are.
@@ -155,17 +139,3 @@ class FootprintIndex:
             ipt, _ = self._tree.query(shapely.points(xy), predicate="dwithin", distance=radius)
             hit[ipt] = True
         return hit
-
-    def distance(self, xy: np.ndarray) -> np.ndarray:
-        """(n,) distance from each of the (n, 2) points to the nearest footprint, 0 inside."""
-        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-        best = np.full(len(xy), np.inf)
-        if len(self._disc_r):
-            d = np.hypot(xy[:, None, 0] - self._disc_xy[None, :, 0], xy[:, None, 1] - self._disc_xy[None, :, 1])
-            best = np.minimum(best, np.maximum(d - self._disc_r[None, :], 0.0).min(axis=1))
-        if self._tree is not None and len(xy):
-            (ipt, _), dist = self._tree.query_nearest(shapely.points(xy), return_distance=True, all_matches=False)
-            poly_best = np.full(len(xy), np.inf)
-            np.minimum.at(poly_best, ipt, dist)
-            best = np.minimum(best, poly_best)
-        return best

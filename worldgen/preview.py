@@ -41,7 +41,7 @@ from worldgen.errors import OutputError, ParameterError
 from worldgen.scene.pose import rpy_matrix
 
 __all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
-           "Layout", "layout", "draw", "render", "attach", "blocking"]
+           "Layout", "layout", "draw", "render", "blocking"]
 
 PREVIEW_NAME = "preview.png"
 DEFAULT_WIDTH = 800

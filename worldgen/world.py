@@ -71,7 +71,7 @@ class World:
         return _text(mjcf.to_mjcf(self.scene, name=self.world_id))
 
     def to_urdf(self) -> str:
-        """The world as one URDF robot: a root link with every entity on a fixed joint."""
+        """The world as one URDF robot: a root link with every entity a link joined to it."""
         from worldgen.export import urdf
         return _text(urdf.to_urdf(self.scene, name=self.world_id))
 
@@ -108,9 +108,15 @@ class World:
         return files
 
     @cached_property
+    def _default_files(self) -> dict[str, tuple[str, bytes]]:
+        # Every format, SDF 1.9: what .metadata describes and what write() writes by default,
+        # rendered once for both.
+        return self.rendered_files()
+
+    @cached_property
     def metadata(self) -> dict:
         """world.json of this world written in every format (SDF 1.9)."""
-        return self.metadata_for(self.rendered_files())
+        return self.metadata_for(self._default_files)
 
     def to_json(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> str:
         from worldgen.export import metadata
@@ -135,8 +141,9 @@ class World:
         """Every file :meth:`write` puts in the folder, world.json included: relative path -> bytes."""
         from worldgen.export import metadata
 
-        files = self.rendered_files(formats, sdf_version)
-        meta = self.metadata_for(files)
+        default = normalise_formats(formats) == FORMATS and sdf_version == "1.9"
+        files = self._default_files if default else self.rendered_files(formats, sdf_version)
+        meta = self.metadata_for(files)  # afresh: a caller may have edited .metadata's dict
         blobs = {path: data for path, data in files.values()}
         if preview:  # a picture of world.json, not listed in its `files` (see worldgen.preview)
             from worldgen.preview import PREVIEW_NAME, render

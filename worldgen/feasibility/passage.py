@@ -20,6 +20,7 @@ import numpy as np
 from scipy import ndimage
 
 from worldgen.feasibility.field import DistanceField
+from worldgen.feasibility.portals import gaps
 
 __all__ = ["bottleneck_radius", "extend_field", "exact_width"]
 
@@ -91,8 +92,6 @@ def exact_width(width: float, field: DistanceField, obstacles, start: np.ndarray
     grid's figure plus half a cell (its usual shortfall). Where no gap fits (the
     bottleneck is the edge of the bounds, say), the grid's figure stands.
     """
-    from worldgen.feasibility.portals import gaps
-
     g = field.grid
     cell = max(g.hx, g.hy)
     lo, hi = width - 1.5 * cell, width + 2.5 * cell

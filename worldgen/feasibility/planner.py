@@ -200,8 +200,3 @@ def string_pull(field: DistanceField, path: np.ndarray, radius: float, window: i
         i = int(visible[-1]) if len(visible) else i + 1
         out.append(i)
     return path[out]
-
-
-def nearest_obstacles(obstacles: Obstacles2D, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Exact (distance, obstacle id) from each point to the nearest footprint."""
-    return obstacles.points_distance(pts)

@@ -18,15 +18,13 @@ from __future__ import annotations
 
 import json
 import multiprocessing
-import os
 import shutil
-import sys
 import time
 from collections import Counter
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Optional, TextIO
+from typing import Any, Optional, TextIO
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError
 from worldgen.pack.manifest import (INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, build_manifest, index_bytes,

@@ -13,7 +13,7 @@ import json
 import os
 import tempfile
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Sequence
+from typing import Any, Iterable, Mapping
 
 __all__ = ["MANIFEST_NAME", "INDEX_NAME", "WORLDS_DIR", "SCHEMA_ID", "METRICS", "build_manifest",
            "manifest_bytes", "index_bytes", "write_atomically"]

@@ -32,7 +32,7 @@ import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any
 
 import numpy as np
 import yaml
@@ -233,7 +233,7 @@ class _Reader:
                 if key == "seed":
                     self.fail(vnode, key, "the seed is set with 'seeds'")
                 if key in lines:
-                    self.fail(vnode, key, f"given in both params and physics")
+                    self.fail(vnode, key, "given in both params and physics")
                 lines[key] = vnode
                 value = self.value(vnode)
                 p = kinds[key]
