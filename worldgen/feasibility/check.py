@@ -172,10 +172,12 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
             wide = extend_field(field)
         on = field if high <= field.cap else wide
         passage = exact_width(2.0 * bottleneck_radius(on, s, g, radius, high), on, obstacles, s, g)
-        # A gap the grid cannot see (a portal) on the path is measured exactly instead.
+        # A gap the grid cannot see (a portal) on the path is measured exactly: where the grid
+        # found no route at all (passage stuck at its lower bound) the portal is the bottleneck.
         through = [p.width for p in portals if _passes(raw, p)]
-        passages.append(max(passage if passage > 2 * radius + 1e-9 else 0.0, min(through, default=0.0))
-                        or passage)
+        if through:
+            passage = min(through) if passage <= 2 * radius + 1e-9 else max(passage, min(through))
+        passages.append(passage)
 
     found = [p for p in paths if p is not None]
     path_exists = Check("path_exists", not no_path,

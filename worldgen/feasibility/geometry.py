@@ -20,7 +20,7 @@ from shapely.geometry.polygon import orient
 
 from worldgen.footprint import Footprint
 
-__all__ = ["Obstacles2D", "point_segment_distance", "segment_segment_distance"]
+__all__ = ["Obstacles2D", "point_segment_distance", "segment_segment_distance", "inside_bounds"]
 
 
 def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -33,6 +33,16 @@ def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nd
     dx = apx - t * abx
     dy = apy - t * aby
     return np.sqrt(dx * dx + dy * dy)
+
+
+def inside_bounds(bounds, pts: np.ndarray, radius: float) -> np.ndarray:
+    """(n,) bool: the disc of ``radius`` round each of the (n, 2) points lies within ``bounds``.
+
+    The bounds are convex, so a segment whose two ends pass keeps the disc inside throughout.
+    """
+    (x0, y0), (x1, y1) = bounds
+    return ((pts[:, 0] - radius >= x0) & (pts[:, 0] + radius <= x1)
+            & (pts[:, 1] - radius >= y0) & (pts[:, 1] + radius <= y1))
 
 
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -24,7 +24,7 @@ import numpy as np
 import shapely
 
 from worldgen.feasibility.field import DistanceField
-from worldgen.feasibility.geometry import Obstacles2D
+from worldgen.feasibility.geometry import Obstacles2D, inside_bounds
 
 __all__ = ["Portal", "gaps", "find_portals", "exact_links"]
 
@@ -121,16 +121,10 @@ def find_portals(obstacles: Obstacles2D, bounds, radius: float, cell: float) -> 
         half = cells * cell
         a, b_ = mids[todo] - half * dirs[todo], mids[todo] + half * dirs[todo]
         clear = ((obstacles.segments_distance(a, b_, radius)[0] > radius)
-                 & _inside(bounds, a, radius) & _inside(bounds, b_, radius))
+                 & inside_bounds(bounds, a, radius) & inside_bounds(bounds, b_, radius))
         for k in np.nonzero(clear)[0]:
             found[int(todo[k])] = Portal(np.array([a[k], b_[k]]), widths[todo[k]])
     return [found[k] for k in sorted(found)]
-
-
-def _inside(bounds, pts: np.ndarray, radius: float) -> np.ndarray:
-    (x0, y0), (x1, y1) = bounds
-    return ((pts[:, 0] - radius >= x0) & (pts[:, 0] + radius <= x1)
-            & (pts[:, 1] - radius >= y0) & (pts[:, 1] + radius <= y1))
 
 
 def exact_links(field: DistanceField, obstacles: Obstacles2D, bounds, points: np.ndarray,
@@ -154,6 +148,6 @@ def exact_links(field: DistanceField, obstacles: Obstacles2D, bounds, points: np
     i, j, which = i[keep], j[keep], which[keep]
     centres = g.centre_of(i, j)
     clear = obstacles.segments_distance(points[which], centres, radius)[0] > radius
-    clear &= _inside(bounds, centres, radius)
+    clear &= inside_bounds(bounds, centres, radius)
     length = np.hypot(*(centres - points[which]).T)
     return which[clear], (i * g.ny + j)[clear], length[clear]

@@ -21,7 +21,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-from worldgen.feasibility.geometry import Obstacles2D
+from worldgen.feasibility.geometry import Obstacles2D, inside_bounds
 
 __all__ = ["ARC_PIECE", "local_shortest", "encloses"]
 
@@ -78,9 +78,7 @@ def local_shortest(obstacles: Obstacles2D, ref: np.ndarray, radius: float, bound
         nxt = np.concatenate([np.roll(r, -1, axis=0) for r in rings])
     else:
         ring_pts = prev = nxt = np.zeros((0, 2))
-    (x0, y0), (x1, y1) = bounds
-    inside = ((ring_pts[:, 0] >= x0 + radius) & (ring_pts[:, 0] <= x1 - radius)
-              & (ring_pts[:, 1] >= y0 + radius) & (ring_pts[:, 1] <= y1 - radius))
+    inside = inside_bounds(bounds, ring_pts, radius)
     # Only obstacles within the radius matter: a bounded query, not a distance to everything.
     free = inside & (obstacles.segments_distance(ring_pts, ring_pts, radius)[0] > radius) if len(ring_pts) else inside
     pts = np.vstack([start, goal, ring_pts[free]])
