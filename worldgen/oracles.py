@@ -190,21 +190,17 @@ def collisions(trajectory, world) -> list[Contact]:
 
 def _touching(pts: np.ndarray, ground: Ground):
     """(sample index, collider index, FCL penetration depth) of every touching pair."""
-    import fcl
-
     col, robot = ground.colliders, ground.robot
     if len(col) == 0:
         return
     # Only pairs whose box bound says they could touch are asked of FCL.
     candidates = col.lower_bounds(robot, pts[:, 1:]) <= 1e-9
-    body = fcl.CollisionObject(fcl.Cylinder(robot.radius, robot.height), fcl.Transform())
-    request = fcl.CollisionRequest(num_max_contacts=1, enable_contact=True)
+    body = col.body(robot)
     for p, c in zip(*np.nonzero(candidates)):
-        body.setTranslation(np.array([pts[p, 1], pts[p, 2], robot.height / 2]))
-        result = fcl.CollisionResult()
-        if fcl.collide(body, col.objects[c], request, result) > 0:
-            depth = max((k.penetration_depth for k in result.contacts), default=0.0)
-            yield int(p), int(c), float(depth)
+        col.place(body, robot, pts[p, 1], pts[p, 2])
+        d = col.distance(body, robot, int(c))
+        if d <= 0.0:  # FCL counts touching as contact
+            yield int(p), int(c), col.depth(body, int(c)) if d < 0.0 else 0.0
 
 
 def min_separation(trajectory, world) -> Optional[float]:
