@@ -71,7 +71,7 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
             details.setdefault(draft.rejected, draft.detail)
             continue
         report = feasibility.check(draft.scene, draft.tasks, robot)
-        world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1)
+        world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1, allow_infeasible)
         if report.feasible or (resolved.get("infeasible") and _infeasible_on_purpose(report)):
             return world
         for failed in report.failed():

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import shutil
 import tempfile
@@ -28,10 +29,11 @@ class World:
     ``params`` holds every parameter resolved (defaults filled in), so
     ``generate(generator, seed, **params)`` rebuilds exactly this world.
     ``attempts`` is how many draws it took (1 = the first draw passed).
+    ``allow_infeasible`` records how it was asked for, so that it regenerates the same way.
     """
 
     def __init__(self, generator: str, seed: int, params: Mapping[str, Any], scene: Scene,
-                 tasks: Sequence[Task], robot: Robot, feasibility, attempts: int):
+                 tasks: Sequence[Task], robot: Robot, feasibility, attempts: int, allow_infeasible: bool = False):
         self.generator = generator
         self.seed = seed
         self.params = dict(params)
@@ -40,6 +42,7 @@ class World:
         self.robot = robot
         self.feasibility = feasibility
         self.attempts = attempts
+        self.allow_infeasible = bool(allow_infeasible)
         self.path: Optional[Path] = None  # the folder once written
 
     def __repr__(self) -> str:
@@ -50,7 +53,24 @@ class World:
 
     @cached_property
     def content_hash(self) -> str:
-        return self.scene.content_hash()
+        """``sha256:<hex>`` of everything the written files depend on, so equal hashes mean equal worlds.
+
+        The scene's canonical description (geometry, joints, movers, physics),
+        plus the generator, seed, every resolved parameter (which fix the robot,
+        the tasks, the sensors and the map) and whether it was asked for with
+        ``allow_infeasible``. Not the worldgen version, nor the
+        formats chosen: those change how a world is written, not which world it is.
+        """
+        identity = {
+            "scene": self.scene.content_hash(),
+            "generator": self.generator,
+            "seed": self.seed,
+            "params": self.params,
+            "allow_infeasible": self.allow_infeasible,
+            "preset": getattr(self, "preset", None),
+        }
+        text = json.dumps(identity, sort_keys=True, separators=(",", ":"))
+        return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
 
     @cached_property
     def world_id(self) -> str:
@@ -124,15 +144,21 @@ class World:
 
     # -- disk --------------------------------------------------------------
     def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
-              preview: bool = True) -> Path:
+              preview: bool = True, overwrite: bool = False) -> Path:
         """Write ``out_dir/<world_id>/`` (the world's files and world.json); return that folder.
 
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
         ``preview`` adds preview.png, a top-down picture (worldgen.preview).
+        A folder of the same name that holds another world (another
+        ``content_hash``, or no readable world.json) is an :class:`OutputError`
+        unless ``overwrite``; the same world is simply written again.
         """
+        out_dir = Path(out_dir)
+        if not overwrite:
+            refuse_other_world(out_dir / self.world_id, self.content_hash)
         blobs = self.folder_blobs(formats, sdf_version, preview)
-        target = write_folder_atomically(Path(out_dir), self.world_id, blobs)
+        target = write_folder_atomically(out_dir, self.world_id, blobs)
         self.path = target
         return target
 
@@ -180,6 +206,19 @@ def _safe_relative(rel: str) -> str:
     if Path(rel).is_absolute() or ".." in parts or not parts:
         raise OutputError(f"refusing to write {rel!r} outside the world folder")
     return rel
+
+
+def refuse_other_world(target: Path, content_hash: str) -> None:
+    """Raise OutputError if ``target`` exists and is not a folder of the world ``content_hash``."""
+    if not os.path.lexists(target):
+        return
+    try:
+        recorded = json.loads((target / METADATA_NAME).read_text(encoding="utf-8")).get("content_hash")
+    except (OSError, ValueError, AttributeError):
+        recorded = None
+    if recorded != content_hash:
+        what = "another world" if recorded else "something that is not a world folder"
+        raise OutputError(f"'{target}' already holds {what}; remove it or pass --overwrite to replace it")
 
 
 def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]) -> Path:
