@@ -13,6 +13,7 @@ import tarfile
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import worldgen
@@ -193,7 +194,7 @@ def test_archive_is_deterministic_safe_and_readable_by_open_and_verify(built, tm
     assert first[4:8] == b"\0\0\0\0"  # gzip mtime 0
     opened = Pack.open(tmp_path / "a.tar.gz")
     assert opened.archive and opened.ids() == Pack.open(pack).ids()
-    assert opened[0].metadata() == json.loads((pack / opened[0].folder / "world.json").read_text())
+    assert opened[0].metadata == json.loads((pack / opened[0].folder / "world.json").read_text())
     assert cli("pack", "verify", tmp_path / "a.tar.gz") == 0
     assert all(ok for ok, _ in verify_pack(tmp_path / "a.tar.gz", regenerate=True))
 
@@ -232,7 +233,7 @@ def test_pack_open_api(built):
     first = p[0]
     assert p[first.world_id] is first and first.world_id in p and p[-1].generator == "corridor"
     assert first.path == pack / "worlds" / first.world_id and first.read("world.sdf").startswith(b"<?xml")
-    assert first.metadata()["world_id"] == first.world_id
+    assert first.metadata["world_id"] == first.world_id
     hard = p.filter("narrowest_passage < 1.0")
     assert all(w.metrics["narrowest_passage"] < 1.0 for w in hard) and len(hard) < len(p)
     assert len(p.filter(lambda m: m["obstacle_count"] == 5)) == 6
@@ -272,3 +273,30 @@ def test_progress_line_has_count_rate_and_eta_and_is_quiet_off_a_terminal(tmp_pa
     assert cli("pack", "build", tmp_path / "m.yaml", "--out", tmp_path / "b") == 0
     captured = capsys.readouterr()
     assert captured.err == "" and "worlds built: 3" in captured.out  # stderr is not a terminal here
+
+
+@pytest.mark.parametrize("kind", ["folder", "archive"])
+def test_oracles_take_pack_worlds_in_a_folder_and_in_an_archive(built, tmp_path, kind):
+    from worldgen import oracles
+
+    _, _, pack = built
+    source = pack if kind == "folder" else write_archive(pack, tmp_path / "one.tar.gz")
+    opened = worldgen.Pack.open(source)
+    assert (opened[0].path is None) == (kind == "archive")
+    for w in list(opened)[:4]:
+        task = w.metadata["tasks"][0]
+        xy = np.asarray(task["path"]["waypoints"], dtype=float)
+        drive = np.column_stack([np.linspace(0.0, 10.0, len(xy)), xy])
+        regenerated = worldgen.generate(w.generator, w.seed, **w.params)
+        assert oracles.collisions(drive, w) == oracles.collisions(drive, regenerated) == []
+        assert oracles.path_efficiency(drive, w) == pytest.approx(1.0, abs=1e-5)
+        assert oracles.min_clearance(drive, w) == pytest.approx(oracles.min_clearance(drive, regenerated), abs=1e-6)
+        assert oracles.reached_goal(drive, w)
+        # A drive straight through the first obstacle is a collision here as in the regenerated world.
+        obstacle = next((e for e in w.metadata["entities"] if e["role"] == "obstacle"), None)
+        if obstacle is not None:
+            x, y = obstacle["pose"][:2]
+            through = np.array([[0.0, x - 1.0, y], [1.0, x + 1.0, y]])
+            assert [c.entity for c in oracles.collisions(through, w)] == \
+                [c.entity for c in oracles.collisions(through, regenerated)] != []
+    opened.close()

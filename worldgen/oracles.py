@@ -9,8 +9,9 @@ A trajectory is an (n, 3) array-like of ``t, x, y`` rows (seconds, metres), or
 about the footprint, a vertical cylinder, which looks the same at every yaw.
 Times must not decrease.
 
-A world is a :class:`~worldgen.World` or a written world folder (its world.json
-is read). Figures are for the world's first task unless ``task`` names another.
+A world is a :class:`~worldgen.World`, a world of a built pack
+(:class:`~worldgen.PackWorld`, folder or archive) or a written world folder (its
+world.json is read). Figures are for the world's first task unless ``task`` names another.
 
 Clearances and contacts are FCL distances between the footprint cylinder
 (world.json ``robot``) and every collider, measured at the recorded samples and
@@ -25,7 +26,7 @@ import json
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -49,10 +50,10 @@ class Contact:
 class Ground:
     """What the oracles need of one world: world.json, and FCL colliders built once (on first use)."""
 
-    def __init__(self, meta: dict, scene=None, folder: Optional[Path] = None):
+    def __init__(self, meta: dict, scene=None, read: Optional[Callable[[str], bytes]] = None):
         self.meta = meta
         self._scene = scene
-        self._folder = folder
+        self._read = read  # a file of the world by its relative path (meshes), where there is no scene
         self._colliders = None
 
     @property
@@ -74,16 +75,19 @@ class Ground:
     def colliders(self):
         if self._colliders is None:
             from worldgen.feasibility.collision import Colliders
-            self._colliders = Colliders(self._scene) if self._scene is not None else _entity_colliders(self.meta, self._folder)
+            self._colliders = Colliders(self._scene) if self._scene is not None else _entity_colliders(self.meta, self._read)
         return self._colliders
 
 
 def load(world) -> Ground:
-    """A :class:`Ground` for a World, a world folder (str/Path) or a Ground (returned as is)."""
+    """A :class:`Ground` for a World, a PackWorld, a world folder (str/Path) or a Ground (returned as is)."""
     if isinstance(world, Ground):
         return world
-    if hasattr(world, "scene") and hasattr(world, "metadata"):
-        return Ground(world.metadata, scene=world.scene)
+    scene = getattr(world, "scene", None)
+    if scene is not None and hasattr(world, "metadata"):
+        return Ground(world.metadata, scene=scene)
+    if hasattr(world, "metadata") and hasattr(world, "read"):  # a PackWorld, in a folder or an archive
+        return Ground(world.metadata, read=world.read)
     if isinstance(world, (str, Path)):
         folder = Path(world)
         path = folder / "world.json" if folder.is_dir() else folder
@@ -91,8 +95,8 @@ def load(world) -> Ground:
             meta = json.loads(path.read_text())
         except (OSError, ValueError) as exc:
             raise ParameterError(f"parameter 'world' must be a World or a world folder with world.json, got {str(world)!r} ({exc})") from None
-        return Ground(meta, folder=path.parent)
-    raise ParameterError(f"parameter 'world' must be a World or a world folder, got {type(world).__name__}")
+        return Ground(meta, read=lambda rel: (path.parent / rel).read_bytes())
+    raise ParameterError(f"parameter 'world' must be a World, a PackWorld or a world folder, got {type(world).__name__}")
 
 
 def as_trajectory(trajectory) -> np.ndarray:
@@ -271,7 +275,7 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
 
 # -- colliders from world.json (a folder has no Scene) ------------------------------
 
-def _entity_colliders(meta: dict, folder: Optional[Path]):
+def _entity_colliders(meta: dict, read: Callable[[str], bytes]):
     """The same Colliders the feasibility check uses, rebuilt from world.json's entities."""
     from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere
 
@@ -287,8 +291,10 @@ def _entity_colliders(meta: dict, folder: Optional[Path]):
         elif s["type"] == "sphere":
             shape = Sphere(s["radius"])
         else:
+            import io
+
             import trimesh
-            mesh = trimesh.load(Path(folder) / s["uri"], force="mesh")
+            mesh = trimesh.load(io.BytesIO(read(s["uri"])), file_type=Path(s["uri"]).suffix.lstrip("."), force="mesh")
             shape = Mesh(s["uri"], np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64),
                          tuple(s.get("scale", (1.0, 1.0, 1.0))))
         # world.json poses are world-frame, so every node becomes a root node here.

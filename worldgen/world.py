@@ -138,6 +138,19 @@ class World:
         """world.json of this world written in every format (SDF 1.9)."""
         return self.metadata_for(self._default_files)
 
+    def read(self, name: str) -> bytes:
+        """A file of this world by its name in the folder (``world.sdf``, ``meshes/...``, ``world.json``).
+
+        The bytes :meth:`write` would write with its defaults; preview.png is not among them.
+        """
+        if name == METADATA_NAME:
+            from worldgen.export import metadata
+            return metadata.dumps(self.metadata).encode()
+        for rel, data in self._default_files.values():
+            if rel == name:
+                return data
+        raise OutputError(f"world {self.world_id} has no file {name!r}")
+
     def to_json(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> str:
         from worldgen.export import metadata
         return metadata.dumps(self.metadata_for(self.rendered_files(formats, sdf_version)))
