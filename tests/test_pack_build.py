@@ -300,3 +300,63 @@ def test_oracles_take_pack_worlds_in_a_folder_and_in_an_archive(built, tmp_path,
             assert [c.entity for c in oracles.collisions(through, w)] == \
                 [c.entity for c in oracles.collisions(through, regenerated)] != []
     opened.close()
+
+
+def test_rebuild_after_the_recipe_changed_leaves_only_the_new_worlds(built, tmp_path, capsys):
+    _, recipe, reference = built
+    pack = tmp_path / "pack"
+    assert cli("pack", "build", recipe, "--out", pack) == 0
+    changed = tmp_path / "tiny.yaml"
+    changed.write_text(RECIPE.replace("seeds: 3", "seeds: 1"))
+    capsys.readouterr()
+    assert cli("pack", "build", changed, "--out", pack) == 0
+    before = len(json.loads((reference / "manifest.json").read_text())["worlds"])
+    manifest = json.loads((pack / "manifest.json").read_text())
+    removed = before - len(manifest["worlds"])
+    assert removed > 0
+    assert f"removed {removed} world folder(s) an earlier recipe left in the pack" in capsys.readouterr().out
+    assert world_folders(pack) == sorted(w["world_id"] for w in manifest["worlds"])
+    assert len(list((pack / ".build").glob("*.json"))) == len(manifest["worlds"])
+    assert all(ok for ok, _ in verify_pack(pack))
+    # A folder that is not in the manifest is a verify failure, and no archive carries it.
+    kept = {w["world_id"] for w in manifest["worlds"]}
+    stale = next(p for p in (reference / "worlds").iterdir() if p.name not in kept)
+    import shutil
+
+    shutil.copytree(stale, pack / "worlds" / stale.name)
+    verdicts = list(verify_pack(pack))
+    assert (False, f"FAIL worlds/{stale.name}: not in the manifest (left by another build?)") in verdicts
+    with tarfile.open(write_archive(pack, tmp_path / "p.tar.gz")) as tar:
+        assert not [n for n in tar.getnames() if stale.name in n]
+
+
+def test_a_pack_whose_every_job_is_rejected_fails_and_writes_no_manifest(tmp_path, capsys):
+    recipe = tmp_path / "none.yaml"
+    recipe.write_text("name: none\nseeds: 2\nworlds:\n  - generator: cluttered\n"
+                      "    params: {size: [3, 3], n_obstacles: 40, max_attempts: 2}\n")
+    assert cli("pack", "build", recipe, "--out", tmp_path / "p") == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: no job of recipe 'none' made a world (2 rejected") and "\n" not in err
+    assert not (tmp_path / "p" / "manifest.json").exists()
+
+
+def test_pack_files_respect_the_umask(built, tmp_path):
+    _, recipe, _ = built
+    old = os.umask(0o022)
+    try:
+        assert cli("pack", "build", recipe, "--out", tmp_path / "p") == 0
+        archive = write_archive(tmp_path / "p", tmp_path / "p.tar.gz")
+    finally:
+        os.umask(old)
+    for path in (tmp_path / "p" / "manifest.json", tmp_path / "p" / "index.csv", archive):
+        assert path.stat().st_mode & 0o777 == 0o644, path
+    some_world = next((tmp_path / "p" / "worlds").iterdir())
+    assert some_world.stat().st_mode & 0o777 == 0o755
+    assert (some_world / "world.json").stat().st_mode & 0o777 == 0o644
+
+
+def test_scheduler_without_the_dask_executor_is_an_error(built, tmp_path, capsys):
+    _, recipe, _ = built
+    assert cli("pack", "build", recipe, "--out", tmp_path / "p", "--scheduler", "tcp://127.0.0.1:8786") == 2
+    assert "parameter 'scheduler' applies only with executor dask" in capsys.readouterr().err
+    assert not (tmp_path / "p").exists()

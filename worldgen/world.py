@@ -221,6 +221,17 @@ def _safe_relative(rel: str) -> str:
     return rel
 
 
+def creation_mode(full: int) -> int:
+    """``full`` (0o666 for files, 0o777 for folders) less the process umask, as open() and mkdir() would give.
+
+    tempfile makes 0600 files and 0700 folders whatever the umask; what is renamed
+    into place must look as if it had been created there.
+    """
+    umask = os.umask(0)
+    os.umask(umask)
+    return full & ~umask
+
+
 def refuse_other_world(target: Path, content_hash: str) -> None:
     """Raise OutputError if ``target`` exists and is not a folder of the world ``content_hash``."""
     if not os.path.lexists(target):
@@ -256,7 +267,7 @@ def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]
                 fh.write(data)
                 fh.flush()
                 os.fsync(fh.fileno())
-        os.chmod(tmp, 0o755)
+        os.chmod(tmp, creation_mode(0o777))
         if target.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=out_dir))
             os.rename(target, old / "w")
