@@ -23,7 +23,6 @@ through a thin obstacle between two recorded samples is still caught.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Optional
@@ -176,20 +175,38 @@ def min_clearance(trajectory, world) -> float:
 
 
 def collisions(trajectory, world) -> list[Contact]:
-    """Every contact of the footprint with a collider along the run, in time order.
+    """Every contact of the footprint with a collider or a mover along the run, in time order.
 
     A contact is reported once, at the first sample where it begins; the same
-    entity touched again after a gap is a second contact.
+    entity touched again after a gap is a second contact. A mover is touched
+    where its disc, at the sample's time, meets the footprint's (gap <= 0, as
+    FCL counts touching).
     """
     ground = load(world)
     pts = _samples(as_trajectory(trajectory), ground)
     col = ground.colliders
-    touching = np.zeros((len(pts), len(col)), dtype=bool)
+    movers = ground.meta.get("dynamic_obstacles") or []
+    names = list(col.names) + [str(m["name"]) for m in movers]
+    touching = np.zeros((len(pts), len(names)), dtype=bool)
     for p, c, _ in _touching(pts, ground):
         touching[p, c] = True
+    if movers:
+        touching[:, len(col):] = _mover_gaps(pts, ground) <= 0.0
     starts = touching & ~np.vstack([np.zeros((1, touching.shape[1]), dtype=bool), touching[:-1]])
-    out = [Contact(float(pts[p, 0]), col.names[c]) for p, c in zip(*np.nonzero(starts))]
+    out = [Contact(float(pts[p, 0]), names[c]) for p, c in zip(*np.nonzero(starts))]
     return sorted(out, key=lambda k: (k.time, k.entity))
+
+
+def _mover_gaps(pts: np.ndarray, ground: Ground) -> np.ndarray:
+    """(samples, movers) gap (m) between the footprint's edge and each mover's disc at each ``t, x, y`` sample."""
+    from worldgen.movers import mover_positions
+
+    radii = np.array([float(m["radius"]) for m in ground.meta["dynamic_obstacles"]])
+    gaps = np.empty((len(pts), len(radii)))
+    for i, (t, x, y) in enumerate(pts):
+        centres = mover_positions(ground.meta, float(t))
+        gaps[i] = np.hypot(centres[:, 0] - x, centres[:, 1] - y) - radii - ground.robot.radius
+    return gaps
 
 
 def _touching(pts: np.ndarray, ground: Ground):
@@ -213,21 +230,11 @@ def min_separation(trajectory, world) -> Optional[float]:
     Movers are where world.json's ``dynamic_obstacles`` scripts have them at each
     sample time (:func:`worldgen.movers.mover_positions`); None without movers.
     """
-    from worldgen.movers import mover_positions
-
     ground = load(world)
-    movers = ground.meta.get("dynamic_obstacles") or []
-    if not movers:
+    if not ground.meta.get("dynamic_obstacles"):
         return None
-    radii = np.array([float(m["radius"]) for m in movers])
     # Movers walk at about a metre a second: sample time no coarser than the footprint spacing allows.
-    pts = _samples(as_trajectory(trajectory), ground)
-    best = math.inf
-    for t, x, y in pts:
-        centres = mover_positions(ground.meta, float(t))
-        gap = np.hypot(centres[:, 0] - x, centres[:, 1] - y) - radii - ground.robot.radius
-        best = min(best, float(gap.min()))
-    return best
+    return float(_mover_gaps(_samples(as_trajectory(trajectory), ground), ground).min())
 
 
 @dataclass(frozen=True)
