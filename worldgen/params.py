@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping, Optional, Sequence
 
-from worldgen.errors import ParameterError
+from worldgen.errors import ParameterError, quoted
 from worldgen.floats import round_float
 
 __all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "describe_range"]
@@ -117,7 +117,7 @@ class Param:
         return ",".join(words)
 
     def _error(self, rule: str, value: Any) -> ParameterError:
-        return ParameterError(f"parameter '{self.name}' {rule}, got {value!r}")
+        return ParameterError(f"parameter '{self.name}' {rule}, got {quoted(value)}")
 
 
 def describe_range(p: Param) -> str:
