@@ -3,7 +3,9 @@
     .venv/bin/python examples/lidar_unit_test.py [OUT_DIR]
 
 The ``lidar_wall`` preset (the ``minimal`` generator) stands the robot at the
-origin facing +x with a wall whose near face is the plane x = 2.0. The "sensor"
+origin facing +x with a wall whose near face is the plane x = 2.0, and starts
+its scan straight ahead (``lidar_angle_min`` 0, so ``ranges[0]`` is the forward
+beam, as in a ROS LaserScan whose angle_min is 0). The "sensor"
 is MuJoCo's own ray caster (``mujoco.mj_ray``) on the exported MJCF, one ray per
 beam of world.json's ``sensors.lidar`` (pose, angles, range limits); every beam
 must agree with the recorded ground truth, and the forward beam must read 2.0 m.
@@ -49,7 +51,8 @@ def main(out_dir: str) -> int:
     mujoco.mj_forward(model, data)
     measured = mujoco_scan(model, data, lidar)
     truth = np.asarray(lidar["ranges"])
-    forward = int(np.argmin(np.abs(np.linspace(lidar["angle_min"], lidar["angle_max"], lidar["samples"]))))
+    forward = 0  # ranges[i] is the beam at angle_min + i * increment, and angle_min is 0 here
+    assert lidar["angle_min"] == 0.0
     worst = float(np.max(np.abs(measured - truth)))
     print(f"{len(truth)} beams; forward beam {measured[forward]:.6f} m (ground truth {truth[forward]:.6f} m); "
           f"largest disagreement {worst:.2e} m")

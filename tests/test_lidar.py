@@ -129,3 +129,38 @@ def test_lidar_range_limits_are_checked():
         worldgen.generate("cluttered", seed=0, lidar_range_min=6.0, lidar_range_max=5.0)
     with pytest.raises(ParameterError, match=r"parameter 'lidar_samples' must be in \[1, 100000\], got 0"):
         worldgen.generate("cluttered", seed=0, lidar_samples=0)
+
+
+@pytest.mark.parametrize("angle_min,fov,samples", [(0.0, 2 * math.pi, 360), (-1.0, 2 * math.pi, 7),
+                                                   (0.3, 1.2, 5), (-math.pi, math.pi, 181)])
+def test_lidar_angle_min_sets_ranges_0_as_a_ros_laserscan(angle_min, fov, samples):
+    """ranges[i] is the beam at angle_min + i * increment, counter-clockwise from the heading."""
+    room = Scene((Node("floor", "floor", Box((20, 20, 0.1)), Pose(0, 0, -0.05)),
+                  *[Node(f"w{k}", "wall", Box((0.1, 20, 1)), Pose(x, 0, 0.5)) for k, x in enumerate((-3.05, 5.05))],
+                  *[Node(f"v{k}", "wall", Box((20, 0.1, 1)), Pose(0, y, 0.5)) for k, y in enumerate((-2.05, 4.05))]),
+                 bounds=((-3, -2), (5, 4)))
+    yaw = 0.4
+    spec = lidar.spec_from_params({"lidar_fov": fov, "lidar_samples": samples, "lidar_angle_min": angle_min,
+                                   "lidar_height": 0.3, "lidar_range_min": 0.0, "lidar_range_max": 50.0},
+                                  Pose(0, 0, 0, 0, 0, yaw))
+    increment = (fov / samples) if fov >= 2 * math.pi - 1e-9 else fov / (samples - 1)
+    assert spec.angle_min == angle_min
+    assert spec.angle_max == pytest.approx(angle_min + (samples - 1) * increment, abs=1e-12)
+    ranges = lidar.scan(room, spec)
+    for i in range(samples):
+        beam = yaw + angle_min + i * increment  # world bearing of beam i
+        c, s = math.cos(beam), math.sin(beam)
+        # Exact distance to the room's inner faces x in [-3, 5], y in [-2, 4] from the origin.
+        t = min(v for v in ((5 / c) if c > 1e-12 else math.inf, (-3 / c) if c < -1e-12 else math.inf,
+                            (4 / s) if s > 1e-12 else math.inf, (-2 / s) if s < -1e-12 else math.inf))
+        assert ranges[i] == pytest.approx(t, abs=1e-9)
+
+
+def test_the_seed_lidar_unit_test_reads_ranges_0():
+    """The seed's test, as it is written: scan.ranges[0] is the wall 2.0 m ahead, within 5 cm."""
+    scan = worldgen.generate_preset("lidar_wall").metadata["sensors"]["lidar"]
+    assert abs(scan["ranges"][0] - 2.0) < 0.05
+    assert scan["angle_min"] == 0.0 and scan["ranges"][0] == pytest.approx(2.0, abs=1e-6)
+    # Without lidar_angle_min, a full circle starts behind the robot: ranges[0] would not be the wall.
+    centred = worldgen.generate_preset("lidar_wall", lidar_angle_min=None).metadata["sensors"]["lidar"]
+    assert centred["angle_min"] == pytest.approx(-math.pi, abs=1e-6) and abs(centred["ranges"][0] - 2.0) > 0.05

@@ -124,3 +124,74 @@ def test_each_mistake_is_one_line_naming_the_key_and_line(text, line, words):
     for w in words:
         assert w in message, message
     assert isinstance(info.value, WorldgenError)
+
+
+# -- files that are not a readable text recipe: one line, exit 2, nothing written ------------
+
+def _unreadable(tmp_path):
+    """A path that exists but cannot be read: mode 000 for a normal user, a socket for root
+    (root reads any file whatever its mode; no process reads a unix socket as a file)."""
+    import os
+    import socket
+
+    path = tmp_path / "recipe.yaml"
+    if os.geteuid() != 0:
+        path.write_text("worlds: []\n")
+        path.chmod(0)
+        return path
+    sock = socket.socket(socket.AF_UNIX)
+    sock.bind(str(path))
+    return path
+
+
+@pytest.mark.parametrize("kind,message", [
+    ("binary", r"recipe file '.*recipe.yaml' is not UTF-8 text \(byte 0x89 at offset 0\); is it a binary file\?$"),
+    ("latin1", r"recipe file '.*recipe.yaml' is not UTF-8 text \(byte 0xe9 at offset 19\); is it a binary file\?$"),
+    ("nul", r"recipe file '.*recipe.yaml' is not text \(it holds NUL bytes\); is it a binary file\?$"),
+    ("directory", r"recipe file '.*recipe.yaml' is a directory, not a file$"),
+    ("missing", r"recipe file '.*recipe.yaml' does not exist$"),
+    ("unreadable", r"recipe file '.*recipe.yaml' cannot be read: .+$"),
+])
+def test_a_recipe_that_is_not_readable_text_is_one_line_and_exit_2(tmp_path, kind, message):
+    import re
+
+    from test_cli import run
+
+    path = tmp_path / "recipe.yaml"
+    if kind == "binary":
+        path.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)))
+    elif kind == "latin1":
+        path.write_bytes("worlds:\n  - {n: caf\u00e9}\n".encode("latin-1"))
+    elif kind == "nul":
+        path.write_bytes(b"worlds: []\n\x00\x00")
+    elif kind == "directory":
+        path.mkdir()
+    elif kind == "unreadable":
+        path = _unreadable(tmp_path)
+    out = tmp_path / "pack"
+    result = run("pack", "build", path, "--out", out)
+    assert result.returncode == 2, result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in result.stderr, result.stderr
+    assert re.search(message, lines[0]), lines[0]
+    assert not out.exists()
+
+
+def test_a_huge_quoted_value_is_cut_to_a_readable_length():
+    huge = "x" * 100_000
+    with pytest.raises(ParameterError) as err:
+        parse_recipe(f"name: {huge}\nworlds:\n  - generator: minimal\n", "r.yaml")
+    message = str(err.value)
+    assert "\n" not in message and len(message) < 200
+    assert message.endswith("got '" + "x" * 76 + "... (100002 characters)")
+    with pytest.raises(ParameterError) as err:
+        parse_recipe(f"worlds:\n  - generator: cluttered\n    params: {{size: [{', '.join(['1.0'] * 20000)}]}}\n", "r.yaml")
+    assert len(str(err.value)) < 300, str(err.value)[:400]
+
+
+def test_quoted_leaves_short_values_alone():
+    from worldgen.errors import QUOTE_LIMIT, quoted
+
+    assert quoted("short") == "'short'" and quoted([1, 2]) == "[1, 2]"
+    long = quoted(list(range(1000)))
+    assert long == repr(list(range(1000)))[:QUOTE_LIMIT - 3] + "... (4890 characters)"

@@ -42,6 +42,7 @@ def test_empty_room():
     t = world.tasks[0]
     assert (t.spawn.x, t.spawn.y) == (-4.5, -4.5)  # the corner start, 0.5 m in from both walls
     assert (t.goal.x - t.spawn.x, t.goal.y - t.spawn.y) == (5.0, 5.0)
+    assert t.spawn.yaw == 0.0  # so (5, 5) is also the goal in the robot's odometry frame
     assert world.feasibility.paths[0].length == pytest.approx(5 * math.sqrt(2), abs=1e-6)
 
 
@@ -80,6 +81,7 @@ def test_50_random_boxes_in_20_by_20():
     obstacles = roles(world, "obstacle")
     assert len(obstacles) == 50 and {o.shape.kind for o in obstacles} == {"box"}
     assert world.scene.bounds == ((-10.0, -10.0), (10.0, 10.0))
+    assert all(o.shape.size[0] == o.shape.size[1] and o.pose.yaw == 0.0 for o in obstacles)  # the seed's draw
 
 
 def test_drl_arena_draws_spawn_and_goal_within_4_5_m_where_free():
@@ -96,6 +98,136 @@ def test_lidar_wall_is_2_m_straight_ahead():
     spawn = world.tasks[0].spawn
     d, name = ray(world, (spawn.x, spawn.y), spawn.yaw, 0.3)
     assert name == "target" and abs(d - 2.0) <= 1e-6
+
+
+# -- every number a preset's texts quote is asserted ------------------------------------------
+#
+# Each claim is a pattern over the preset's description + reproduces text and a check of the
+# world against the numbers it captures. Every number in the texts must fall inside some claim's
+# match, so a preset whose text changes without its world (or the reverse) fails here.
+
+N = r"(-?\d+(?:\.\d+)?)"
+
+
+def _extent(world):
+    (x0, y0), (x1, y1) = world.scene.bounds
+    return x1 - x0, y1 - y0
+
+
+def _odom_goal(world):
+    """The goal in the odometry frame: from the spawn, x along the robot's heading."""
+    t = world.tasks[0]
+    dx, dy = t.goal.x - t.spawn.x, t.goal.y - t.spawn.y
+    c, s = math.cos(t.spawn.yaw), math.sin(t.spawn.yaw)
+    return c * dx + s * dy, -s * dx + c * dy
+
+
+def _boxes(world):
+    return [o for o in roles(world, "obstacle") if o.shape.kind == "box"]
+
+
+def _lidar(world):
+    return world.metadata["sensors"]["lidar"]
+
+
+def _drawn_within(world, h):
+    return all(abs(p.x) <= h and abs(p.y) <= h for t in world.tasks for p in (t.spawn, t.goal))
+
+
+def _spans(values, lo, hi):
+    """Values drawn from uniform(lo, hi): all inside, and both ends approached (50 draws: within 0.1 of
+    each end of a 0.7 m range but for odds of 2 x (6/7)^50 < 1e-3)."""
+    return min(values) >= lo and max(values) <= hi and min(values) < lo + 0.1 and max(values) > hi - 0.1
+
+
+CLAIMS = {
+    "empty_room": [
+        (rf"{N} x {N} m", lambda w, a, b: _extent(w) == (a, b)),
+        (rf"start at \({N}, {N}\)", lambda w, x, y: (w.tasks[0].spawn.x, w.tasks[0].spawn.y) == (x, y)),
+        (rf"yaw {N}\b", lambda w, yaw: w.tasks[0].spawn.yaw == yaw),
+        (rf"(?<!world )goal(?: at)? \({N}, {N}\)", lambda w, x, y: _odom_goal(w) == pytest.approx((x, y), abs=1e-9)),
+        (rf"\({N}, {N}\) in the odometry frame", lambda w, x, y: _odom_goal(w) == pytest.approx((x, y), abs=1e-9)),
+        (rf"world goal \({N}, {N}\) = spawn \+ \({N}, {N}\)",
+         lambda w, gx, gy, dx, dy: (w.tasks[0].goal.x, w.tasks[0].goal.y) == (gx, gy)
+         == (w.tasks[0].spawn.x + dx, w.tasks[0].spawn.y + dy)),
+        (rf"start {N} m in from the \({N}, {N}\) corner",
+         lambda w, d, cx, cy: w.scene.bounds[0] == (cx, cy)
+         and (w.tasks[0].spawn.x - cx, w.tasks[0].spawn.y - cy) == (d, d)),
+        (rf"straight line, {N} m", lambda w, length: w.feasibility.paths[0].length == pytest.approx(length, abs=5e-4)
+         and len(w.feasibility.paths[0].waypoints) == 2),
+    ],
+    "clutter_50_boxes": [
+        (rf"{N} random boxes", lambda w, n: len(_boxes(w)) == len(roles(w, "obstacle")) == n),
+        (rf"generate {N} obstacles", lambda w, n: len(roles(w, "obstacle")) == n),
+        (rf"{N} x {N} m area", lambda w, a, b: _extent(w) == (a, b) and len(roles(w, "wall")) == 4),
+        (rf"square footprint of side uniform\({N}, {N}\) m",
+         lambda w, lo, hi: all(b.shape.size[0] == b.shape.size[1] for b in _boxes(w))
+         and _spans([b.shape.size[0] for b in _boxes(w)], lo, hi)),
+        (rf"height of uniform\({N}, {N}\) m", lambda w, lo, hi: _spans([b.shape.size[2] for b in _boxes(w)], lo, hi)),
+        (rf"yaw {N}\b", lambda w, yaw: all(b.pose.yaw == yaw for b in _boxes(w))),
+        (rf"base at z = {N}", lambda w, z: all(w.scene.aabb(b.name)[0][2] == pytest.approx(z, abs=1e-9) for b in _boxes(w))),
+    ],
+    "lidar_wall": [
+        (rf"{N} m wide wall", lambda w, width: w.scene.aabb("target")[1][1] - w.scene.aabb("target")[0][1]
+         == pytest.approx(width, abs=1e-9)),
+        (rf"{N} m straight ahead", lambda w, d: w.scene.aabb("target")[0][0] - w.tasks[0].spawn.x == pytest.approx(d)),
+        (r"ranges\[0\]", lambda w: _lidar(w)["angle_min"] == 0.0),
+        (r"ranges\[i\] at angle_min \+ i \* increment",
+         lambda w: _lidar(w)["angle_max"] == pytest.approx(2 * math.pi * (_lidar(w)["samples"] - 1) / _lidar(w)["samples"],
+                                                            abs=1e-6)),
+        (rf"wall at {N} m", lambda w, d: _lidar(w)["ranges"][0] == pytest.approx(d, abs=1e-6)),
+        (rf"plane x = {N}", lambda w, x: w.scene.aabb("target")[0][0] == pytest.approx(x, abs=1e-9)),
+        (rf"lidar_angle_min {N}", lambda w, a: w.params["lidar_angle_min"] == a == _lidar(w)["angle_min"]),
+        (rf"reads {N} m, within its {N} cm tolerance", lambda w, d, cm: abs(_lidar(w)["ranges"][0] - d) < cm / 100),
+    ],
+    "narrow_corridor": [
+        (rf"Straight {N} m corridor", lambda w, length: _extent(w)[0] == pytest.approx(length)),
+        (rf"{N} m wide", lambda w, width: _extent(w)[1] == pytest.approx(width)),
+        (rf"radius {N} m, clearance\s+{N} m", lambda w, r, c: (w.robot.radius, w.robot.clearance) == (r, c)),
+        (rf"leaves {N} m on each side",
+         lambda w, side: (_extent(w)[1] - 2 * w.robot.inflation) / 2 == pytest.approx(side, abs=1e-9)),
+        (rf"narrowest_passage is {N} m, reported to\s+within {N} feasibility grid cells below",
+         lambda w, width, cells: cells == pytest.approx(PASSAGE_CELLS, abs=5e-3)
+         and width - cells * w.feasibility.resolution <= w.metadata["metrics"]["narrowest_passage"] <= width + 1e-6),
+    ],
+    "room_5_obstacles": [
+        (rf"{N} x {N} m walled room", lambda w, a, b: _extent(w) == (a, b) and len(roles(w, "wall")) == 4),
+        (rf"with {N} randomly placed boxes and cylinders",
+         lambda w, n: len(roles(w, "obstacle")) == n and {o.shape.kind for o in roles(w, "obstacle")} <= {"box", "cylinder"}),
+    ],
+    "drl_arena": [
+        (rf"{N} x {N} m (?:walled )?room", lambda w, a, b: _extent(w) == (a, b) and len(roles(w, "wall")) == 4),
+        (rf"{N} random boxes", lambda w, n: len(_boxes(w)) == len(roles(w, "obstacle")) == n),
+        (rf"\+-{N} m", lambda w, h: _drawn_within(w, h)),
+    ],
+    "door_crossing": [
+        (rf"door(?:way)? at x = {N} m", lambda w, x: w.metadata["doors"][0]["passage"]["center"][0] == pytest.approx(x)),
+        (rf"beyond it at \({N}, {N}\)", lambda w, x, y: (w.tasks[0].goal.x, w.tasks[0].goal.y) == (x, y)
+         and w.tasks[0].spawn.x < w.metadata["doors"][0]["passage"]["center"][0] < x),
+        (rf"crosses x = {N}", lambda w, x: min(p[0] for p in w.feasibility.paths[0].waypoints) < x
+         < max(p[0] for p in w.feasibility.paths[0].waypoints)),
+    ],
+}
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_every_number_a_preset_quotes_holds(name):
+    import re
+
+    preset = presets.load(name)
+    text = f"{preset.description} {preset.reproduces}"
+    covered = set()
+    for seed in range(3):
+        world = worldgen.generate_preset(name, seed=seed)
+        for pattern, holds in CLAIMS[name]:
+            found = list(re.finditer(pattern, text))
+            assert found, f"{name}: the text no longer says {pattern!r}"
+            for m in found:
+                covered.update(range(*m.span()))
+                numbers = [float(g) for g in m.groups()]
+                assert holds(world, *numbers), f"{name} seed {seed}: {m.group(0)!r} does not hold"
+    unclaimed = [m.group(0) for m in re.finditer(r"\d+(?:\.\d+)?", text) if not set(range(*m.span())) <= covered]
+    assert not unclaimed, f"{name}: numbers quoted but not asserted: {unclaimed}"
 
 
 # -- the API ---------------------------------------------------------------------------------

@@ -14,7 +14,9 @@ Conventions (the ``door`` generator follows them; a hand-built scene may too):
 
 Feasibility plans the reference path with every leaf at its open limit
 (:func:`open_scene`) and reports separately whether the goal is reachable with
-the doors as they start.
+the doors as they start (:func:`fixed_scene`). A task needs a door opened where
+the robot's footprint, swept along that path, meets a leaf as it starts, closed
+or ajar (:func:`leaves_in_the_way`).
 """
 
 from __future__ import annotations
@@ -23,11 +25,13 @@ import math
 from typing import Mapping, Optional
 
 import numpy as np
+import shapely
 
+from worldgen.footprint import scene_footprints
 from worldgen.scene import Box, Joint, Node, Scene, matrix_to_pose
 
-__all__ = ["door_joints", "open_angle", "state_of", "scene_at", "open_scene", "door_records",
-           "crosses_passage", "requires_door_open", "STATE_TOL"]
+__all__ = ["door_joints", "open_angle", "state_of", "scene_at", "open_scene", "fixed_scene", "door_records",
+           "leaves_in_the_way", "requires_door_open", "STATE_TOL"]
 
 #: Angles (rad) closer than this to 0 or to the open limit count as closed or open.
 STATE_TOL = 1e-6
@@ -151,33 +155,46 @@ def _leaf_width(leaf: Node) -> float:
     return float(max(hi[0] - lo[0], hi[1] - lo[1]))
 
 
-def crosses_passage(waypoints: np.ndarray, passage: Mapping) -> bool:
-    """True when the polyline ``waypoints`` (k, 2) crosses the doorway's centre line.
+def fixed_scene(scene: Scene) -> Scene:
+    """``scene`` with every door leaf held where it starts: door hinges become fixed joints.
 
-    The centre line runs across the opening through ``center``, ``width`` long,
-    perpendicular to ``normal``; crossing means two consecutive waypoints on
-    strictly opposite sides of the wall plane, meeting the plane inside it.
+    Feasibility plans through doors at their open limit; on this scene the same
+    check answers whether a task can be driven without moving any leaf.
     """
-    w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
-    if len(w) < 2:
-        return False
-    c = np.asarray(passage["center"], dtype=float)
-    n = np.asarray(passage["normal"], dtype=float)
-    along = np.array([-n[1], n[0]])
-    s = (w - c) @ n
-    a, b = s[:-1], s[1:]
-    cross = (a * b < 0) | ((a == 0) ^ (b == 0))
-    for k in np.nonzero(cross)[0]:
-        t = a[k] / (a[k] - b[k]) if a[k] != b[k] else 0.0
-        p = w[k] + t * (w[k + 1] - w[k])
-        if abs(float((p - c) @ along)) <= passage["width"] / 2:
-            return True
-    return False
+    doors = {j.name for j in door_joints(scene)}
+    if not doors:
+        return scene
+    joints = tuple(Joint(j.name, "fixed", j.parent, j.child, j.pose) if j.name in doors else j for j in scene.joints)
+    return Scene(scene.nodes, joints, scene.bounds, scene.physics, scene.movers)
 
 
-def requires_door_open(records: list[dict], waypoints) -> bool:
-    """True when the path crosses the doorway of a door that starts closed."""
+def leaves_in_the_way(scene: Scene, waypoints, radius: float, height: float) -> list[str]:
+    """Door leaves (names, in joint order) that a disc of ``radius`` swept along ``waypoints`` meets.
+
+    Each leaf stands at its initial angle, closed or ajar; only the part of it
+    below ``height`` (the robot's top) counts, as its floor shadow. The sweep is
+    exact: the polyline buffered by ``radius``, so "meets" is a distance below
+    ``radius`` between the leaf's shadow and the path.
+    """
     if waypoints is None:
-        return False
-    return any(r["state"] == "closed" and r["passage"] is not None and crosses_passage(waypoints, r["passage"])
-               for r in records)
+        return []
+    leaves = [j.child for j in door_joints(scene)]
+    if not leaves:
+        return []
+    w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+    path = shapely.LineString(w) if len(w) > 1 else shapely.Point(w[0])
+    prints = {fp.name: fp for fp in scene_footprints(scene, height) if fp.name in leaves}
+    out = []
+    for name in leaves:
+        fp = prints.get(name)
+        if fp is None:  # a leaf entirely above the robot
+            continue
+        shadow = fp.polygon if not fp.is_disc else shapely.Point(fp.centre).buffer(fp.radius, quad_segs=64)
+        if shadow.distance(path) < radius:
+            out.append(name)
+    return out
+
+
+def requires_door_open(scene: Scene, waypoints, robot) -> bool:
+    """True when ``robot``'s footprint, swept along ``waypoints``, meets any door leaf as it starts."""
+    return bool(leaves_in_the_way(scene, waypoints, robot.radius, robot.height))

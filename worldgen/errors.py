@@ -14,7 +14,13 @@ __all__ = [
     "InfeasibleError",
     "SceneError",
     "OutputError",
+    "quoted",
+    "read_user_text",
+    "QUOTE_LIMIT",
 ]
+
+#: Longest quotation of a user's value in a message (characters), so one line stays readable.
+QUOTE_LIMIT = 80
 
 
 class WorldgenError(Exception):
@@ -46,3 +52,39 @@ class InfeasibleError(WorldgenError):
 
 class OutputError(WorldgenError, OSError):
     """The output folder cannot be written (missing permission, not a folder, ...)."""
+
+
+def quoted(value, limit: int = QUOTE_LIMIT) -> str:
+    """``repr(value)`` for a message, cut to ``limit`` characters (saying how long it was) and on one line."""
+    text = repr(value)
+    if len(text) <= limit:
+        return text
+    return f"{text[:limit - 3]}... ({len(text)} characters)"
+
+
+def read_user_text(path, what: str) -> str:
+    """The UTF-8 text of the file a user named; every way it can fail is one :class:`ParameterError` line.
+
+    ``what`` names the file's role in the message (e.g. ``recipe file``). A
+    missing path, a directory, an unreadable file and bytes that are not UTF-8
+    text (a binary file) each get their own message.
+    """
+    from pathlib import Path
+
+    path = Path(path)
+    if path.is_dir():
+        raise ParameterError(f"{what} '{path}' is a directory, not a file")
+    if not path.exists():
+        raise ParameterError(f"{what} '{path}' does not exist")
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ParameterError(f"{what} '{path}' cannot be read: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(f"{what} '{path}' is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start}); "
+                             "is it a binary file?") from None
+    if "\x00" in text:
+        raise ParameterError(f"{what} '{path}' is not text (it holds NUL bytes); is it a binary file?")
+    return text

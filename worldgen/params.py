@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping, Optional, Sequence
 
-from worldgen.errors import ParameterError
+from worldgen.errors import ParameterError, quoted
 from worldgen.floats import round_float
 
 __all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "describe_range"]
@@ -117,7 +117,7 @@ class Param:
         return ",".join(words)
 
     def _error(self, rule: str, value: Any) -> ParameterError:
-        return ParameterError(f"parameter '{self.name}' {rule}, got {value!r}")
+        return ParameterError(f"parameter '{self.name}' {rule}, got {quoted(value)}")
 
 
 def describe_range(p: Param) -> str:
@@ -213,6 +213,9 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn", 0.001, 50.0, unit="m"),
     Param("lidar_fov", "float", 6.283185, "field of view of the ground-truth lidar, centred ahead (6.283185 = full circle)",
           1e-3, 6.283185307179586, unit="rad"),
+    Param("lidar_angle_min", "float", None, "angle of the first ray (ranges[0]) from the robot's heading, as ROS "
+          "LaserScan angle_min; unset: the field of view is centred ahead", -6.283185307179586, 6.283185307179586,
+          optional=True, unit="rad"),
     Param("lidar_samples", "int", 360, "rays of the ground-truth lidar", 1, 100000),
     Param("lidar_range_min", "float", 0.05, "shortest range of the ground-truth lidar (rays start there)", 0.0, 100.0, unit="m"),
     Param("lidar_range_max", "float", 30.0, "longest range of the ground-truth lidar, written where nothing is hit", 0.01, 10000.0, unit="m"),

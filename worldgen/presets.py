@@ -23,7 +23,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping, Optional
 
-from worldgen.errors import ParameterError, WorldgenError
+from worldgen.errors import ParameterError, WorldgenError, quoted, read_user_text
 
 __all__ = ["Preset", "PRESET_KEYS", "names", "all_presets", "load", "generate_preset"]
 
@@ -70,9 +70,7 @@ def load(name_or_path: str) -> Preset:
     text_name = str(name_or_path)
     if text_name.endswith((".yaml", ".yml")):
         path = Path(text_name)
-        if not path.is_file():
-            raise ParameterError(f"preset file '{path}' does not exist")
-        return _parse(path.read_text(encoding="utf-8"), str(path), path.stem)
+        return _parse(read_user_text(path, "preset file"), str(path), path.stem)
     available = names()
     if text_name not in available:
         raise ParameterError(f"unknown preset '{text_name}'; available: {', '.join(available)}")
@@ -99,15 +97,15 @@ def _parse(text: str, source: str, stem: str) -> Preset:
             raise ParameterError(f"preset file '{source}': key '{key}' is missing")
     for key in ("name", "description", "reproduces", "generator"):
         if not isinstance(doc[key], str) or not doc[key].strip():
-            raise ParameterError(f"preset file '{source}': key '{key}' must be a non-empty string, got {doc[key]!r}")
+            raise ParameterError(f"preset file '{source}': key '{key}' must be a non-empty string, got {quoted(doc[key])}")
     if doc["name"] != stem:
-        raise ParameterError(f"preset file '{source}': key 'name' must equal the file's name '{stem}', got {doc['name']!r}")
+        raise ParameterError(f"preset file '{source}': key 'name' must equal the file's name '{stem}', got {quoted(doc['name'])}")
     params = doc["params"]
     if params is None:
         params = {}
     if not isinstance(params, dict) or not all(isinstance(k, str) for k in params):
         raise ParameterError(f"preset file '{source}': key 'params' must be a mapping of parameter names to values, "
-                             f"got {params!r}")
+                             f"got {quoted(params)}")
     preset = Preset(doc["name"], " ".join(doc["description"].split()), " ".join(doc["reproduces"].split()),
                     doc["generator"], dict(params), source)
     from worldgen.generators import get

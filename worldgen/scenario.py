@@ -15,7 +15,7 @@ world.json can still launch and judge a task:
         success_criteria:
           - {type: robot_reaches_waypoint, waypoint: [x, y], tolerance: 0.2}
           - {type: max_time, seconds: 30.79}
-          - {type: door_opened, door: door_leaf}      # only where the path needs a closed door open
+          - {type: door_opened, door: door_0}         # each leaf that stands in the path as it starts
         failure_conditions:
           - {type: collision}
           - {type: timeout, seconds: 30.79}
@@ -40,27 +40,23 @@ SCENARIO_NAME = "scenario.yaml"
 
 def scenario(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, Any]:
     """The scenario spec of ``world`` as a plain dict; ``world`` names the first written of SDF, MJCF, URDF."""
-    from worldgen.doors import door_records, requires_door_open
-    from worldgen.export.metadata import _default, time_limit
+    from worldgen.export.metadata import _default, _in_the_way, time_limit
     from worldgen.floats import round_float
     from worldgen.world import FILE_NAMES, FORMATS
 
     speed = world.params.get("robot_speed", _default("robot_speed"))
-    doors = door_records(world.scene)
     paths = list(world.feasibility.paths) + [None] * len(world.tasks)
     tasks = []
     for task, path in zip(world.tasks, paths):
-        limit: Optional[float] = None if path is None else round_float(time_limit(path.length, speed))
+        leaves = _in_the_way(world, path)
+        limit: Optional[float] = None if path is None else round_float(time_limit(path.length, speed, len(leaves)))
         success = [{"type": "robot_reaches_waypoint", "waypoint": [round_float(task.goal.x), round_float(task.goal.y)],
                     "tolerance": round_float(task.goal_tolerance)}]
         failure: list[dict[str, Any]] = [{"type": "collision"}]
         if limit is not None:
             success.append({"type": "max_time", "seconds": limit})
             failure.append({"type": "timeout", "seconds": limit})
-        if path is not None and requires_door_open(doors, path.waypoints):
-            for d in doors:
-                if d["state"] == "closed":
-                    success.append({"type": "door_opened", "door": d["name"]})
+        success += [{"type": "door_opened", "door": name} for name in leaves]
         tasks.append({
             "id": task.id,
             "spawn": {"x": round_float(task.spawn.x), "y": round_float(task.spawn.y), "z": round_float(task.spawn.z),

@@ -19,7 +19,7 @@ from typing import Any, Mapping
 import numpy as np
 import shapely
 
-from worldgen.doors import door_records, requires_door_open
+from worldgen.doors import door_records, leaves_in_the_way
 from worldgen.floats import round_float
 from worldgen.groundtruth import truth
 from worldgen.footprint import scene_footprints
@@ -35,6 +35,8 @@ SCHEMA_ID = "worldgen.world/1"
 #: ideal run needs, plus a fixed allowance for start-up and turning on the spot.
 TIME_FACTOR = 2.0
 TIME_MARGIN = 10.0
+#: Added to time_limit for each door leaf the path needs moved (pushing or pulling it open).
+DOOR_TIME = 10.0
 
 #: Segments per quarter circle when a disc footprint becomes a polygon for area sums:
 #: the polygon's area is within 0.1 % of the disc's.
@@ -65,7 +67,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "entities": [_entity(scene, node) for node in scene.nodes],
         "doors": door_records(scene),
         "dynamic_obstacles": [mover_entry(m) for m in scene.movers],
-        "tasks": [_task(task, path, speed) for task, path in zip(world.tasks, paths)],
+        "tasks": [_task(task, path, speed, _in_the_way(world, path)) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
             "allow_infeasible": world.allow_infeasible,
@@ -92,8 +94,6 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "occupancy": truth.occupancy_block(world),
         "files": {key: {"path": path, "sha256": digest} for key, (path, digest) in sorted(files.items())},
     }
-    for task, path in zip(meta["tasks"], paths):
-        task["requires_door_open"] = requires_door_open(meta["doors"], None if path is None else path.waypoints)
     return _plain(meta)
 
 
@@ -107,9 +107,16 @@ def dumps(meta: Mapping[str, Any]) -> str:
     return _emit(meta, "") + "\n"
 
 
-def time_limit(length: float, robot_speed: float) -> float:
-    """A generous time bound (s) for a path of ``length`` m at ``robot_speed`` m/s."""
-    return TIME_FACTOR * length / robot_speed + TIME_MARGIN
+def time_limit(length: float, robot_speed: float, doors: int = 0) -> float:
+    """A generous time bound (s) for a path of ``length`` m at ``robot_speed`` m/s that must open ``doors`` leaves."""
+    return TIME_FACTOR * length / robot_speed + TIME_MARGIN + DOOR_TIME * doors
+
+
+def _in_the_way(world, path) -> list[str]:
+    """The door leaves, as they start, that the robot's footprint meets along ``path``."""
+    if path is None:
+        return []
+    return leaves_in_the_way(world.scene, path.waypoints, world.robot.radius, world.robot.height)
 
 
 def free_area_ratio(scene, height: float) -> float:
@@ -188,7 +195,7 @@ def _entity(scene, node) -> dict:
     }
 
 
-def _task(task, path, speed: float) -> dict:
+def _task(task, path, speed: float, leaves: list) -> dict:
     spawn, goal = task.spawn, task.goal
     out = {
         "id": task.id,
@@ -198,7 +205,7 @@ def _task(task, path, speed: float) -> dict:
         "straight_line_distance": math.hypot(goal.x - spawn.x, goal.y - spawn.y),
         "path": None,
         "time_limit": None,
-        "requires_door_open": False,
+        "requires_door_open": bool(leaves),
     }
     if path is not None:
         out["path"] = {
@@ -206,7 +213,7 @@ def _task(task, path, speed: float) -> dict:
             "length": path.length,
             "min_clearance": _finite_or_none(path.min_clearance),
         }
-        out["time_limit"] = time_limit(path.length, speed)
+        out["time_limit"] = time_limit(path.length, speed, len(leaves))
     return out
 
 

@@ -44,6 +44,7 @@ PARAMS = (
     Param("box_size", "range", [0.3, 1.0], "range of each box side length (x and y drawn separately)", 0.01, 50.0, unit="m"),
     Param("cylinder_radius", "range", [0.1, 0.4], "range of cylinder radii", 0.01, 25.0, unit="m"),
     Param("obstacle_height", "range", [0.5, 1.5], "range of obstacle heights", 0.01, 50.0, unit="m"),
+    Param("square_boxes", "bool", False, "draw one side length for both x and y of each box (a square footprint)"),
     Param("random_yaw", "bool", True, "turn each box by a random yaw"),
     Param("min_gap", "float", 0.1, "smallest distance between any two obstacles", 0.0, 50.0, unit="m"),
     Param("walls", "bool", True, "surround the room with walls"),
@@ -119,7 +120,10 @@ def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
         kind = shapes if shapes != "mixed" else ("box" if rng.random() < 0.5 else "cylinder")
         height = round_float(rng.uniform(*params["obstacle_height"]))
         if kind == "box":
-            sx, sy = (round_float(v) for v in rng.uniform(*params["box_size"], size=2))
+            if params["square_boxes"]:
+                sx = sy = round_float(rng.uniform(*params["box_size"]))
+            else:
+                sx, sy = (round_float(v) for v in rng.uniform(*params["box_size"], size=2))
             yaw = round_float(rng.uniform(-math.pi, math.pi)) if params["random_yaw"] else 0.0
             shape = Box((sx, sy, height))
         else:

@@ -10,7 +10,9 @@ ray above the floor never meets the floor slab, so no special case is needed.
 Conventions (also in world.json ``sensors.lidar``):
 - the sensor sits at ``pose``; ray i points along the sensor's x axis turned by
   ``angle_min + i * (angle_max - angle_min) / (samples - 1)`` about its z axis
-  (the Gazebo / ROS LaserScan spacing). A full circle (``lidar_fov`` = 2 pi) gets
+  (the Gazebo / ROS LaserScan spacing). ``angle_min`` is ``lidar_angle_min`` when set
+  (0 puts ``ranges[0]`` straight ahead, as many 360-degree scanners do), else the
+  field of view is centred ahead. A full circle (``lidar_fov`` = 2 pi) gets
   ``angle_max = angle_min + 2 pi (samples - 1) / samples`` so no ray is cast twice;
 - a ray starts at ``range_min`` (as Gazebo casts from its minimum range): the range
   is the distance from the sensor to the first surface at or beyond ``range_min``;
@@ -50,16 +52,22 @@ class LidarSpec:
 
 
 def spec_from_params(params: Mapping, spawn: Pose) -> LidarSpec:
-    """The default lidar: at ``spawn`` (x, y, yaw), ``lidar_height`` above the floor."""
+    """The default lidar: at ``spawn`` (x, y, yaw), ``lidar_height`` above the floor.
+
+    ``lidar_angle_min`` (optional) is ROS LaserScan's ``angle_min``: ray 0 points
+    there and the rays follow counter-clockwise over ``lidar_fov``; unset, the
+    field of view is centred ahead (a full circle then starts at -pi).
+    """
     fov = float(params["lidar_fov"])
     n = int(params["lidar_samples"])
+    start = params.get("lidar_angle_min")
     if n == 1:
-        lo = hi = 0.0
-    elif fov >= FULL_CIRCLE - _CIRCLE_TOL:
-        lo = -math.pi
-        hi = lo + FULL_CIRCLE * (n - 1) / n
+        lo = hi = 0.0 if start is None else float(start)
     else:
-        lo, hi = -fov / 2.0, fov / 2.0
+        circle = fov >= FULL_CIRCLE - _CIRCLE_TOL
+        span = FULL_CIRCLE * (n - 1) / n if circle else fov
+        lo = float(start) if start is not None else (-math.pi if circle else -fov / 2.0)
+        hi = lo + span
     pose = Pose(spawn.x, spawn.y, float(params["lidar_height"]), 0.0, 0.0, spawn.yaw)
     return LidarSpec(pose, lo, hi, n, float(params["lidar_range_min"]), float(params["lidar_range_max"]))
 

@@ -30,7 +30,7 @@ def lidar_spec(world) -> lidar.LidarSpec:
     """The world's lidar: at its first task's spawn, ``lidar_height`` up (a world without
     tasks, made by hand, gets it at the centre of its bounds, facing +x)."""
     params = {name: _param(world, name) for name in
-              ("lidar_height", "lidar_fov", "lidar_samples", "lidar_range_min", "lidar_range_max")}
+              ("lidar_height", "lidar_fov", "lidar_angle_min", "lidar_samples", "lidar_range_min", "lidar_range_max")}
     if world.tasks:
         at = world.tasks[0].spawn
     else:

@@ -37,7 +37,7 @@ from typing import Any
 import numpy as np
 import yaml
 
-from worldgen.errors import InfeasibleError, ParameterError, WorldgenError
+from worldgen.errors import InfeasibleError, ParameterError, WorldgenError, quoted, read_user_text
 from worldgen.floats import round_float
 from worldgen.world import FORMATS, SDF_VERSIONS, normalise_formats
 
@@ -92,9 +92,11 @@ class Recipe:
 
 def load_recipe(path) -> Recipe:
     path = Path(path)
-    if not path.is_file():
-        raise RecipeError(f"recipe file '{path}' does not exist")
-    return parse_recipe(path.read_text(encoding="utf-8"), str(path), path.stem)
+    try:
+        text = read_user_text(path, "recipe file")
+    except ParameterError as exc:
+        raise RecipeError(str(exc)) from None
+    return parse_recipe(text, str(path), path.stem)
 
 
 def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack") -> Recipe:
@@ -115,24 +117,24 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
     if "name" in top:
         name = r.value(top["name"])
         if not isinstance(name, str) or not _NAME.match(name):
-            r.fail(top["name"], "name", f"must be 1-64 letters, digits, '_', '.', '-', got {name!r}")
+            r.fail(top["name"], "name", f"must be 1-64 letters, digits, '_', '.', '-', got {quoted(name)}")
     formats = FORMATS
     if "formats" in top:
         value = r.value(top["formats"])
         try:
             formats = normalise_formats(value if isinstance(value, (list, str)) else [str(value)])
         except (ParameterError, AttributeError):
-            r.fail(top["formats"], "formats", f"must list formats among {', '.join(FORMATS)}, got {value!r}")
+            r.fail(top["formats"], "formats", f"must list formats among {', '.join(FORMATS)}, got {quoted(value)}")
     sdf_version = SDF_VERSIONS[0]
     if "sdf_version" in top:
         sdf_version = str(r.value(top["sdf_version"]))
         if sdf_version not in SDF_VERSIONS:
-            r.fail(top["sdf_version"], "sdf_version", f"must be one of {', '.join(SDF_VERSIONS)}, got {sdf_version!r}")
+            r.fail(top["sdf_version"], "sdf_version", f"must be one of {', '.join(SDF_VERSIONS)}, got {quoted(sdf_version)}")
     preview = False
     if "preview" in top:
         preview = r.value(top["preview"])
         if not isinstance(preview, bool):
-            r.fail(top["preview"], "preview", f"must be true or false, got {preview!r}")
+            r.fail(top["preview"], "preview", f"must be true or false, got {quoted(preview)}")
     default_seeds = r.seeds(top["seeds"]) if "seeds" in top else None
     worlds = top["worlds"]
     if not isinstance(worlds, yaml.SequenceNode) or not worlds.value:
@@ -170,7 +172,7 @@ class _Reader:
         for k, v in node.value:
             key = self.value(k)
             if not isinstance(key, str):
-                raise RecipeError(f"{self.source}:{k.start_mark.line + 1}: key {key!r} in {what} is not a name")
+                raise RecipeError(f"{self.source}:{k.start_mark.line + 1}: key {quoted(key)} in {what} is not a name")
             if allowed is not None and key not in allowed:
                 self.fail(k, key, f"unknown key in {what}; allowed: {', '.join(allowed)}")
             if key in out:
@@ -191,12 +193,12 @@ class _Reader:
         if isinstance(value, dict) and set(value) in ({"start", "count"}, {"min", "max"}):
             a, b = (value["start"], value["count"]) if "start" in value else (value["min"], value["max"])
             if not (_is_int(a) and _is_int(b)):
-                self.fail(node, "seeds", f"needs integers, got {value!r}")
+                self.fail(node, "seeds", f"needs integers, got {quoted(value)}")
             first, count = (a, b) if "start" in value else (a, b - a + 1)
             if not (0 <= first and 1 <= count <= MAX_WORLDS and first + count - 1 <= MAX_SEED):
-                self.fail(node, "seeds", f"must give 1 to {MAX_WORLDS} seeds in [0, {MAX_SEED}], got {value!r}")
+                self.fail(node, "seeds", f"must give 1 to {MAX_WORLDS} seeds in [0, {MAX_SEED}], got {quoted(value)}")
             return tuple(range(first, first + count))
-        self.fail(node, "seeds", f"must be a count, {{start, count}} or {{min, max}}, got {value!r}")
+        self.fail(node, "seeds", f"must be a count, {{start, count}} or {{min, max}}, got {quoted(value)}")
 
     def entry(self, node, e: int, default_seeds):
         from worldgen.generators import get
@@ -239,12 +241,12 @@ class _Reader:
                 p = kinds[key]
                 if isinstance(value, dict):
                     if set(value) != {"min", "max"} or p.kind not in ("int", "float"):
-                        self.fail(vnode, key, f"a mapping must be {{min, max}} on an int or float parameter, got {value!r}")
+                        self.fail(vnode, key, f"a mapping must be {{min, max}} on an int or float parameter, got {quoted(value)}")
                     lo, hi = value["min"], value["max"]
                     if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in (lo, hi)) or lo > hi:
-                        self.fail(vnode, key, f"needs numbers min <= max, got {value!r}")
+                        self.fail(vnode, key, f"needs numbers min <= max, got {quoted(value)}")
                     if p.kind == "int" and not (_is_int(lo) and _is_int(hi)):
-                        self.fail(vnode, key, f"is an integer parameter; min and max must be integers, got {value!r}")
+                        self.fail(vnode, key, f"is an integer parameter; min and max must be integers, got {quoted(value)}")
                     ranges[key] = (lo, hi)
                 elif isinstance(value, list) and (p.kind not in _LIST_KINDS or (value and all(isinstance(v, list) for v in value))):
                     if not value:
