@@ -28,6 +28,8 @@ class World:
     ``params`` holds every parameter resolved (defaults filled in), so
     ``generate(generator, seed, **params)`` rebuilds exactly this world.
     ``attempts`` is how many draws it took (1 = the first draw passed).
+    ``preset`` names the preset it came from (None otherwise): recorded in
+    world.json and in the folder's name, never in ``world_id``.
     """
 
     def __init__(self, generator: str, seed: int, params: Mapping[str, Any], scene: Scene,
@@ -41,6 +43,7 @@ class World:
         self.feasibility = feasibility
         self.attempts = attempts
         self.path: Optional[Path] = None  # the folder once written
+        self.preset: Optional[str] = None
 
     def __repr__(self) -> str:
         try:
@@ -56,6 +59,12 @@ class World:
     def world_id(self) -> str:
         """``<generator>-s<seed>-<8 hex of content_hash>``: stable and filesystem-safe."""
         return f"{self.generator}-s{self.seed}-{self.content_hash.split(':', 1)[1][:8]}"
+
+    @property
+    def folder_name(self) -> str:
+        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, else ``world_id``,
+        so worlds of several presets over one generator can be told apart in one folder."""
+        return f"{self.preset}--{self.world_id}" if self.preset else self.world_id
 
     # -- in-memory exports -------------------------------------------------
     def to_sdf(self, version: str = "1.9") -> str:
@@ -125,14 +134,14 @@ class World:
     # -- disk --------------------------------------------------------------
     def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
               preview: bool = True) -> Path:
-        """Write ``out_dir/<world_id>/`` (the world's files and world.json); return that folder.
+        """Write ``out_dir/<folder_name>/`` (the world's files and world.json); return that folder.
 
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
         ``preview`` adds preview.png, a top-down picture (worldgen.preview).
         """
         blobs = self.folder_blobs(formats, sdf_version, preview)
-        target = write_folder_atomically(Path(out_dir), self.world_id, blobs)
+        target = write_folder_atomically(Path(out_dir), self.folder_name, blobs)
         self.path = target
         return target
 
