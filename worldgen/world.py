@@ -72,7 +72,11 @@ class World:
         if version not in SDF_VERSIONS:
             raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
         from worldgen.export import sdf
-        return _text(sdf.to_sdf(self.scene, version=version, name=self.world_id))
+        scene = self.scene
+        if scene.movers and not self.params.get("sdf_actors", True):
+            # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.
+            scene = scene.with_movers(())
+        return _text(sdf.to_sdf(scene, version=version, name=self.world_id))
 
     def to_mjcf(self) -> str:
         """The world as MJCF, loadable with ``mujoco.MjModel.from_xml_string``."""
