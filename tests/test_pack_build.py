@@ -18,6 +18,7 @@ import pytest
 
 import worldgen
 from worldgen.cli import main
+from worldgen.pack.manifest import world_folder
 from worldgen.pack import Pack, build_pack, parse_recipe, verify_pack, write_archive
 
 RECIPE = """\
@@ -59,15 +60,18 @@ def test_build_writes_manifest_index_and_every_world(built, capsys):
     manifest = json.loads((pack / "manifest.json").read_text())
     assert manifest["world_count"] == 14 and len(manifest["worlds"]) == 14 and manifest["rejected"] == []
     assert manifest["worldgen_version"] == worldgen.__version__ and manifest["recipe"]["name"] == "tiny"
-    assert world_folders(pack) == sorted(w["world_id"] for w in manifest["worlds"])
+    # A preset entry's folder is <preset>--<world_id>, every other <world_id>.
+    assert world_folders(pack) == sorted(f"{w['preset']}--{w['world_id']}" if "preset" in w else w["world_id"]
+                                         for w in manifest["worlds"])
     for w in manifest["worlds"]:
+        folder = world_folder(w)
         listed = {rel for rel in w["files"]}
-        on_disk = {f"worlds/{w['world_id']}/{p.name}" for p in (pack / "worlds" / w["world_id"]).iterdir()}
+        on_disk = {f"{folder}/{p.name}" for p in (pack / folder).iterdir()}
         assert listed == on_disk  # preview.png is off in packs by default, so nothing unlisted
         for rel, digest in w["files"].items():
             assert hashlib.sha256((pack / rel).read_bytes()).hexdigest() == digest
-        meta = json.loads((pack / "worlds" / w["world_id"] / "world.json").read_text())
-        assert meta["params"] == w["params"] and meta["seed"] == w["seed"]
+        meta = json.loads((pack / folder / "world.json").read_text())
+        assert meta["params"] == w["params"] and meta["seed"] == w["seed"] and meta.get("preset") == w.get("preset")
         assert w["metrics"]["narrowest_passage"] == meta["metrics"]["narrowest_passage"]
     rows = (pack / "index.csv").read_text().splitlines()
     assert len(rows) == 15 and rows[0].startswith("index,world_id,generator,seed,folder,obstacle_count")
@@ -126,7 +130,7 @@ def test_a_build_killed_with_sigkill_finishes_on_rerun_without_redoing_or_duplic
     assert (pack / "manifest.json").read_bytes() == (expected / "manifest.json").read_bytes()
     assert world_folders(pack) == world_folders(expected)  # nothing twice, nothing missing
     assert not [p for p in (pack / "worlds").iterdir() if p.name.startswith(".")]  # leftovers removed
-    recorded = {json.loads(p.read_text()).get("world_id") for p in (pack / ".build").glob("*.json") if p.stem in done}
+    recorded = {json.loads(p.read_text()).get("folder") for p in (pack / ".build").glob("*.json") if p.stem in done}
     for name, stamp in stamps.items():  # finished worlds were not written again
         if name in recorded:
             assert (pack / "worlds" / name / "world.json").stat().st_mtime_ns == stamp

@@ -334,3 +334,55 @@ def test_cli_allow_infeasible_writes_the_too_narrow_corridor(tmp_path):
     meta = json.loads((folder / "world.json").read_text())
     assert meta["feasibility"]["feasible"] is False
     assert "spawn_free" in {c["name"] for c in meta["feasibility"]["checks"] if not c["ok"]}
+
+
+# -- a preset's world says so: world.json `preset`, folder <preset>--<world_id> ---------------
+
+def test_a_preset_world_records_its_preset_and_names_its_folder(tmp_path):
+    from worldgen.export.metadata import validate
+    from worldgen.verify import check_folder
+
+    world = worldgen.generate_preset("room_5_obstacles", seed=2)
+    plain = worldgen.generate(world.generator, 2, **world.params)
+    assert world.preset == "room_5_obstacles" and plain.preset is None
+    # The id is the scene's, however it was asked for; only the folder and world.json name the preset.
+    assert world.world_id == plain.world_id and world.world_id.startswith("cluttered-s2-")
+    assert world.metadata["preset"] == "room_5_obstacles" and "preset" not in plain.metadata
+    validate(world.metadata)
+    folder = world.write(tmp_path, preview=False)
+    assert folder.name == f"room_5_obstacles--{world.world_id}"
+    assert json.loads((folder / "world.json").read_text())["preset"] == "room_5_obstacles"
+    assert check_folder(folder).ok, check_folder(folder)  # regenerates byte for byte, preset included
+    assert plain.write(tmp_path, preview=False).name == plain.world_id
+
+
+def test_cli_names_preset_folders_apart(tmp_path):
+    for name in ("empty_room", "room_5_obstacles", "drl_arena"):
+        result = run("generate", "--preset", name, "--seed", "1", "--out", tmp_path, "--formats", "mjcf")
+        assert result.returncode == 0, result.stderr
+    names = sorted(p.name for p in world_dirs(tmp_path))
+    assert [n.split("--")[0] for n in names] == ["drl_arena", "empty_room", "room_5_obstacles"]
+    for n in names:
+        meta = json.loads((tmp_path / n / "world.json").read_text())
+        assert n == f"{meta['preset']}--{meta['world_id']}" and meta["generator"] == "cluttered"
+
+
+def test_pack_folders_of_preset_entries(tmp_path):
+    from worldgen.pack.build import build_pack
+    from worldgen.pack.recipe import parse_recipe
+
+    recipe = parse_recipe("formats: [mjcf]\nseeds: 2\nworlds:\n  - preset: empty_room\n    seeds: 1\n"
+                          "  - preset: drl_arena\n  - generator: cluttered\n    params: {n_obstacles: 3}\n", "r.yaml")
+    build_pack(recipe, tmp_path / "pack")
+    pack = worldgen.Pack.open(tmp_path / "pack")
+    folders = [w.folder for w in pack]
+    assert [f.split("/")[1].split("--")[0] for f in folders[:3]] == ["empty_room", "drl_arena", "drl_arena"]
+    assert folders[3] == f"worlds/{pack[3].world_id}"
+    for w in pack:
+        meta = json.loads(w.read("world.json"))
+        assert w.folder == "worlds/" + (f"{meta['preset']}--" if "preset" in meta else "") + w.world_id
+        assert w.path.is_dir()
+    index = (tmp_path / "pack" / "index.csv").read_text().splitlines()
+    assert [line.split(",")[4] for line in index[1:]] == folders
+    verified = run("pack", "verify", tmp_path / "pack")
+    assert verified.returncode == 0, verified.stdout + verified.stderr

@@ -90,7 +90,7 @@ def list_command(as_json: bool) -> None:
 @click.option("--set", "settings", multiple=True, metavar="KEY=VALUE",
               help="Set a generator parameter (repeatable), e.g. --set size=20,20 --set n_obstacles=50.")
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
-              help="Folder to write DIR/<world_id>/ into (created if missing).")
+              help="Folder to write DIR/<world_id>/ (DIR/<preset>--<world_id>/ with --preset) into (created if missing).")
 @click.option("--formats", default=",".join(FORMATS), show_default=True,
               help=f"Comma-separated subset of {', '.join(FORMATS)}; world.json is always written.")
 @click.option("--sdf-version", type=click.Choice(SDF_VERSIONS), default=SDF_VERSIONS[0], show_default=True,
@@ -111,6 +111,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     task and how many draws it took. Each folder appears complete or not at all.
     """
     base: dict[str, Any] = {}
+    preset = None
     if preset_name is not None:
         if generator is not None:
             raise ParameterError(f"give either GENERATOR or --preset, not both (got '{generator}' and '{preset_name}')")
@@ -133,6 +134,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     _check_out(out)
     for s in range(seed, seed + count):
         world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, **params)
+        world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
         folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
         failed = ",".join(c.name for c in world.feasibility.failed())

@@ -208,6 +208,8 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("mover_height", "float", 1.7, "height of each mover's cylinder", 0.1, 5.0, unit="m"),
     Param("mover_speed", "float", 1.0, "walking speed of every mover", 0.05, 10.0, unit="m/s"),
     Param("mover_waypoints", "int", 4, "distinct waypoints of each mover's loop", 2, 32),
+    Param("sdf_actors", "bool", True, "write movers into the SDF as <actor>s; false leaves them out of the SDF only "
+          "(for SDF readers that reject actors, e.g. Drake): they stay in the MJCF and world.json"),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
     # Ground truth written with every world (worldgen.groundtruth).
     Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn", 0.001, 50.0, unit="m"),

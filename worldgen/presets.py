@@ -122,9 +122,12 @@ def generate_preset(name: str, seed: int = 0, *, allow_infeasible: bool = False,
 
     The returned World records the underlying generator and every resolved
     parameter, so ``worldgen.generate(world.generator, seed, **world.params)``
-    rebuilds it without the preset.
+    rebuilds it without the preset; ``world.preset`` (world.json ``preset``, and
+    the folder name ``<preset>--<world_id>``) says where it came from.
     """
     from worldgen.api import generate
 
     preset = load(name)
-    return generate(preset.generator, seed, allow_infeasible=allow_infeasible, **preset.merged(overrides))
+    world = generate(preset.generator, seed, allow_infeasible=allow_infeasible, **preset.merged(overrides))
+    world.preset = preset.name
+    return world

@@ -149,6 +149,7 @@ def _regenerate(meta: dict):
                                   allow_infeasible=meta["feasibility"]["allow_infeasible"], **meta["params"])
     except WorldgenError as exc:
         raise _Fail("regenerate", f"{meta['generator']} seed {meta['seed']} with the recorded params: {exc}") from None
+    world.preset = meta.get("preset")  # not a parameter: where the world came from (world.json and folder name)
     if world.content_hash != meta["content_hash"]:
         raise _Fail("regenerate", f"content_hash {_h(world.content_hash)} regenerated, "
                                   f"{_h(meta['content_hash'])} recorded{_versions(meta)}")

@@ -30,6 +30,8 @@ class World:
     ``generate(generator, seed, **params)`` rebuilds exactly this world.
     ``attempts`` is how many draws it took (1 = the first draw passed).
     ``allow_infeasible`` records how it was asked for, so that it regenerates the same way.
+    ``preset`` names the preset it came from (None otherwise): recorded in
+    world.json and in the folder's name, never in ``world_id``.
     """
 
     def __init__(self, generator: str, seed: int, params: Mapping[str, Any], scene: Scene,
@@ -44,6 +46,7 @@ class World:
         self.attempts = attempts
         self.allow_infeasible = bool(allow_infeasible)
         self.path: Optional[Path] = None  # the folder once written
+        self.preset: Optional[str] = None
 
     def __repr__(self) -> str:
         try:
@@ -58,8 +61,11 @@ class World:
         The scene's canonical description (geometry, joints, movers, physics),
         plus the generator, seed, every resolved parameter (which fix the robot,
         the tasks, the sensors and the map) and whether it was asked for with
-        ``allow_infeasible``. Not the worldgen version, nor the
-        formats chosen: those change how a world is written, not which world it is.
+        ``allow_infeasible``. Not the preset's name: a preset's world is the
+        generator's world with those parameters, written to its own folder
+        (``folder_name``) so that the two never replace each other. Not the
+        worldgen version, nor the formats chosen: those change how a world is
+        written, not which world it is.
         """
         identity = {
             "scene": self.scene.content_hash(),
@@ -67,7 +73,6 @@ class World:
             "seed": self.seed,
             "params": self.params,
             "allow_infeasible": self.allow_infeasible,
-            "preset": getattr(self, "preset", None),
         }
         text = json.dumps(identity, sort_keys=True, separators=(",", ":"))
         return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
@@ -77,13 +82,23 @@ class World:
         """``<generator>-s<seed>-<8 hex of content_hash>``: stable and filesystem-safe."""
         return f"{self.generator}-s{self.seed}-{self.content_hash.split(':', 1)[1][:8]}"
 
+    @property
+    def folder_name(self) -> str:
+        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, else ``world_id``,
+        so worlds of several presets over one generator can be told apart in one folder."""
+        return f"{self.preset}--{self.world_id}" if self.preset else self.world_id
+
     # -- in-memory exports -------------------------------------------------
     def to_sdf(self, version: str = "1.9") -> str:
         """The world as SDFormat ``version`` (1.9 for Gazebo Fortress-Harmonic, 1.6 for classic)."""
         if version not in SDF_VERSIONS:
             raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
         from worldgen.export import sdf
-        return _text(sdf.to_sdf(self.scene, version=version, name=self.world_id))
+        scene = self.scene
+        if scene.movers and not self.params.get("sdf_actors", True):
+            # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.
+            scene = scene.with_movers(())
+        return _text(sdf.to_sdf(scene, version=version, name=self.world_id))
 
     def to_mjcf(self) -> str:
         """The world as MJCF, loadable with ``mujoco.MjModel.from_xml_string``."""
@@ -158,7 +173,7 @@ class World:
     # -- disk --------------------------------------------------------------
     def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
               preview: bool = True, overwrite: bool = False) -> Path:
-        """Write ``out_dir/<world_id>/`` (the world's files and world.json); return that folder.
+        """Write ``out_dir/<folder_name>/`` (the world's files and world.json); return that folder.
 
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
@@ -169,9 +184,9 @@ class World:
         """
         out_dir = Path(out_dir)
         if not overwrite:
-            refuse_other_world(out_dir / self.world_id, self.content_hash)
+            refuse_other_world(out_dir / self.folder_name, self.content_hash)
         blobs = self.folder_blobs(formats, sdf_version, preview)
-        target = write_folder_atomically(out_dir, self.world_id, blobs)
+        target = write_folder_atomically(out_dir, self.folder_name, blobs)
         self.path = target
         return target
 

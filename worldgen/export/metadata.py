@@ -94,6 +94,8 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "occupancy": truth.occupancy_block(world),
         "files": {key: {"path": path, "sha256": digest} for key, (path, digest) in sorted(files.items())},
     }
+    if world.preset:
+        meta["preset"] = world.preset
     return _plain(meta)
 
 

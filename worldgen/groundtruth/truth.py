@@ -9,11 +9,12 @@ from __future__ import annotations
 
 import weakref
 
+from worldgen.doors import open_scene
 from worldgen.groundtruth import lidar, metrics, occupancy
 from worldgen.params import COMMON_PARAMS
 from worldgen.scene import Pose
 
-__all__ = ["lidar_spec", "sensors", "occupancy_map", "occupancy_block", "map_files", "difficulty", "MAP_KEYS"]
+__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "MAP_KEYS"]
 
 #: world.json ``files`` keys of the map's two files.
 MAP_KEYS = ("map_pgm", "map_yaml")
@@ -44,9 +45,19 @@ def sensors(world) -> dict:
     return {"lidar": lidar.describe(world.scene, lidar_spec(world))}
 
 
+def planning_scene(world):
+    """The scene the reference paths were planned in: every door leaf at its open limit.
+
+    The map and the difficulty metrics describe this scene, so that BARN's
+    grid metrics computed on map.pgm along the path agree with world.json's;
+    the lidar describes the scene as it starts (what the sensor sees at the spawn).
+    """
+    return open_scene(world.scene)
+
+
 def occupancy_map(world) -> occupancy.OccupancyMap:
     if world not in _MAPS:
-        _MAPS[world] = occupancy.build(world.scene, float(_param(world, "map_height")),
+        _MAPS[world] = occupancy.build(planning_scene(world), float(_param(world, "map_height")),
                                        float(_param(world, "map_resolution")))
     return _MAPS[world]
 
@@ -65,4 +76,4 @@ def map_files(world) -> dict[str, tuple[str, bytes]]:
 
 def difficulty(world) -> dict:
     """The five BARN-style figures of world.json's ``metrics``."""
-    return metrics.difficulty(world.scene, world.robot, world.tasks, world.feasibility.paths)
+    return metrics.difficulty(planning_scene(world), world.robot, world.tasks, world.feasibility.paths)

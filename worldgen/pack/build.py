@@ -76,10 +76,13 @@ def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict
     except InfeasibleError as exc:
         rec.update(params=params, reason=str(exc), failures=dict(sorted(exc.failures.items())))
         return rec, {}
+    world.preset = job.preset
+    if job.preset:
+        rec["preset"] = job.preset
     blobs = world.folder_blobs(formats, sdf_version, preview)
     meta = json.loads(blobs["world.json"])
-    folder = f"{WORLDS_DIR}/{world.world_id}"
-    rec.update(world_id=world.world_id, params=meta["params"], metrics=key_metrics(meta),
+    folder = f"{WORLDS_DIR}/{world.folder_name}"
+    rec.update(world_id=world.world_id, folder=world.folder_name, params=meta["params"], metrics=key_metrics(meta),
                attempts=world.attempts,
                files={f"{folder}/{rel}": hashlib.sha256(data).hexdigest() for rel, data in sorted(blobs.items())})
     return rec, blobs
@@ -91,7 +94,7 @@ def build_job(job: Job, worlds_dir: str, formats, sdf_version: str, preview: boo
 
     rec, blobs = render_job(job, formats, sdf_version, preview)
     if blobs:
-        write_folder_atomically(Path(worlds_dir), rec["world_id"], blobs)
+        write_folder_atomically(Path(worlds_dir), rec["folder"], blobs)
     return rec
 
 
@@ -146,7 +149,7 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
 
         for rec, blobs in run_on_dask(todo, scheduler, args[1:], version or worldgen.__version__):
             if blobs:  # the folder is written here, so workers need no access to the pack's disk
-                write_folder_atomically(worlds_dir, rec["world_id"], blobs)
+                write_folder_atomically(worlds_dir, rec["folder"], blobs)
             finished(rec)
     elif jobs == 1 or len(todo) <= 1:
         for job in todo:
@@ -184,7 +187,7 @@ def _load_records(state: Path, recipe: Recipe) -> dict[str, dict]:
         except (OSError, ValueError):
             continue  # cannot happen with atomic writes; rebuilt if it does
         rec["job"] = wanted[key].index  # the index in this recipe
-        if rec.get("world_id") and not (state.parent / WORLDS_DIR / rec["world_id"]).is_dir():
+        if rec.get("world_id") and not (state.parent / WORLDS_DIR / rec.get("folder", rec["world_id"])).is_dir():
             continue
         out[key] = rec
     return out

@@ -35,7 +35,8 @@ def build_manifest(recipe, records: Iterable[Mapping[str, Any]], version: str) -
     worlds, rejected = [], []
     for rec in sorted(records, key=lambda r: r["job"]):
         if rec.get("world_id"):
-            worlds.append({k: rec[k] for k in ("world_id", "generator", "seed", "params", "metrics", "files", "job")})
+            worlds.append({k: rec[k] for k in ("world_id", "preset", "generator", "seed", "params", "metrics", "files", "job")
+                           if k in rec})
         else:
             rejected.append({k: rec[k] for k in ("job", "generator", "seed", "params", "reason")})
     return {
@@ -56,6 +57,15 @@ def manifest_bytes(manifest: Mapping[str, Any]) -> bytes:
     return (json.dumps(manifest, indent=1, sort_keys=True, ensure_ascii=True, allow_nan=False) + "\n").encode()
 
 
+def world_folder(world: Mapping[str, Any]) -> str:
+    """A manifest world's folder, relative to the pack: where its world.json is listed
+    (``worlds/<preset>--<world_id>`` for a preset's world, else ``worlds/<world_id>``)."""
+    for rel in world["files"]:
+        if rel.endswith("/world.json") and rel.count("/") == 2:
+            return rel[: -len("/world.json")]
+    return f"{WORLDS_DIR}/{world['world_id']}"
+
+
 def index_bytes(manifest: Mapping[str, Any]) -> bytes:
     """index.csv: one row per world, its id, generator, seed, folder and key metrics."""
     buf = io.StringIO()
@@ -63,7 +73,7 @@ def index_bytes(manifest: Mapping[str, Any]) -> bytes:
     w.writerow(["index", "world_id", "generator", "seed", "folder", *METRICS])
     for i, world in enumerate(manifest["worlds"]):
         m = world["metrics"]
-        w.writerow([i, world["world_id"], world["generator"], world["seed"], f"{WORLDS_DIR}/{world['world_id']}",
+        w.writerow([i, world["world_id"], world["generator"], world["seed"], world_folder(world),
                     *("" if m.get(k) is None else repr(m[k]) for k in METRICS)])
     return buf.getvalue().encode()
 

@@ -16,7 +16,7 @@ from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from worldgen.errors import ParameterError
 from worldgen.pack.archive import ArchiveReader, is_archive
-from worldgen.pack.manifest import MANIFEST_NAME, METRICS, SCHEMA_ID, WORLDS_DIR
+from worldgen.pack.manifest import MANIFEST_NAME, METRICS, SCHEMA_ID, world_folder
 from worldgen.pack.where import parse_where
 
 __all__ = ["Pack", "PackWorld", "open_source"]
@@ -77,7 +77,7 @@ class PackWorld:
 
     @property
     def folder(self) -> str:
-        return f"{WORLDS_DIR}/{self.world_id}"
+        return world_folder({"world_id": self.world_id, "files": self.files})
 
     @property
     def path(self) -> Optional[Path]:

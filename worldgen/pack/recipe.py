@@ -32,7 +32,7 @@ import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Optional
 
 import numpy as np
 import yaml
@@ -66,6 +66,7 @@ class Job:
     generator: str
     seed: int
     params: tuple  # sorted (name, value) pairs: hashable and order-free
+    preset: Optional[str] = None  # the entry's preset: world.json's `preset` and the folder's name
 
     @property
     def param_dict(self) -> dict[str, Any]:
@@ -73,7 +74,8 @@ class Job:
 
     @property
     def key(self) -> str:
-        text = json.dumps([self.generator, self.seed, self.params], sort_keys=True, separators=(",", ":"))
+        what = [self.generator, self.seed, self.params] + ([self.preset] if self.preset else [])
+        text = json.dumps(what, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
 
@@ -141,8 +143,9 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
         r.fail(worlds, "worlds", "must be a non-empty list of entries (each with 'generator' or 'preset')")
     jobs: list[Job] = []
     for e, node in enumerate(worlds.value):
+        preset = next((Path(str(r.value(v))).stem for k, v in node.value if k.value == "preset"), None)
         for generator, seed, params in r.entry(node, e, default_seeds):
-            jobs.append(Job(len(jobs), e, generator, seed, params))
+            jobs.append(Job(len(jobs), e, generator, seed, params, preset))
             if len(jobs) > MAX_WORLDS:
                 r.fail(worlds, "worlds", f"describes more than {MAX_WORLDS} worlds")
     return Recipe(name, tuple(formats), sdf_version, preview, tuple(jobs), r.value(root))
