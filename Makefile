@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 DEMO_OUT ?= demo-worlds
 
-.PHONY: demo test bench clean
+.PHONY: demo test bench fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -29,6 +29,10 @@ test: $(TEST_STAMP)
 ## bench: per-stage medians for cluttered worlds; table on stdout, JSON in benchmarks/results/
 bench: $(STAMP)
 	$(PY) benchmarks/bench_pipeline.py
+
+## fuzz: the long fuzz sweep over every generator's full parameter ranges (a table; reproducers of defects)
+fuzz: $(TEST_STAMP)
+	$(PY) benchmarks/fuzz_sweep.py
 
 clean:
 	rm -rf $(VENV) $(DEMO_OUT) tests/.cache .pytest_cache .hypothesis

@@ -170,3 +170,14 @@ def test_export_option_mistakes(world, tmp_path):
     blocker.write_text("x")
     with pytest.raises(OutputError, match="cannot write to output folder"):
         world.write(blocker / "worlds")
+
+
+def test_a_map_too_fine_for_the_floor_is_refused_before_any_planning(monkeypatch):
+    from worldgen import feasibility
+
+    def no_planning(*args, **kwargs):
+        raise AssertionError("feasibility ran before the map's size was checked")
+
+    monkeypatch.setattr(feasibility, "check", no_planning)
+    with pytest.raises(worldgen.ParameterError, match=r"parameter 'map_resolution' must be at least 0\.1000 m"):
+        worldgen.generate("cluttered", size=[500, 500], n_obstacles=0)

@@ -336,3 +336,70 @@ def test_bad_parameters_get_one_line_errors(params, message):
     text = str(err.value)
     assert "\n" not in text
     assert text.startswith(message), text
+
+
+def leaf_contacts_at(model, data, angle_of) -> list[tuple[str, str]]:
+    """(leaf, wall or frame) geom names in contact with every hinge at ``angle_of(joint)``, after mj_forward."""
+    for j in range(model.njnt):
+        data.qpos[model.jnt_qposadr[j]] = angle_of(j)
+    mujoco.mj_forward(model, data)
+    out = []
+    for c in data.contact[: data.ncon]:
+        names = sorted((model.geom(c.geom1).name, model.geom(c.geom2).name))
+        leaves = [n for n in names if n.startswith("door_") and n.count("_") == 1]
+        # Leaf against wall or frame; two leaves opening into one room may meet (not a wall: left to the doors).
+        if c.dist <= 0 and len(leaves) == 1:
+            out.append(tuple(names))
+    return out
+
+
+@settings(max_examples=60, suppress_health_check=[HealthCheck.too_slow], deadline=None)
+@given(
+    seed=st.integers(0, 10_000),
+    hi=st.floats(0.2, 3.0),
+    leaf_thickness=st.sampled_from([0.02, 0.04, 0.3, 1.0]),
+    door_width=st.floats(0.4, 2.0),
+    n_doors=st.integers(1, 3),
+    hinge_side=st.sampled_from(["left", "right", "random"]),
+    swing=st.sampled_from(["push", "pull", "random"]),
+    sy=st.floats(2.2, 6.0),
+)
+def test_every_leaf_at_both_limits_touches_no_wall_or_frame(seed, hi, leaf_thickness, door_width, n_doors,
+                                                            hinge_side, swing, sy):
+    """MuJoCo's own collision detection, every hinge at its lower and at its upper limit."""
+    try:
+        world = worldgen.generate("door", seed=seed, state="open", limits=[0.0, round(hi, 3)], size=[5.0 * n_doors, sy],
+                                  n_doors=n_doors, leaf_thickness=leaf_thickness, door_width=round(door_width, 3),
+                                  hinge_side=hinge_side, swing=swing, max_attempts=3)
+    except (ParameterError, InfeasibleError):
+        return
+    model = mujoco.MjModel.from_xml_string(world.to_mjcf())
+    data = mujoco.MjData(model)
+    for end in (0, 1):
+        touching = leaf_contacts_at(model, data, lambda j: model.jnt_range[j][end])
+        assert not touching, f"limit {end}: {touching}"
+    for door in world.metadata["doors"]:
+        assert door["limits"][1] <= round(hi, 3) + 1e-9
+
+
+def test_limits_past_the_room_stop_at_the_wall_issue_reproducer():
+    # limits 0..3.0 rad with the doorway near the outer wall: the leaf used to start 0.12 m inside it.
+    world = worldgen.generate("door", seed=0, state="open", limits=[0.0, 3.0])
+    (door,) = world.metadata["doors"]
+    assert 1.5708 < door["limits"][1] < 3.0 and door["angle"] == door["limits"][1]
+    model = mujoco.MjModel.from_xml_string(world.to_mjcf())
+    assert not leaf_contacts_at(model, mujoco.MjData(model), lambda j: model.jnt_range[j][1])
+    # The stop is tight: a little further and the leaf is in the wall.
+    assert leaf_contacts_at(model, mujoco.MjData(model), lambda j: model.jnt_range[j][1] + 0.05)
+
+
+def test_swing_stop_exact_references():
+    from worldgen.generators.door import LEAF_GAP, swing_stop
+
+    # Room enough beside and ahead: the leaf may open until it lies on the wall face.
+    assert swing_stop(0.88, 0.04, beside=5.0, ahead=5.0) == math.floor(math.pi * 1e6) / 1e6
+    # Only 0.44 m + gap of wall beside the hinge: -0.88 cos a = 0.44 -> a = 2 pi / 3.
+    assert swing_stop(0.88, 0.0, beside=0.44 + LEAF_GAP, ahead=5.0) == pytest.approx(2 * math.pi / 3, abs=1e-6)
+    # A room just as long as the leaf ahead, thick leaf: stops where the far corner meets the wall.
+    a = swing_stop(0.88, 0.3, beside=5.0, ahead=0.88 + LEAF_GAP)
+    assert 0.88 * math.sin(a) - 0.3 * math.cos(a) == pytest.approx(0.88, abs=1e-5)

@@ -163,7 +163,7 @@ def test_hand_world_validates_and_says_what_the_scene_says():
                                                  "detail": "inside_bounds detail"}
     assert meta["files"] == {"sdf": {"path": "world.sdf", "sha256": "a" * 64},
                              "mesh:meshes/tetra.stl": {"path": "meshes/tetra.stl", "sha256": "b" * 64}}
-    assert meta["content_hash"] == scene.content_hash() and meta["world_id"] == world.world_id
+    assert meta["content_hash"] == world.content_hash and meta["world_id"] == world.world_id
     assert meta["worldgen_version"] == worldgen.__version__
     assert meta["params"] == world.params  # every parameter, resolved
 

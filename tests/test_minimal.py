@@ -76,7 +76,8 @@ def test_a_cylinder_counts_to_its_surface_and_a_box_to_its_face():
 def test_no_random_draws_the_seed_only_names_the_world():
     a = worldgen.generate("minimal", seed=0, target="box")
     b = worldgen.generate("minimal", seed=99, target="box")
-    assert a.content_hash == b.content_hash and a.to_sdf() != b.to_sdf()  # the world's name carries the seed
+    assert a.scene.content_hash() == b.scene.content_hash() and a.to_sdf() != b.to_sdf()  # the name carries the seed
+    assert a.content_hash != b.content_hash  # world.json records the seed
     assert a.world_id != b.world_id
 
 

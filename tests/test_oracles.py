@@ -109,6 +109,20 @@ def test_min_separation_standing_on_a_mover():
     assert oracles.min_separation(far, world) > 90
 
 
+def test_driving_through_a_mover_is_a_collision():
+    world = worldgen.generate("cluttered", seed=2, size=[8, 8], n_obstacles=3, n_movers=1)
+    mover = world.metadata["dynamic_obstacles"][0]
+    t0, x0, y0 = mover["trajectory"][0]
+    stand = [[t0, x0, y0], [t0 + 1e-3, x0, y0]]
+    assert oracles.collisions(stand, world) == [oracles.Contact(t0, mover["name"])]
+    report = evaluate([(stand, world)], {"safety": {"collision_tolerance": 0}})
+    assert not report.passed and report.summary["collision_count"] == 1
+    # Just out of reach of the mover's disc at that instant: no contact.
+    r = mover["radius"] + world.robot.radius
+    beside = [[t0, x0 + r + 1e-3, y0], [t0, x0 + r + 1e-3, y0]]
+    assert [c.entity for c in oracles.collisions(beside, world)] == []
+
+
 CRITERIA = """
 navigation: {success_rate: 0.5, path_efficiency: 1.1}
 safety: {obstacle_clearance: 0.05, collision_tolerance: 0, max_velocity: 1.0, min_obstacle_distance: 0.3}

@@ -13,6 +13,7 @@ import tarfile
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import worldgen
@@ -197,7 +198,7 @@ def test_archive_is_deterministic_safe_and_readable_by_open_and_verify(built, tm
     assert first[4:8] == b"\0\0\0\0"  # gzip mtime 0
     opened = Pack.open(tmp_path / "a.tar.gz")
     assert opened.archive and opened.ids() == Pack.open(pack).ids()
-    assert opened[0].metadata() == json.loads((pack / opened[0].folder / "world.json").read_text())
+    assert opened[0].metadata == json.loads((pack / opened[0].folder / "world.json").read_text())
     assert cli("pack", "verify", tmp_path / "a.tar.gz") == 0
     assert all(ok for ok, _ in verify_pack(tmp_path / "a.tar.gz", regenerate=True))
 
@@ -236,7 +237,7 @@ def test_pack_open_api(built):
     first = p[0]
     assert p[first.world_id] is first and first.world_id in p and p[-1].generator == "corridor"
     assert first.path == pack / "worlds" / first.world_id and first.read("world.sdf").startswith(b"<?xml")
-    assert first.metadata()["world_id"] == first.world_id
+    assert first.metadata["world_id"] == first.world_id
     hard = p.filter("narrowest_passage < 1.0")
     assert all(w.metrics["narrowest_passage"] < 1.0 for w in hard) and len(hard) < len(p)
     assert len(p.filter(lambda m: m["obstacle_count"] == 5)) == 6
@@ -276,3 +277,90 @@ def test_progress_line_has_count_rate_and_eta_and_is_quiet_off_a_terminal(tmp_pa
     assert cli("pack", "build", tmp_path / "m.yaml", "--out", tmp_path / "b") == 0
     captured = capsys.readouterr()
     assert captured.err == "" and "worlds built: 3" in captured.out  # stderr is not a terminal here
+
+
+@pytest.mark.parametrize("kind", ["folder", "archive"])
+def test_oracles_take_pack_worlds_in_a_folder_and_in_an_archive(built, tmp_path, kind):
+    from worldgen import oracles
+
+    _, _, pack = built
+    source = pack if kind == "folder" else write_archive(pack, tmp_path / "one.tar.gz")
+    opened = worldgen.Pack.open(source)
+    assert (opened[0].path is None) == (kind == "archive")
+    for w in list(opened)[:4]:
+        task = w.metadata["tasks"][0]
+        xy = np.asarray(task["path"]["waypoints"], dtype=float)
+        drive = np.column_stack([np.linspace(0.0, 10.0, len(xy)), xy])
+        regenerated = worldgen.generate(w.generator, w.seed, **w.params)
+        assert oracles.collisions(drive, w) == oracles.collisions(drive, regenerated) == []
+        assert oracles.path_efficiency(drive, w) == pytest.approx(1.0, abs=1e-5)
+        assert oracles.min_clearance(drive, w) == pytest.approx(oracles.min_clearance(drive, regenerated), abs=1e-6)
+        assert oracles.reached_goal(drive, w)
+        # A drive straight through the first obstacle is a collision here as in the regenerated world.
+        obstacle = next((e for e in w.metadata["entities"] if e["role"] == "obstacle"), None)
+        if obstacle is not None:
+            x, y = obstacle["pose"][:2]
+            through = np.array([[0.0, x - 1.0, y], [1.0, x + 1.0, y]])
+            assert [c.entity for c in oracles.collisions(through, w)] == \
+                [c.entity for c in oracles.collisions(through, regenerated)] != []
+    opened.close()
+
+
+def test_rebuild_after_the_recipe_changed_leaves_only_the_new_worlds(built, tmp_path, capsys):
+    _, recipe, reference = built
+    pack = tmp_path / "pack"
+    assert cli("pack", "build", recipe, "--out", pack) == 0
+    changed = tmp_path / "tiny.yaml"
+    changed.write_text(RECIPE.replace("seeds: 3", "seeds: 1"))
+    capsys.readouterr()
+    assert cli("pack", "build", changed, "--out", pack) == 0
+    before = len(json.loads((reference / "manifest.json").read_text())["worlds"])
+    manifest = json.loads((pack / "manifest.json").read_text())
+    removed = before - len(manifest["worlds"])
+    assert removed > 0
+    assert f"removed {removed} world folder(s) an earlier recipe left in the pack" in capsys.readouterr().out
+    assert world_folders(pack) == sorted(w["world_id"] for w in manifest["worlds"])
+    assert len(list((pack / ".build").glob("*.json"))) == len(manifest["worlds"])
+    assert all(ok for ok, _ in verify_pack(pack))
+    # A folder that is not in the manifest is a verify failure, and no archive carries it.
+    kept = {w["world_id"] for w in manifest["worlds"]}
+    stale = next(p for p in (reference / "worlds").iterdir() if p.name not in kept)
+    import shutil
+
+    shutil.copytree(stale, pack / "worlds" / stale.name)
+    verdicts = list(verify_pack(pack))
+    assert (False, f"FAIL worlds/{stale.name}: not in the manifest (left by another build?)") in verdicts
+    with tarfile.open(write_archive(pack, tmp_path / "p.tar.gz")) as tar:
+        assert not [n for n in tar.getnames() if stale.name in n]
+
+
+def test_a_pack_whose_every_job_is_rejected_fails_and_writes_no_manifest(tmp_path, capsys):
+    recipe = tmp_path / "none.yaml"
+    recipe.write_text("name: none\nseeds: 2\nworlds:\n  - generator: cluttered\n"
+                      "    params: {size: [3, 3], n_obstacles: 40, max_attempts: 2}\n")
+    assert cli("pack", "build", recipe, "--out", tmp_path / "p") == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("error: no job of recipe 'none' made a world (2 rejected") and "\n" not in err
+    assert not (tmp_path / "p" / "manifest.json").exists()
+
+
+def test_pack_files_respect_the_umask(built, tmp_path):
+    _, recipe, _ = built
+    old = os.umask(0o022)
+    try:
+        assert cli("pack", "build", recipe, "--out", tmp_path / "p") == 0
+        archive = write_archive(tmp_path / "p", tmp_path / "p.tar.gz")
+    finally:
+        os.umask(old)
+    for path in (tmp_path / "p" / "manifest.json", tmp_path / "p" / "index.csv", archive):
+        assert path.stat().st_mode & 0o777 == 0o644, path
+    some_world = next((tmp_path / "p" / "worlds").iterdir())
+    assert some_world.stat().st_mode & 0o777 == 0o755
+    assert (some_world / "world.json").stat().st_mode & 0o777 == 0o644
+
+
+def test_scheduler_without_the_dask_executor_is_an_error(built, tmp_path, capsys):
+    _, recipe, _ = built
+    assert cli("pack", "build", recipe, "--out", tmp_path / "p", "--scheduler", "tcp://127.0.0.1:8786") == 2
+    assert "parameter 'scheduler' applies only with executor dask" in capsys.readouterr().err
+    assert not (tmp_path / "p").exists()

@@ -88,7 +88,7 @@ def test_pack_parametrisation(pytester, tmp_path):
 
         @pytest.mark.worldgen(pack={str(tmp_path / "pack")!r})
         def test_pack(world):
-            assert world.metadata()["world_id"] == world.world_id
+            assert world.metadata["world_id"] == world.world_id
     """)
     result = pytester.runpytest_subprocess("-v")
     result.stdout.fnmatch_lines(["*test_pack?cluttered-s0-*? PASSED*", "*test_pack?cluttered-s1-*? PASSED*"])

@@ -17,6 +17,7 @@ import numpy as np
 from worldgen import feasibility
 from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.generators import Draft, get, robot_from_params
+from worldgen.groundtruth import occupancy
 from worldgen.infeasible import wall_in_goals
 from worldgen.movers import mover_rng, place_movers
 from worldgen.params import validate_params
@@ -62,6 +63,7 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
     details: dict[str, str] = {}
     last = None
     budget = resolved["max_attempts"]
+    map_extent = None
     for attempt in range(budget):
         draft = spec.build(resolved, attempt_rng(seed, attempt))
         if not draft.rejected:
@@ -70,8 +72,10 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
             failures[draft.rejected] += 1
             details.setdefault(draft.rejected, draft.detail)
             continue
+        if map_extent is None:  # the map's size follows from the floor: refuse before planning on it
+            map_extent = occupancy.extent(draft.scene, resolved["map_resolution"])
         report = feasibility.check(draft.scene, draft.tasks, robot)
-        world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1)
+        world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1, allow_infeasible)
         if report.feasible or (resolved.get("infeasible") and _infeasible_on_purpose(report)):
             return world
         for failed in report.failed():

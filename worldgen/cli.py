@@ -100,8 +100,11 @@ def list_command(as_json: bool) -> None:
 @click.option("--allow-infeasible", is_flag=True,
               help="For negative tests: where no draw passes, write the last checked one; "
                    "its world.json says feasible false and which checks failed.")
+@click.option("--overwrite", is_flag=True,
+              help="Replace a folder of the same name that holds another world (without it, that is an error).")
 def generate_command(generator: Optional[str], seed: int, settings: Sequence[str], out: Path, formats: str,
-                     sdf_version: str, count: int, allow_infeasible: bool, preset_name: Optional[str] = None) -> None:
+                     sdf_version: str, count: int, allow_infeasible: bool, overwrite: bool = False,
+                     preset_name: Optional[str] = None) -> None:
     """Generate, check and write worlds of GENERATOR.
 
     Prints one line per world: its folder, the reference path length of each
@@ -132,7 +135,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     for s in range(seed, seed + count):
         world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, **params)
         world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
-        folder = world.write(out, formats=chosen, sdf_version=sdf_version)
+        folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
         failed = ",".join(c.name for c in world.feasibility.failed())
         verdict = f"\tinfeasible: {failed}" if failed else ""

@@ -12,6 +12,7 @@ __all__ = [
     "ParameterError",
     "UnknownGeneratorError",
     "InfeasibleError",
+    "SceneError",
     "OutputError",
     "quoted",
     "read_user_text",
@@ -32,6 +33,10 @@ class ParameterError(WorldgenError, ValueError):
 
 class UnknownGeneratorError(WorldgenError, LookupError):
     """No generator is registered under the requested name."""
+
+
+class SceneError(WorldgenError, ValueError):
+    """The scene asked for cannot exist: a shape of no size, a name used twice, a pose that is not finite."""
 
 
 class InfeasibleError(WorldgenError):

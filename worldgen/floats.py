@@ -8,6 +8,8 @@ negative zero.
 
 from __future__ import annotations
 
+from worldgen.errors import SceneError
+
 __all__ = ["DECIMALS", "round_float", "fmt", "fmt_seq"]
 
 #: Decimals kept in every written float: 1e-6 m is far below any simulator's tolerance.
@@ -18,7 +20,7 @@ def round_float(x: float) -> float:
     """Round ``x`` to :data:`DECIMALS`, mapping -0.0 and |x| < 5e-7 to 0.0."""
     r = round(float(x), DECIMALS)
     if r - r != 0:  # inf - inf and nan - nan are nan: the cheapest finiteness test
-        raise ValueError(f"non-finite value {x!r} cannot be written")
+        raise SceneError(f"non-finite value {x!r} cannot be written")
     return r if r != 0 else 0.0
 
 
@@ -32,7 +34,7 @@ def fmt(x: float) -> str:
     """
     text = f"{x:.{DECIMALS}f}"
     if text[-1] in "fn":  # inf, -inf, nan
-        raise ValueError(f"non-finite value {x!r} cannot be written")
+        raise SceneError(f"non-finite value {x!r} cannot be written")
     text = text.rstrip("0").rstrip(".")
     return "0" if text == "-0" else text
 

@@ -9,8 +9,9 @@ A trajectory is an (n, 3) array-like of ``t, x, y`` rows (seconds, metres), or
 about the footprint, a vertical cylinder, which looks the same at every yaw.
 Times must not decrease.
 
-A world is a :class:`~worldgen.World` or a written world folder (its world.json
-is read). Figures are for the world's first task unless ``task`` names another.
+A world is a :class:`~worldgen.World`, a world of a built pack
+(:class:`~worldgen.PackWorld`, folder or archive) or a written world folder (its
+world.json is read). Figures are for the world's first task unless ``task`` names another.
 
 Clearances and contacts are FCL distances between the footprint cylinder
 (world.json ``robot``) and every collider, measured at the recorded samples and
@@ -22,10 +23,9 @@ through a thin obstacle between two recorded samples is still caught.
 from __future__ import annotations
 
 import json
-import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -49,10 +49,10 @@ class Contact:
 class Ground:
     """What the oracles need of one world: world.json, and FCL colliders built once (on first use)."""
 
-    def __init__(self, meta: dict, scene=None, folder: Optional[Path] = None):
+    def __init__(self, meta: dict, scene=None, read: Optional[Callable[[str], bytes]] = None):
         self.meta = meta
         self._scene = scene
-        self._folder = folder
+        self._read = read  # a file of the world by its relative path (meshes), where there is no scene
         self._colliders = None
 
     @property
@@ -74,16 +74,19 @@ class Ground:
     def colliders(self):
         if self._colliders is None:
             from worldgen.feasibility.collision import Colliders
-            self._colliders = Colliders(self._scene) if self._scene is not None else _entity_colliders(self.meta, self._folder)
+            self._colliders = Colliders(self._scene) if self._scene is not None else _entity_colliders(self.meta, self._read)
         return self._colliders
 
 
 def load(world) -> Ground:
-    """A :class:`Ground` for a World, a world folder (str/Path) or a Ground (returned as is)."""
+    """A :class:`Ground` for a World, a PackWorld, a world folder (str/Path) or a Ground (returned as is)."""
     if isinstance(world, Ground):
         return world
-    if hasattr(world, "scene") and hasattr(world, "metadata"):
-        return Ground(world.metadata, scene=world.scene)
+    scene = getattr(world, "scene", None)
+    if scene is not None and hasattr(world, "metadata"):
+        return Ground(world.metadata, scene=scene)
+    if hasattr(world, "metadata") and hasattr(world, "read"):  # a PackWorld, in a folder or an archive
+        return Ground(world.metadata, read=world.read)
     if isinstance(world, (str, Path)):
         folder = Path(world)
         path = folder / "world.json" if folder.is_dir() else folder
@@ -91,8 +94,8 @@ def load(world) -> Ground:
             meta = json.loads(path.read_text())
         except (OSError, ValueError) as exc:
             raise ParameterError(f"parameter 'world' must be a World or a world folder with world.json, got {str(world)!r} ({exc})") from None
-        return Ground(meta, folder=path.parent)
-    raise ParameterError(f"parameter 'world' must be a World or a world folder, got {type(world).__name__}")
+        return Ground(meta, read=lambda rel: (path.parent / rel).read_bytes())
+    raise ParameterError(f"parameter 'world' must be a World, a PackWorld or a world folder, got {type(world).__name__}")
 
 
 def as_trajectory(trajectory) -> np.ndarray:
@@ -172,39 +175,53 @@ def min_clearance(trajectory, world) -> float:
 
 
 def collisions(trajectory, world) -> list[Contact]:
-    """Every contact of the footprint with a collider along the run, in time order.
+    """Every contact of the footprint with a collider or a mover along the run, in time order.
 
     A contact is reported once, at the first sample where it begins; the same
-    entity touched again after a gap is a second contact.
+    entity touched again after a gap is a second contact. A mover is touched
+    where its disc, at the sample's time, meets the footprint's (gap <= 0, as
+    FCL counts touching).
     """
     ground = load(world)
     pts = _samples(as_trajectory(trajectory), ground)
     col = ground.colliders
-    touching = np.zeros((len(pts), len(col)), dtype=bool)
+    movers = ground.meta.get("dynamic_obstacles") or []
+    names = list(col.names) + [str(m["name"]) for m in movers]
+    touching = np.zeros((len(pts), len(names)), dtype=bool)
     for p, c, _ in _touching(pts, ground):
         touching[p, c] = True
+    if movers:
+        touching[:, len(col):] = _mover_gaps(pts, ground) <= 0.0
     starts = touching & ~np.vstack([np.zeros((1, touching.shape[1]), dtype=bool), touching[:-1]])
-    out = [Contact(float(pts[p, 0]), col.names[c]) for p, c in zip(*np.nonzero(starts))]
+    out = [Contact(float(pts[p, 0]), names[c]) for p, c in zip(*np.nonzero(starts))]
     return sorted(out, key=lambda k: (k.time, k.entity))
+
+
+def _mover_gaps(pts: np.ndarray, ground: Ground) -> np.ndarray:
+    """(samples, movers) gap (m) between the footprint's edge and each mover's disc at each ``t, x, y`` sample."""
+    from worldgen.movers import mover_positions
+
+    radii = np.array([float(m["radius"]) for m in ground.meta["dynamic_obstacles"]])
+    gaps = np.empty((len(pts), len(radii)))
+    for i, (t, x, y) in enumerate(pts):
+        centres = mover_positions(ground.meta, float(t))
+        gaps[i] = np.hypot(centres[:, 0] - x, centres[:, 1] - y) - radii - ground.robot.radius
+    return gaps
 
 
 def _touching(pts: np.ndarray, ground: Ground):
     """(sample index, collider index, FCL penetration depth) of every touching pair."""
-    import fcl
-
     col, robot = ground.colliders, ground.robot
     if len(col) == 0:
         return
     # Only pairs whose box bound says they could touch are asked of FCL.
     candidates = col.lower_bounds(robot, pts[:, 1:]) <= 1e-9
-    body = fcl.CollisionObject(fcl.Cylinder(robot.radius, robot.height), fcl.Transform())
-    request = fcl.CollisionRequest(num_max_contacts=1, enable_contact=True)
+    body = col.body(robot)
     for p, c in zip(*np.nonzero(candidates)):
-        body.setTranslation(np.array([pts[p, 1], pts[p, 2], robot.height / 2]))
-        result = fcl.CollisionResult()
-        if fcl.collide(body, col.objects[c], request, result) > 0:
-            depth = max((k.penetration_depth for k in result.contacts), default=0.0)
-            yield int(p), int(c), float(depth)
+        col.place(body, robot, pts[p, 1], pts[p, 2])
+        d = col.distance(body, robot, int(c))
+        if d <= 0.0:  # FCL counts touching as contact
+            yield int(p), int(c), col.depth(body, int(c)) if d < 0.0 else 0.0
 
 
 def min_separation(trajectory, world) -> Optional[float]:
@@ -213,21 +230,11 @@ def min_separation(trajectory, world) -> Optional[float]:
     Movers are where world.json's ``dynamic_obstacles`` scripts have them at each
     sample time (:func:`worldgen.movers.mover_positions`); None without movers.
     """
-    from worldgen.movers import mover_positions
-
     ground = load(world)
-    movers = ground.meta.get("dynamic_obstacles") or []
-    if not movers:
+    if not ground.meta.get("dynamic_obstacles"):
         return None
-    radii = np.array([float(m["radius"]) for m in movers])
     # Movers walk at about a metre a second: sample time no coarser than the footprint spacing allows.
-    pts = _samples(as_trajectory(trajectory), ground)
-    best = math.inf
-    for t, x, y in pts:
-        centres = mover_positions(ground.meta, float(t))
-        gap = np.hypot(centres[:, 0] - x, centres[:, 1] - y) - radii - ground.robot.radius
-        best = min(best, float(gap.min()))
-    return best
+    return float(_mover_gaps(_samples(as_trajectory(trajectory), ground), ground).min())
 
 
 @dataclass(frozen=True)
@@ -275,7 +282,7 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
 
 # -- colliders from world.json (a folder has no Scene) ------------------------------
 
-def _entity_colliders(meta: dict, folder: Optional[Path]):
+def _entity_colliders(meta: dict, read: Callable[[str], bytes]):
     """The same Colliders the feasibility check uses, rebuilt from world.json's entities."""
     from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere
 
@@ -291,8 +298,10 @@ def _entity_colliders(meta: dict, folder: Optional[Path]):
         elif s["type"] == "sphere":
             shape = Sphere(s["radius"])
         else:
+            import io
+
             import trimesh
-            mesh = trimesh.load(Path(folder) / s["uri"], force="mesh")
+            mesh = trimesh.load(io.BytesIO(read(s["uri"])), file_type=Path(s["uri"]).suffix.lstrip("."), force="mesh")
             shape = Mesh(s["uri"], np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64),
                          tuple(s.get("scale", (1.0, 1.0, 1.0))))
         # world.json poses are world-frame, so every node becomes a root node here.

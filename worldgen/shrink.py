@@ -72,7 +72,7 @@ class _Search:
         # world.json params hold plain values only: the origin and the removed names as strings.
         params["shrunk_from"] = w.world_id
         params["shrunk_removed"] = ",".join(sorted(drop_nodes | drop_movers))
-        return World(w.generator, w.seed, params, scene, w.tasks, w.robot, report, w.attempts)
+        return World(w.generator, w.seed, params, scene, w.tasks, w.robot, report, w.attempts, w.allow_infeasible)
 
     def fails(self, drop_nodes: set, drop_movers: set) -> bool:
         if self.calls >= self.max_calls:

@@ -144,10 +144,9 @@ def _regenerate(meta: dict):
     import worldgen
     from worldgen.errors import WorldgenError
 
-    feasible = bool(meta["feasibility"]["feasible"])
     try:
-        world = worldgen.generate(meta["generator"], seed=meta["seed"], allow_infeasible=not feasible,
-                                  **meta["params"])
+        world = worldgen.generate(meta["generator"], seed=meta["seed"],
+                                  allow_infeasible=meta["feasibility"]["allow_infeasible"], **meta["params"])
     except WorldgenError as exc:
         raise _Fail("regenerate", f"{meta['generator']} seed {meta['seed']} with the recorded params: {exc}") from None
     world.preset = meta.get("preset")  # not a parameter: where the world came from (world.json and folder name)

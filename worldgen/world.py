@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import json
 import os
 import shutil
 import tempfile
@@ -28,12 +29,13 @@ class World:
     ``params`` holds every parameter resolved (defaults filled in), so
     ``generate(generator, seed, **params)`` rebuilds exactly this world.
     ``attempts`` is how many draws it took (1 = the first draw passed).
+    ``allow_infeasible`` records how it was asked for, so that it regenerates the same way.
     ``preset`` names the preset it came from (None otherwise): recorded in
     world.json and in the folder's name, never in ``world_id``.
     """
 
     def __init__(self, generator: str, seed: int, params: Mapping[str, Any], scene: Scene,
-                 tasks: Sequence[Task], robot: Robot, feasibility, attempts: int):
+                 tasks: Sequence[Task], robot: Robot, feasibility, attempts: int, allow_infeasible: bool = False):
         self.generator = generator
         self.seed = seed
         self.params = dict(params)
@@ -42,6 +44,7 @@ class World:
         self.robot = robot
         self.feasibility = feasibility
         self.attempts = attempts
+        self.allow_infeasible = bool(allow_infeasible)
         self.path: Optional[Path] = None  # the folder once written
         self.preset: Optional[str] = None
 
@@ -53,7 +56,26 @@ class World:
 
     @cached_property
     def content_hash(self) -> str:
-        return self.scene.content_hash()
+        """``sha256:<hex>`` of everything the written files depend on, so equal hashes mean equal worlds.
+
+        The scene's canonical description (geometry, joints, movers, physics),
+        plus the generator, seed, every resolved parameter (which fix the robot,
+        the tasks, the sensors and the map) and whether it was asked for with
+        ``allow_infeasible``. Not the preset's name: a preset's world is the
+        generator's world with those parameters, written to its own folder
+        (``folder_name``) so that the two never replace each other. Not the
+        worldgen version, nor the formats chosen: those change how a world is
+        written, not which world it is.
+        """
+        identity = {
+            "scene": self.scene.content_hash(),
+            "generator": self.generator,
+            "seed": self.seed,
+            "params": self.params,
+            "allow_infeasible": self.allow_infeasible,
+        }
+        text = json.dumps(identity, sort_keys=True, separators=(",", ":"))
+        return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
 
     @cached_property
     def world_id(self) -> str:
@@ -131,21 +153,40 @@ class World:
         """world.json of this world written in every format (SDF 1.9)."""
         return self.metadata_for(self._default_files)
 
+    def read(self, name: str) -> bytes:
+        """A file of this world by its name in the folder (``world.sdf``, ``meshes/...``, ``world.json``).
+
+        The bytes :meth:`write` would write with its defaults; preview.png is not among them.
+        """
+        if name == METADATA_NAME:
+            from worldgen.export import metadata
+            return metadata.dumps(self.metadata).encode()
+        for rel, data in self._default_files.values():
+            if rel == name:
+                return data
+        raise OutputError(f"world {self.world_id} has no file {name!r}")
+
     def to_json(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> str:
         from worldgen.export import metadata
         return metadata.dumps(self.metadata_for(self.rendered_files(formats, sdf_version)))
 
     # -- disk --------------------------------------------------------------
     def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
-              preview: bool = True) -> Path:
+              preview: bool = True, overwrite: bool = False) -> Path:
         """Write ``out_dir/<folder_name>/`` (the world's files and world.json); return that folder.
 
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
         ``preview`` adds preview.png, a top-down picture (worldgen.preview).
+        A folder of the same name that holds another world (another
+        ``content_hash``, or no readable world.json) is an :class:`OutputError`
+        unless ``overwrite``; the same world is simply written again.
         """
+        out_dir = Path(out_dir)
+        if not overwrite:
+            refuse_other_world(out_dir / self.folder_name, self.content_hash)
         blobs = self.folder_blobs(formats, sdf_version, preview)
-        target = write_folder_atomically(Path(out_dir), self.folder_name, blobs)
+        target = write_folder_atomically(out_dir, self.folder_name, blobs)
         self.path = target
         return target
 
@@ -195,6 +236,30 @@ def _safe_relative(rel: str) -> str:
     return rel
 
 
+def creation_mode(full: int) -> int:
+    """``full`` (0o666 for files, 0o777 for folders) less the process umask, as open() and mkdir() would give.
+
+    tempfile makes 0600 files and 0700 folders whatever the umask; what is renamed
+    into place must look as if it had been created there.
+    """
+    umask = os.umask(0)
+    os.umask(umask)
+    return full & ~umask
+
+
+def refuse_other_world(target: Path, content_hash: str) -> None:
+    """Raise OutputError if ``target`` exists and is not a folder of the world ``content_hash``."""
+    if not os.path.lexists(target):
+        return
+    try:
+        recorded = json.loads((target / METADATA_NAME).read_text(encoding="utf-8")).get("content_hash")
+    except (OSError, ValueError, AttributeError):
+        recorded = None
+    if recorded != content_hash:
+        what = "another world" if recorded else "something that is not a world folder"
+        raise OutputError(f"'{target}' already holds {what}; remove it or pass --overwrite to replace it")
+
+
 def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]) -> Path:
     """Write ``blobs`` (relative path -> bytes) as ``out_dir/name``; complete or absent."""
     if "/" in name or name in ("", ".", ".."):
@@ -217,7 +282,7 @@ def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]
                 fh.write(data)
                 fh.flush()
                 os.fsync(fh.fileno())
-        os.chmod(tmp, 0o755)
+        os.chmod(tmp, creation_mode(0o777))
         if target.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=out_dir))
             os.rename(target, old / "w")

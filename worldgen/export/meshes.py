@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from worldgen.errors import SceneError
 from worldgen.floats import DECIMALS
 from worldgen.scene import Mesh, Scene
 
@@ -52,7 +53,7 @@ def mesh_files(scene: Scene) -> dict[str, bytes]:
             other_name, other = seen
             same = np.array_equal(other.vertices, shape.vertices) and np.array_equal(other.faces, shape.faces)
             if not same:
-                raise ValueError(
+                raise SceneError(
                     f"mesh uri {shape.uri!r} is used by nodes {other_name!r} and {node.name!r} with different geometry"
                 )
             continue

@@ -70,6 +70,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "tasks": [_task(task, path, speed, _in_the_way(world, path)) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
+            "allow_infeasible": world.allow_infeasible,
             "checker": report.checker,
             "checks": [
                 {"name": c.name, "ok": bool(c.ok), "value": _finite_or_none(c.value), "detail": c.detail}

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 from typing import Optional
 
+from worldgen.errors import SceneError
 from worldgen.export.movers import write_mjcf_mocap
 from worldgen.export.xml import load_template, sub
 from worldgen.floats import fmt, fmt_seq, round_float
@@ -69,22 +70,22 @@ def joints_by_child(scene: Scene) -> dict[str, Joint]:
     names: set[str] = set()
     for joint in scene.joints:
         if joint.name in names:
-            raise ValueError(f"joint name {joint.name!r} is used twice; joint names must be unique")
+            raise SceneError(f"joint name {joint.name!r} is used twice; joint names must be unique")
         names.add(joint.name)
         if joint.child == RESERVED_NAME:
-            raise ValueError(f"joint {joint.name!r}: the world cannot be a joint's child")
+            raise SceneError(f"joint {joint.name!r}: the world cannot be a joint's child")
         if joint.child in found:
-            raise ValueError(f"node {joint.child!r} is the child of joints {found[joint.child].name!r} and {joint.name!r}")
+            raise SceneError(f"node {joint.child!r} is the child of joints {found[joint.child].name!r} and {joint.name!r}")
         parent = scene.node(joint.child).parent or RESERVED_NAME
         if joint.parent != parent:
-            raise ValueError(
+            raise SceneError(
                 f"joint {joint.name!r} connects {joint.parent!r} to {joint.child!r}, "
                 f"but the node's parent is {parent!r}"
             )
         found[joint.child] = joint
     for node in scene.nodes:
         if node.name == RESERVED_NAME:
-            raise ValueError(f"node name {RESERVED_NAME!r} is reserved for the world frame in MJCF and URDF")
+            raise SceneError(f"node name {RESERVED_NAME!r} is reserved for the world frame in MJCF and URDF")
     return found
 
 
@@ -117,7 +118,7 @@ def _check_joint_names(scene: Scene, joints: dict[str, Joint]) -> None:
     scene_names = {j.name for j in scene.joints}
     for node in scene.nodes:
         if _is_free(node, joints) and node.name in scene_names:
-            raise ValueError(f"node {node.name!r} is dynamic and its free joint's name clashes with a scene joint")
+            raise SceneError(f"node {node.name!r} is dynamic and its free joint's name clashes with a scene joint")
 
 
 def _is_free(node: Node, joints: dict[str, Joint]) -> bool:

@@ -47,6 +47,7 @@ from __future__ import annotations
 import numpy as np
 from lxml import etree
 
+from worldgen.errors import SceneError
 from worldgen.export.mjcf import RESERVED_NAME, joints_by_child, mass_properties
 from worldgen.export.xml import load_template, sub
 from worldgen.floats import fmt, fmt_seq
@@ -104,7 +105,7 @@ def _check_joint_names(scene: Scene, joints: dict[str, Joint]) -> None:
     for node in scene.nodes:
         jname = _joint_name(node, joints.get(node.name))
         if jname in seen:
-            raise ValueError(f"URDF joint name {jname!r} would attach both {seen[jname]!r} and {node.name!r}; "
+            raise SceneError(f"URDF joint name {jname!r} would attach both {seen[jname]!r} and {node.name!r}; "
                              "rename the scene joint")
         seen[jname] = node.name
 

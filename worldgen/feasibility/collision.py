@@ -68,10 +68,46 @@ class Colliders:
         boxes = np.array([scene.aabb(n.name) for n in nodes], dtype=float).reshape(-1, 2, 3)
         self.lo = boxes[:, 0, :]
         self.hi = boxes[:, 1, :]
-        self._request = fcl.DistanceRequest(enable_signed_distance=True)
+        self._unsigned = fcl.DistanceRequest(enable_signed_distance=False)
+        self._signed = fcl.DistanceRequest(enable_signed_distance=True)
+        self._contact = fcl.CollisionRequest(num_max_contacts=1, enable_contact=True)
 
     def __len__(self) -> int:
         return len(self.names)
+
+    def body(self, robot: Robot) -> fcl.CollisionObject:
+        """The robot's FCL cylinder, to be placed with :meth:`place`."""
+        return fcl.CollisionObject(fcl.Cylinder(robot.radius, robot.height), fcl.Transform())
+
+    @staticmethod
+    def place(body: fcl.CollisionObject, robot: Robot, x: float, y: float) -> None:
+        body.setTranslation(np.array([x, y, robot.height / 2]))
+
+    def distance(self, body: fcl.CollisionObject, robot: Robot, c: int) -> float:
+        """FCL's signed distance (m, negative = penetration depth) from the placed body to collider ``c``.
+
+        Asked unsigned first (GJK alone) and signed only for pairs in contact. A pair
+        that touches only across a horizontal plane (a robot exactly as tall as the
+        opening under a lintel) is distance 0 and never reaches the signed query:
+        libccd's EPA throws on such face-to-face contacts, and a C++ exception from
+        python-fcl aborts the whole process.
+        """
+        d = fcl.distance(body, self.objects[c], self._unsigned, fcl.DistanceResult())
+        if d > 0:
+            return float(d)
+        if self.lo[c, 2] >= robot.height or self.hi[c, 2] <= 0.0:
+            return 0.0
+        return float(fcl.distance(body, self.objects[c], self._signed, fcl.DistanceResult()))
+
+    def depth(self, body: fcl.CollisionObject, c: int) -> float:
+        """FCL's contact depth (m) of the placed body in collider ``c``; only for pairs :meth:`distance` puts below 0.
+
+        The signed distance reads about 0 for a cylinder wholly inside a box; the
+        contact's penetration depth does not.
+        """
+        result = fcl.CollisionResult()
+        fcl.collide(body, self.objects[c], self._contact, result)
+        return max((k.penetration_depth for k in result.contacts), default=0.0)
 
     def lower_bounds(self, robot: Robot, xy: np.ndarray) -> np.ndarray:
         """(n, m) lower bound of the distance from the robot at each of the (n, 2) points to each collider."""
@@ -95,7 +131,7 @@ class Colliders:
             return Nearest(float("inf"), 0, None, 0)
         bounds = self.lower_bounds(robot, xy)
         best, where, who, queries = float("inf"), 0, None, 0
-        body = fcl.CollisionObject(fcl.Cylinder(robot.radius, robot.height), fcl.Transform())
+        body = self.body(robot)
         threshold = expect + max(robot.radius / 2, 1e-3)
         while True:
             pi, ci = np.nonzero(bounds < threshold)
@@ -105,8 +141,8 @@ class Colliders:
                 if lb >= best:
                     break
                 p, c = int(pi[k]), int(ci[k])
-                body.setTranslation(np.array([xy[p, 0], xy[p, 1], robot.height / 2]))
-                d = fcl.distance(body, self.objects[c], self._request, fcl.DistanceResult())
+                self.place(body, robot, xy[p, 0], xy[p, 1])
+                d = self.distance(body, robot, c)
                 queries += 1
                 if d < best:
                     best, where, who = float(d), p, self.names[c]

@@ -213,8 +213,10 @@ def check(params: Mapping[str, Any]) -> None:
     need = 2 * (r + c)
     proven = proven_width(params, lay.bounds())
     g = _passage(params, proven)
-    if params["n_obstacles"] and w >= proven:
-        if g < proven:
+    # Obstacles need room beside the passage whether or not the corridor itself is passable:
+    # --allow-infeasible skips only the InfeasibleErrors below, never a world that cannot be built.
+    if params["n_obstacles"]:
+        if g < proven <= w:
             raise ParameterError(
                 f"parameter 'min_passage' must be in [{proven:.3f}, {w:g}] (from the narrowest gap the checker "
                 f"proves passable for this robot to the width), got {params['min_passage']!r}")

@@ -15,6 +15,14 @@ side the leaf opens into, so the leaf, closed, fills the doorway inside the wall
 thickness and, opening, sweeps only that side's room (up to ``limits`` hi <= 3
 rad, short of lying flat against the wall). Positive angles open the door in
 every format; world.json's ``doors[]`` says where (see :mod:`worldgen.doors`).
+
+A leaf opens only as far as its room lets it: past pi/2 its free edge comes
+back towards the outer wall on the hinge side, and a thick leaf's corner
+reaches furthest into the room a little past pi/2. Where a wall would stop the
+leaf before ``limits`` hi, that door's upper limit is the angle at which the
+leaf stays ``LEAF_GAP`` short of it (a door stop); world.json's ``doors[].limits``
+and every format carry that door's own limits. An ``ajar`` angle or a lower
+limit the room cannot hold rejects the draw (a fixed ``door_y``: one line).
 """
 
 from __future__ import annotations
@@ -145,6 +153,26 @@ def check(params: Mapping[str, Any]) -> None:
         raise ParameterError(f"parameter 'spawn' yaw (third value) must be in [-pi, pi] rad, got {spawn!r}")
 
 
+def swing_stop(lw: float, lt: float, beside: float, ahead: float) -> float:
+    """Largest opening angle (rad, at most pi) of a ``lw`` x ``lt`` leaf that stays LEAF_GAP off the walls.
+
+    The leaf turns about its hinge, which sits on the wall face; ``beside`` is the
+    free wall face from the hinge to the wall across its path on the hinge side,
+    ``ahead`` the room's length in front of the wall face. At angle a, the leaf
+    reaches ``-lw cos a`` along the wall face beside the hinge and
+    ``lw sin a - lt cos a`` into the room (its far corners).
+    """
+    stop = math.pi
+    u = beside - LEAF_GAP
+    if u < lw:  # past pi/2 the free edge comes back along the wall face
+        stop = min(stop, math.acos(max(-1.0, -u / lw)))
+    reach, tilt = math.hypot(lw, lt), math.atan2(lt, lw)
+    v = ahead - LEAF_GAP
+    if v < reach:  # lw sin a - lt cos a = reach sin(a - tilt) <= v
+        stop = min(stop, tilt + math.asin(max(-1.0, v / reach)))
+    return math.floor(stop * 1e6) / 1e6  # rounded down: world.json's 6 decimals never open it further
+
+
 def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     door_rng, task_rng = rng.spawn(2)
     sx, sy = params["size"]
@@ -154,17 +182,19 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     nodes = [floor_node(params["size"], t, friction)]
     nodes += wall_nodes(params["size"], h_w, t, friction)
     joints = []
+    rooms = _room_spans(params)
     for k, x in enumerate(wall_positions(params)):
         # Always draw the same four numbers per door, so fixing one choice never reshuffles the rest.
         u_side, u_swing, u_state, u_y = door_rng.random(4)
-        door_nodes, joint = _door(params, k, x, u_side, u_swing, u_state, u_y)
+        door_nodes, joint = _door(params, k, x, u_side, u_swing, u_state, u_y, rooms)
+        if isinstance(joint, str):
+            return Draft(None, rejected="door_swing", detail=joint)
         nodes += door_nodes
         joints.append(joint)
     scene = Scene(tuple(nodes), tuple(joints), bounds, Physics(params["step_size"], params["real_time_factor"]))
     robot = robot_from_params(params)
     # Spawns and goals must be free with the doors as they start and as they open.
     index = FootprintIndex(robot_footprints(scene, robot) + robot_footprints(open_scene(scene), robot))
-    rooms = _room_spans(params)
     first = ((rooms[0][0], -sy / 2), (rooms[0][1], sy / 2))
     last = ((rooms[-1][0], -sy / 2), (rooms[-1][1], sy / 2))
     tasks, reason = _tasks(params, task_rng, index, first, last, robot)
@@ -177,8 +207,11 @@ def _pick(u: float, value: str, options: tuple[str, ...]) -> str:
     return options[min(int(u * len(options)), len(options) - 1)] if value == "random" else value
 
 
-def _door(params, k: int, x: float, u_side, u_swing, u_state, u_y):
-    """Nodes (wall pieces, jambs, head, leaf) and the hinge of dividing wall ``k`` at ``x``."""
+def _door(params, k: int, x: float, u_side, u_swing, u_state, u_y, rooms):
+    """Nodes (wall pieces, jambs, head, leaf) and the hinge of dividing wall ``k`` at ``x``.
+
+    Instead of the hinge, the reason when this door's room cannot hold its initial angle.
+    """
     sy = params["size"][1]
     w, t, h_w = params["door_width"], params["wall_thickness"], params["wall_height"]
     d_h, lt = params["door_height"], params["leaf_thickness"]
@@ -188,8 +221,15 @@ def _door(params, k: int, x: float, u_side, u_swing, u_state, u_y):
     h = 1 if _pick(u_side, params["hinge_side"], ("left", "right")) == "left" else -1
     s = 1 if _pick(u_swing, params["swing"], ("push", "pull")) == "push" else -1
     state = _pick(u_state, params["state"], ("closed", "open", "ajar"))
+    lw, lh = w - 2 * LEAF_GAP, d_h - 2 * LEAF_GAP
+    hx, hy = x + s * t / 2, c + h * (w / 2 - LEAF_GAP)
+    room = rooms[k + 1] if s > 0 else rooms[k]
     lo, hi = params["limits"]
+    hi = min(hi, swing_stop(lw, lt, sy / 2 - h * hy, room[1] - room[0]))
     initial = {"closed": 0.0, "open": hi, "ajar": params["angle"]}[state]
+    if not lo < hi or (state == "ajar" and not initial < hi):
+        return [], (f"door {k}'s room stops its leaf at {hi:g} rad, short of its "
+                    f"{'ajar angle' if state == 'ajar' else 'lower limit'} ({initial if state == 'ajar' else lo:g} rad)")
 
     wall_mat = Material("wall", WALL_RGBA, friction)
     frame_mat = Material("door_frame", FRAME_RGBA, friction)
@@ -207,8 +247,6 @@ def _door(params, k: int, x: float, u_side, u_swing, u_state, u_y):
     head = Node(f"door_{k}_head", "door_frame", Box((w, t, h_w - d_h)),
                 Pose(x, c, d_h + (h_w - d_h) / 2, 0.0, 0.0, -s * math.pi / 2), material=frame_mat)
     nodes.append(head)
-    lw, lh = w - 2 * LEAF_GAP, d_h - 2 * LEAF_GAP
-    hx, hy = x + s * t / 2, c + h * (w / 2 - LEAF_GAP)
     closed = Pose(hx - s * lt / 2, hy - h * lw / 2, LEAF_GAP + lh / 2, 0.0, 0.0, -h * math.pi / 2)
     hinge = Pose(-lw / 2, s * h * lt / 2, 0.0)
     axis = (0.0, 0.0, float(s * h))

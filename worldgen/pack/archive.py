@@ -10,13 +10,14 @@ whose name is absolute, has ``..`` or leaves that folder is refused.
 from __future__ import annotations
 
 import gzip
+import json
 import io
 import tarfile
 from pathlib import Path, PurePosixPath
 from typing import Optional
 
 from worldgen.errors import OutputError, ParameterError
-from worldgen.pack.manifest import MANIFEST_NAME, write_atomically
+from worldgen.pack.manifest import MANIFEST_NAME, WORLDS_DIR, write_atomically
 
 __all__ = ["write_archive", "ArchiveReader", "is_archive", "SUFFIX"]
 
@@ -35,11 +36,14 @@ def write_archive(pack_dir, out: Optional[Path] = None) -> Path:
         raise ParameterError(f"'{pack_dir}' is not a finished pack (no {MANIFEST_NAME}); build it first")
     top = pack_dir.resolve().name
     out = Path(out) if out is not None else pack_dir.resolve().parent / f"{top}{SUFFIX}"
+    listed = {w["world_id"] for w in json.loads((pack_dir / MANIFEST_NAME).read_bytes())["worlds"]}
     paths = []
     for p in pack_dir.rglob("*"):
         rel = p.relative_to(pack_dir)
         if any(part.startswith(".") for part in rel.parts):
             continue  # build state and temporary leftovers are not part of the pack
+        if len(rel.parts) >= 2 and rel.parts[0] == WORLDS_DIR and rel.parts[1] not in listed:
+            continue  # a world the manifest does not list is not part of the pack either
         if p.is_symlink():
             raise OutputError(f"refusing to archive symlink '{p}'")
         paths.append(rel)

@@ -45,6 +45,7 @@ class BuildSummary:
     rejected_jobs: int = 0
     rejected_draws: Counter = field(default_factory=Counter)  # check name -> draws
     extra_draws: int = 0  # draws of built worlds that failed a check before one passed
+    stale: int = 0  # world folders of an earlier recipe removed
     seconds: float = 0.0
 
     @property
@@ -58,7 +59,7 @@ class BuildSummary:
             f"jobs rejected as infeasible: {self.rejected_jobs}; failed draws of those: {why}",
             f"extra draws before a feasible one (max_attempts retries): {self.extra_draws}",
             f"time: {self.seconds:.2f} s, {self.rate:.1f} worlds/s",
-        ]
+        ] + ([f"removed {self.stale} world folder(s) an earlier recipe left in the pack"] if self.stale else [])
 
 
 def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict, dict[str, bytes]]:
@@ -111,6 +112,10 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
 
     if not 1 <= jobs <= MAX_JOBS:
         raise ParameterError(f"parameter 'jobs' must be in [1, {MAX_JOBS}], got {jobs}")
+    if executor not in ("local", "dask"):
+        raise ParameterError(f"parameter 'executor' must be one of local, dask, got {executor!r}")
+    if scheduler is not None and executor != "dask":
+        raise ParameterError(f"parameter 'scheduler' applies only with executor dask (--executor dask), got {scheduler!r}")
     out = Path(out)
     state = out / STATE_DIR
     worlds_dir = out / WORLDS_DIR
@@ -139,8 +144,6 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
             summary.rejected_draws.update(rec["failures"])
         bar.step()
 
-    if executor not in ("local", "dask"):
-        raise ParameterError(f"parameter 'executor' must be one of local, dask, got {executor!r}")
     if executor == "dask":
         from worldgen.pack.dask import run_on_dask
 
@@ -161,6 +164,11 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
     summary.seconds = time.monotonic() - start
     manifest = build_manifest(recipe, records.values(), version or worldgen.__version__)
     _check_unique(manifest)
+    if not manifest["worlds"]:
+        why = ", ".join(f"{k} {v}x" for k, v in sorted(summary.rejected_draws.items())) or "no draws"
+        raise InfeasibleError(f"no job of recipe '{recipe.name}' made a world ({len(recipe.jobs)} rejected; "
+                              f"failed draws: {why}); the pack was not written")
+    summary.stale = _remove_stale(out, {w["world_id"] for w in manifest["worlds"]}, {j.key for j in recipe.jobs})
     write_atomically(out / INDEX_NAME, index_bytes(manifest))
     write_atomically(out / MANIFEST_NAME, manifest_bytes(manifest))  # last: its presence means complete
     return summary
@@ -183,6 +191,17 @@ def _load_records(state: Path, recipe: Recipe) -> dict[str, dict]:
             continue
         out[key] = rec
     return out
+
+
+def _remove_stale(out: Path, world_ids: set[str], keys: set[str]) -> int:
+    """Remove world folders and job records an earlier recipe left in the pack; return how many worlds."""
+    stale = [p for p in (out / WORLDS_DIR).iterdir() if not p.name.startswith(".") and p.name not in world_ids]
+    for p in stale:
+        shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
+    for p in (out / STATE_DIR).glob("*.json"):
+        if p.stem not in keys:
+            p.unlink()
+    return len(stale)
 
 
 def _remove_leftovers(worlds_dir: Path, state: Path) -> None:

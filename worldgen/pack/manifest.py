@@ -15,6 +15,8 @@ import tempfile
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
+from worldgen.world import creation_mode
+
 __all__ = ["MANIFEST_NAME", "INDEX_NAME", "WORLDS_DIR", "SCHEMA_ID", "METRICS", "build_manifest",
            "manifest_bytes", "index_bytes", "write_atomically"]
 
@@ -86,6 +88,7 @@ def write_atomically(path: Path, data: bytes) -> None:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+        os.chmod(tmp, creation_mode(0o666))
         os.replace(tmp, path)
     except BaseException:
         try:

@@ -3,13 +3,14 @@
     >>> pack = worldgen.Pack.open("packs/small")          # or "packs/small.tar.gz"
     >>> len(pack), pack[0].world_id, pack["cluttered-s3-1f3a9c0b"].seed
     >>> hard = pack.filter("narrowest_passage < 1.0 and obstacle_count >= 5")
-    >>> meta = hard[0].metadata()                          # its world.json as a dict
+    >>> meta = hard[0].metadata                            # its world.json as a dict
 """
 
 from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path, PurePosixPath
 from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
@@ -58,7 +59,12 @@ def open_source(path):
 
 @dataclass(frozen=True)
 class PackWorld:
-    """One world of a pack, as its manifest records it."""
+    """One world of a pack, as its manifest records it.
+
+    It reads as a :class:`~worldgen.World` does where both make sense: ``world_id``,
+    ``metadata`` (world.json as a dict), ``read(name)`` (a file's bytes) and
+    ``path`` (None inside an archive), so the oracles take either.
+    """
 
     index: int
     world_id: str
@@ -82,7 +88,9 @@ class PackWorld:
         """A file of this world by its name in the folder, e.g. ``world.sdf``."""
         return self.pack.source.read(f"{self.folder}/{name}")
 
+    @cached_property
     def metadata(self) -> dict:
+        """world.json as a dict."""
         return json.loads(self.read("world.json"))
 
 

@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from worldgen.pack.manifest import INDEX_NAME, index_bytes
+from worldgen.pack.manifest import INDEX_NAME, WORLDS_DIR, index_bytes
 from worldgen.pack.pack import Pack
 
 __all__ = ["verify_pack"]
@@ -31,6 +31,10 @@ def verify_pack(path, regenerate: bool = False) -> Iterator[tuple[bool, str]]:
         for world in pack:
             yield _world(pack, world, validate, regenerate)
         src = pack.source
+        listed = {w.folder for w in pack}
+        for folder in sorted({"/".join(n.split("/")[:2]) for n in src.names() if n.startswith(WORLDS_DIR + "/")}):
+            if folder not in listed:
+                yield False, f"FAIL {folder}: not in the manifest (left by another build?)"
         ok = src.exists(INDEX_NAME) and src.read(INDEX_NAME) == index_bytes(pack.manifest)
         yield ok, f"{'OK' if ok else 'FAIL'} {INDEX_NAME}" + ("" if ok else ": does not match the manifest")
     finally:

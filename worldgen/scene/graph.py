@@ -17,6 +17,7 @@ from typing import Iterable, Optional
 
 import numpy as np
 
+from worldgen.errors import SceneError
 from worldgen.floats import round_float
 from worldgen.scene.pose import Pose
 from worldgen.scene.shapes import Mesh, Shape, unit_inertia
@@ -42,9 +43,9 @@ class Material:
     def __post_init__(self):
         rgba = tuple(float(c) for c in self.rgba)
         if len(rgba) != 4 or not all(0.0 <= c <= 1.0 for c in rgba):
-            raise ValueError(f"material rgba must be 4 values in [0, 1], got {self.rgba!r}")
+            raise SceneError(f"material rgba must be 4 values in [0, 1], got {self.rgba!r}")
         if not (math.isfinite(self.friction) and self.friction >= 0):
-            raise ValueError(f"material friction must be >= 0, got {self.friction!r}")
+            raise SceneError(f"material friction must be >= 0, got {self.friction!r}")
         object.__setattr__(self, "rgba", rgba)
         object.__setattr__(self, "friction", float(self.friction))
 
@@ -70,11 +71,11 @@ class Node:
 
     def __post_init__(self):
         if not NAME_PATTERN.match(self.name):
-            raise ValueError(f"node name {self.name!r} must match {NAME_PATTERN.pattern}")
+            raise SceneError(f"node name {self.name!r} must match {NAME_PATTERN.pattern}")
         if self.role not in ROLES:
-            raise ValueError(f"node {self.name!r}: role must be one of {', '.join(ROLES)}, got {self.role!r}")
+            raise SceneError(f"node {self.name!r}: role must be one of {', '.join(ROLES)}, got {self.role!r}")
         if not (math.isfinite(self.mass) and self.mass > 0):
-            raise ValueError(f"node {self.name!r}: mass must be > 0 kg, got {self.mass!r}")
+            raise SceneError(f"node {self.name!r}: mass must be > 0 kg, got {self.mass!r}")
         if self.role == "marker" and self.collision:
             object.__setattr__(self, "collision", False)
 
@@ -109,12 +110,12 @@ class Joint:
 
     def __post_init__(self):
         if not NAME_PATTERN.match(self.name):
-            raise ValueError(f"joint name {self.name!r} must match {NAME_PATTERN.pattern}")
+            raise SceneError(f"joint name {self.name!r} must match {NAME_PATTERN.pattern}")
         if self.kind not in ("fixed", "revolute"):
-            raise ValueError(f"joint {self.name!r}: kind must be fixed or revolute, got {self.kind!r}")
+            raise SceneError(f"joint {self.name!r}: kind must be fixed or revolute, got {self.kind!r}")
         lo, hi = self.limits
         if self.kind == "revolute" and not lo <= self.initial <= hi:
-            raise ValueError(f"joint {self.name!r}: initial {self.initial} outside limits {self.limits}")
+            raise SceneError(f"joint {self.name!r}: initial {self.initial} outside limits {self.limits}")
 
 
 @dataclass(frozen=True)
@@ -158,9 +159,9 @@ class Physics:
 
     def __post_init__(self):
         if not (math.isfinite(self.step_size) and self.step_size > 0):
-            raise ValueError(f"physics step_size must be > 0 s, got {self.step_size!r}")
+            raise SceneError(f"physics step_size must be > 0 s, got {self.step_size!r}")
         if not (math.isfinite(self.real_time_factor) and self.real_time_factor >= 0):
-            raise ValueError(f"physics real_time_factor must be >= 0, got {self.real_time_factor!r}")
+            raise SceneError(f"physics real_time_factor must be >= 0, got {self.real_time_factor!r}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -187,23 +188,23 @@ class Scene:
         seen: set[str] = set()
         for name in names:
             if name in seen:
-                raise ValueError(f"node name {name!r} is used twice; names must be unique")
+                raise SceneError(f"node name {name!r} is used twice; names must be unique")
             seen.add(name)
         for node in self.nodes:
             if node.parent is not None and node.parent not in seen:
-                raise ValueError(f"node {node.name!r} has unknown parent {node.parent!r}")
+                raise SceneError(f"node {node.name!r} has unknown parent {node.parent!r}")
         for joint in self.joints:
             for end in (joint.parent, joint.child):
                 if end != "world" and end not in seen:
-                    raise ValueError(f"joint {joint.name!r} names unknown node {end!r}")
+                    raise SceneError(f"joint {joint.name!r} names unknown node {end!r}")
         (x0, y0), (x1, y1) = self.bounds
         if not (x1 > x0 and y1 > y0):
-            raise ValueError(f"scene bounds must have min < max, got {self.bounds!r}")
+            raise SceneError(f"scene bounds must have min < max, got {self.bounds!r}")
         self._check_acyclic()
         taken = seen | {j.name for j in self.joints}
         for mover in self.movers:
             if mover.name in taken:
-                raise ValueError(f"mover name {mover.name!r} is already used by a node, joint or mover")
+                raise SceneError(f"mover name {mover.name!r} is already used by a node, joint or mover")
             taken.add(mover.name)
 
     def _check_acyclic(self):
@@ -212,7 +213,7 @@ class Scene:
             seen = set()
             while name is not None:
                 if name in seen:
-                    raise ValueError(f"node {name!r} is its own ancestor")
+                    raise SceneError(f"node {name!r} is its own ancestor")
                 seen.add(name)
                 name = parents[name]
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from worldgen.errors import SceneError
 from worldgen.floats import round_float
 
 __all__ = ["Mover", "MOVER_RGBA"]
@@ -39,19 +40,19 @@ class Mover:
         from worldgen.scene.graph import NAME_PATTERN  # graph imports this module
 
         if not NAME_PATTERN.match(self.name):
-            raise ValueError(f"mover name {self.name!r} must match {NAME_PATTERN.pattern}")
+            raise SceneError(f"mover name {self.name!r} must match {NAME_PATTERN.pattern}")
         for what, value in (("radius", self.radius), ("height", self.height)):
             if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"mover {self.name!r}: {what} must be > 0 m, got {value!r}")
+                raise SceneError(f"mover {self.name!r}: {what} must be > 0 m, got {value!r}")
         rows = tuple(tuple(float(v) for v in row) for row in self.trajectory)
         if len(rows) < 2 or any(len(row) != 3 for row in rows):
-            raise ValueError(f"mover {self.name!r}: trajectory must be at least two (t, x, y) rows")
+            raise SceneError(f"mover {self.name!r}: trajectory must be at least two (t, x, y) rows")
         if not all(math.isfinite(v) for row in rows for v in row):
-            raise ValueError(f"mover {self.name!r}: trajectory values must be finite")
+            raise SceneError(f"mover {self.name!r}: trajectory values must be finite")
         if rows[0][0] != 0.0:
-            raise ValueError(f"mover {self.name!r}: trajectory must start at t = 0, got t = {rows[0][0]!r}")
+            raise SceneError(f"mover {self.name!r}: trajectory must start at t = 0, got t = {rows[0][0]!r}")
         if any(b[0] <= a[0] for a, b in zip(rows, rows[1:])):
-            raise ValueError(f"mover {self.name!r}: trajectory times must strictly increase")
+            raise SceneError(f"mover {self.name!r}: trajectory times must strictly increase")
         object.__setattr__(self, "trajectory", rows)
         object.__setattr__(self, "loop", bool(self.loop))
 

@@ -7,6 +7,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from worldgen.errors import SceneError
+
 __all__ = ["Pose", "rpy_matrix", "matrix_to_pose"]
 
 
@@ -39,7 +41,7 @@ class Pose:
         for name in ("x", "y", "z", "roll", "pitch", "yaw"):
             value = float(getattr(self, name))
             if not math.isfinite(value):
-                raise ValueError(f"pose {name} must be finite, got {value!r}")
+                raise SceneError(f"pose {name} must be finite, got {value!r}")
             object.__setattr__(self, name, value)
 
     @property

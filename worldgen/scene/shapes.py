@@ -8,13 +8,15 @@ from typing import Union
 
 import numpy as np
 
+from worldgen.errors import SceneError
+
 __all__ = ["Box", "Cylinder", "Sphere", "Mesh", "Shape", "unit_inertia"]
 
 
 def _positive(kind: str, name: str, value: float) -> float:
     value = float(value)
     if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{kind} {name} must be a positive finite number, got {value!r}")
+        raise SceneError(f"{kind} {name} must be a positive finite number, got {value!r}")
     return value
 
 
@@ -27,7 +29,7 @@ class Box:
 
     def __post_init__(self):
         if len(self.size) != 3:
-            raise ValueError(f"box size needs 3 values, got {self.size!r}")
+            raise SceneError(f"box size needs 3 values, got {self.size!r}")
         object.__setattr__(self, "size", tuple(_positive("box", "size", v) for v in self.size))
 
     def local_corners(self) -> np.ndarray:
@@ -106,18 +108,18 @@ class Mesh:
         v = np.array(self.vertices, dtype=float).reshape(-1, 3)
         f = np.array(self.faces, dtype=np.int64).reshape(-1, 3)
         if len(v) < 4 or len(f) < 4:
-            raise ValueError("mesh needs at least 4 vertices and 4 faces")
+            raise SceneError("mesh needs at least 4 vertices and 4 faces")
         if f.min() < 0 or f.max() >= len(v):
-            raise ValueError("mesh faces index missing vertices")
+            raise SceneError("mesh faces index missing vertices")
         if not np.all(np.isfinite(v)):
-            raise ValueError("mesh vertices must be finite")
+            raise SceneError("mesh vertices must be finite")
         v.flags.writeable = False
         f.flags.writeable = False
         object.__setattr__(self, "vertices", v)
         object.__setattr__(self, "faces", f)
         object.__setattr__(self, "scale", tuple(_positive("mesh", "scale", s) for s in self.scale))
         if ".." in self.uri.split("/") or self.uri.startswith("/"):
-            raise ValueError(f"mesh uri must stay inside the world folder, got {self.uri!r}")
+            raise SceneError(f"mesh uri must stay inside the world folder, got {self.uri!r}")
 
     @classmethod
     def from_trimesh(cls, uri: str, mesh, scale=(1.0, 1.0, 1.0)) -> "Mesh":

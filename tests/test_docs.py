@@ -1,0 +1,48 @@
+"""docs/world-json.md names every field of the shipped JSON Schema, and nothing the schema lacks."""
+
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+
+
+def schema_fields() -> set[str]:
+    schema = json.loads((REPO / "worldgen" / "schema" / "world.schema.json").read_text())
+    defs = schema.get("$defs", {})
+    out: set[str] = set()
+
+    def walk(node: dict, path: str, depth: int = 0) -> None:
+        if "$ref" in node:
+            if depth < 8:
+                walk(defs[node["$ref"].split("/")[-1]], path, depth + 1)
+            return
+        for name, sub in node.get("properties", {}).items():
+            here = f"{path}.{name}" if path else name
+            out.add(here)
+            walk(sub, here, depth + 1)
+        if node.get("type") == "array" and "items" in node:
+            walk(node["items"], path + "[]", depth + 1)
+        for key in ("oneOf", "anyOf", "allOf"):
+            for alt in node.get(key, []):
+                walk(alt, path, depth + 1)
+
+    walk(schema, "")
+    return out
+
+
+def test_world_json_doc_lists_exactly_the_schema_fields():
+    text = (REPO / "docs" / "world-json.md").read_text()
+    documented = set(re.findall(r"^\| `([^`]+)` \|", text, flags=re.M))
+    fields = schema_fields()
+    assert fields - documented == set(), "fields the doc does not describe"
+    assert documented - fields == set(), "fields the doc describes that the schema does not have"
+
+
+def test_readme_points_at_documents_that_exist():
+    readme = (REPO / "README.md").read_text()
+    assert "METADATA.md" not in readme
+    for target in re.findall(r"\]\(((?:docs|examples)/[^)#]+)\)", readme):
+        assert (REPO / target).exists(), target
