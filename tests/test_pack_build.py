@@ -319,11 +319,11 @@ def test_rebuild_after_the_recipe_changed_leaves_only_the_new_worlds(built, tmp_
     removed = before - len(manifest["worlds"])
     assert removed > 0
     assert f"removed {removed} world folder(s) an earlier recipe left in the pack" in capsys.readouterr().out
-    assert world_folders(pack) == sorted(w["world_id"] for w in manifest["worlds"])
+    assert world_folders(pack) == sorted(world_folder(w).split("/")[1] for w in manifest["worlds"])
     assert len(list((pack / ".build").glob("*.json"))) == len(manifest["worlds"])
     assert all(ok for ok, _ in verify_pack(pack))
     # A folder that is not in the manifest is a verify failure, and no archive carries it.
-    kept = {w["world_id"] for w in manifest["worlds"]}
+    kept = {world_folder(w).split("/")[1] for w in manifest["worlds"]}
     stale = next(p for p in (reference / "worlds").iterdir() if p.name not in kept)
     import shutil
 

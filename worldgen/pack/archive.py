@@ -17,7 +17,7 @@ from pathlib import Path, PurePosixPath
 from typing import Optional
 
 from worldgen.errors import OutputError, ParameterError
-from worldgen.pack.manifest import MANIFEST_NAME, WORLDS_DIR, write_atomically
+from worldgen.pack.manifest import MANIFEST_NAME, WORLDS_DIR, world_folder, write_atomically
 
 __all__ = ["write_archive", "ArchiveReader", "is_archive", "SUFFIX"]
 
@@ -36,7 +36,7 @@ def write_archive(pack_dir, out: Optional[Path] = None) -> Path:
         raise ParameterError(f"'{pack_dir}' is not a finished pack (no {MANIFEST_NAME}); build it first")
     top = pack_dir.resolve().name
     out = Path(out) if out is not None else pack_dir.resolve().parent / f"{top}{SUFFIX}"
-    listed = {w["world_id"] for w in json.loads((pack_dir / MANIFEST_NAME).read_bytes())["worlds"]}
+    listed = {world_folder(w).split("/", 1)[1] for w in json.loads((pack_dir / MANIFEST_NAME).read_bytes())["worlds"]}
     paths = []
     for p in pack_dir.rglob("*"):
         rel = p.relative_to(pack_dir)

@@ -28,7 +28,7 @@ from typing import Any, Optional, TextIO
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError
 from worldgen.pack.manifest import (INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, build_manifest, index_bytes,
-                                    key_metrics, manifest_bytes, write_atomically)
+                                    key_metrics, manifest_bytes, world_folder, write_atomically)
 from worldgen.pack.recipe import Job, Recipe
 
 __all__ = ["build_pack", "BuildSummary", "STATE_DIR", "build_job", "render_job"]
@@ -168,7 +168,8 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
         why = ", ".join(f"{k} {v}x" for k, v in sorted(summary.rejected_draws.items())) or "no draws"
         raise InfeasibleError(f"no job of recipe '{recipe.name}' made a world ({len(recipe.jobs)} rejected; "
                               f"failed draws: {why}); the pack was not written")
-    summary.stale = _remove_stale(out, {w["world_id"] for w in manifest["worlds"]}, {j.key for j in recipe.jobs})
+    summary.stale = _remove_stale(out, {world_folder(w).split("/", 1)[1] for w in manifest["worlds"]},
+                                  {j.key for j in recipe.jobs})
     write_atomically(out / INDEX_NAME, index_bytes(manifest))
     write_atomically(out / MANIFEST_NAME, manifest_bytes(manifest))  # last: its presence means complete
     return summary
@@ -193,9 +194,9 @@ def _load_records(state: Path, recipe: Recipe) -> dict[str, dict]:
     return out
 
 
-def _remove_stale(out: Path, world_ids: set[str], keys: set[str]) -> int:
+def _remove_stale(out: Path, folders: set[str], keys: set[str]) -> int:
     """Remove world folders and job records an earlier recipe left in the pack; return how many worlds."""
-    stale = [p for p in (out / WORLDS_DIR).iterdir() if not p.name.startswith(".") and p.name not in world_ids]
+    stale = [p for p in (out / WORLDS_DIR).iterdir() if not p.name.startswith(".") and p.name not in folders]
     for p in stale:
         shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
     for p in (out / STATE_DIR).glob("*.json"):
