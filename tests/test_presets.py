@@ -309,7 +309,8 @@ def test_cli_generate_with_a_preset_and_an_override(tmp_path):
     (folder,) = world_dirs(tmp_path)
     meta = json.loads((folder / "world.json").read_text())
     assert meta["generator"] == "corridor" and meta["params"]["width"] == 0.8 and meta["params"]["length"] == 6.0
-    assert meta["seed"] == 2 and folder.name.startswith("narrow_corridor--corridor-s2-")
+    assert meta["seed"] == 2 and meta["world_id"].startswith("corridor-s2-")
+    assert folder.name == f"narrow_corridor--{meta['world_id']}" and meta["preset"] == "narrow_corridor"
 
 
 @pytest.mark.parametrize("args,message", [

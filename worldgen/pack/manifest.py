@@ -61,8 +61,9 @@ def world_folder(world: Mapping[str, Any]) -> str:
     """A manifest world's folder, relative to the pack: where its world.json is listed
     (``worlds/<preset>--<world_id>`` for a preset's world, else ``worlds/<world_id>``)."""
     for rel in world["files"]:
-        if rel.endswith("/world.json") and rel.count("/") == 2:
-            return rel[: -len("/world.json")]
+        parts = rel.split("/")
+        if len(parts) == 3 and parts[0] == WORLDS_DIR and parts[1] not in ("", ".", "..") and parts[2] == "world.json":
+            return f"{WORLDS_DIR}/{parts[1]}"
     return f"{WORLDS_DIR}/{world['world_id']}"
 
 
