@@ -60,8 +60,13 @@ def main() -> int:
     print(f"{len(requests)} requests in {took:.0f} s with {args.jobs} workers; {len(defects)} defects")
     for d in defects:
         print(f"  {d['kind']}: {json.dumps(d['request'])} -> {d['detail'][:300]}")
+    slowest = sorted(outcomes, key=lambda o: -o.seconds)[:5]
+    print("slowest requests:")
+    for o in slowest:
+        print(f"  {o.seconds:7.1f} s {o.kind}: {json.dumps(o.request)} -> {o.detail[:120]}")
     RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps({"seed": args.seed, "seconds": took, "rows": rows, "defects": defects},
+    RESULTS.write_text(json.dumps({"seed": args.seed, "seconds": took, "rows": rows, "defects": defects,
+                                  "slowest": [{"seconds": o.seconds, "kind": o.kind, "request": o.request} for o in slowest]},
                                   indent=2, sort_keys=True) + "\n")
     return 1 if defects else 0
 
