@@ -329,6 +329,7 @@ def test_same_parameters_same_world():
     ({"n_doors": 0}, "parameter 'n_doors' must be in [1, 16]"),
     ({"spawn": [9.0, 0.0, 0.0]}, "parameter 'spawn' must keep the robot's 0.25 m disc on the floor"),
     ({"leaf_thickness": -1}, "parameter 'leaf_thickness' must be in [0.005, 1]"),
+    ({"robot_height": 1.96}, "parameter 'robot_height' must be at most door_height - clearance = 1.95 m"),
 ])
 def test_bad_parameters_get_one_line_errors(params, message):
     with pytest.raises(ParameterError) as err:
@@ -403,3 +404,10 @@ def test_swing_stop_exact_references():
     # A room just as long as the leaf ahead, thick leaf: stops where the far corner meets the wall.
     a = swing_stop(0.88, 0.3, beside=5.0, ahead=0.88 + LEAF_GAP)
     assert 0.88 * math.sin(a) - 0.3 * math.cos(a) == pytest.approx(0.88, abs=1e-5)
+
+
+@pytest.mark.parametrize("height,clearance", [(1.95, 0.05), (2.0, 0.0)])
+def test_a_robot_exactly_as_tall_as_the_doorway_allows_passes_under_it(height, clearance):
+    world = worldgen.generate("door", seed=3, robot_height=height, clearance=clearance)
+    assert world.feasibility.feasible
+    assert world.metadata["tasks"][0]["path"]["min_clearance"] >= clearance - 1e-6

@@ -123,6 +123,11 @@ def check(params: Mapping[str, Any]) -> None:
     if params["door_height"] > params["wall_height"] - MIN_HEAD:
         raise ParameterError(f"parameter 'door_height' must be in [0.1, {params['wall_height'] - MIN_HEAD:g}] m "
                              f"(wall_height - {MIN_HEAD:g}), got {params['door_height']!r}")
+    if params["robot_height"] + params["clearance"] > params["door_height"]:
+        # The footprint passes under a doorway's head only with its clearance to spare (FCL measures in 3-D).
+        raise ParameterError(
+            f"parameter 'robot_height' must be at most door_height - clearance = "
+            f"{params['door_height'] - params['clearance']:g} m to pass under the doorways, got {params['robot_height']!r}")
     if params["door_height"] - 2 * LEAF_GAP <= 0:
         raise ParameterError(f"parameter 'door_height' must exceed {2 * LEAF_GAP:g} m, got {params['door_height']!r}")
     room = sy - 2 * JAMB_WIDTH
