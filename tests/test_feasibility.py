@@ -255,7 +255,7 @@ def test_corridor_reports_its_width_as_the_narrowest_passage(width):
     scene = scene_of(walls, half=(5.0, 3.0))
     report = feasibility.check(scene, [task((-4.0, 0.3), (4.0, -0.2))], ROBOT)
     assert report.feasible, report.failed()
-    assert width - 1.2 * report.resolution <= report.narrowest_passage <= width + 1e-6
+    assert report.narrowest_passage == pytest.approx(width, abs=1e-9)
 
 
 def test_a_wall_corner_is_wrapped_tightly():

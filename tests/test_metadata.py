@@ -376,7 +376,9 @@ def test_written_world_json_is_valid_canonical_and_true(written):
             assert path["waypoints"][0] == pytest.approx(task["spawn"][:2], abs=1e-6)
             assert path["waypoints"][-1] == pytest.approx(task["goal"][:2], abs=1e-6)
             polyline = sum(math.dist(a, b) for a, b in zip(path["waypoints"], path["waypoints"][1:]))
-            assert polyline == pytest.approx(path["length"], rel=1e-5, abs=1e-5)
+            # length: the exact taut path (arcs included); the polyline rounds each arc on a
+            # circumscribed polygon, so it is a hair longer (METADATA allows 2 %, we keep 0.5 %).
+            assert path["length"] - 1e-5 <= polyline <= path["length"] * 1.005 + 1e-5
             assert path["length"] >= task["straight_line_distance"] - 1e-6
             if path["min_clearance"] is not None:
                 assert path["min_clearance"] >= robot["clearance"] - 1e-6

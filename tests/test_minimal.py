@@ -84,7 +84,8 @@ def test_no_random_draws_the_seed_only_names_the_world():
 def test_the_default_goal_stands_beside_the_target_and_a_given_one_is_kept():
     world = worldgen.generate("minimal", target="wall", target_distance=2.0)
     goal = world.tasks[0].goal
-    assert goal.x == pytest.approx(2.0) and goal.y == pytest.approx(2.0 + 0.25 + 2 * 0.25 / 3 + 0.05, abs=1e-6)
+    # Level with the near face, clear of the wall's end by the footprint + 1 mm + 0.05 m.
+    assert goal.x == pytest.approx(2.0) and goal.y == pytest.approx(2.0 + 0.25 + 0.001 + 0.05, abs=1e-6)
     world = worldgen.generate("minimal", target="wall", goal=[-2.0, 1.0])
     assert (world.tasks[0].goal.x, world.tasks[0].goal.y) == (-2.0, 1.0)
     recheck(world)
@@ -101,15 +102,15 @@ def test_sample_worlds_pass_the_reference_tools(params, tmp_path):
 
 
 @pytest.mark.parametrize("params,pattern", [
-    (dict(target_distance=0.4), r"^parameter 'target_distance' must be at least robot_radius \+ clearance \+ 2 "
-                                r"feasibility grid cells = 0.417 m, got 0.4"),
+    (dict(target_distance=0.25), r"^parameter 'target_distance' must be at least robot_radius \+ clearance \+ "
+                                 r"1 mm = 0.251 m, got 0.25"),
     (dict(target_distance=8.0), r"^parameter 'target_distance' puts the wall .* off the floor \[-5, 5\] x \[-5, 5\]"),
     (dict(target="cylinder", target_width=1.0), r"^parameter 'target_width' does not apply to a cylinder target"),
     (dict(spawn=[0.0, 0.0, 0.5], spawn_yaw=0.5), r"^parameters 'spawn' and 'spawn_yaw' both set the heading"),
     (dict(spawn=[0.0, 0.0, 4.0]), r"^parameter 'spawn' yaw \(third value\) must be in \[-3.1416, 3.1416\] rad"),
-    (dict(spawn=[4.6, 0.0, math.pi]), r"^parameter 'spawn' must keep the robot's 0.25 m disc and 2 grid cells "
-                                      r"\(0.417 m\) inside the floor \[-5, 5\] x \[-5, 5\]"),
-    (dict(goal=[0.0, 4.7]), r"^parameter 'goal' must keep the robot's 0.25 m disc and 2 grid cells"),
+    (dict(spawn=[4.76, 0.0, math.pi]), r"^parameter 'spawn' must keep the robot's 0.25 m disc and 1 mm "
+                                       r"\(0.251 m\) inside the floor \[-5, 5\] x \[-5, 5\]"),
+    (dict(goal=[0.0, 4.75]), r"^parameter 'goal' must keep the robot's 0.25 m disc and 1 mm"),
     (dict(target_width=10.5), r"^parameter 'target_distance' puts the wall"),
     (dict(target_width=9.9), r"^parameter 'goal' must be given: neither side of the target leaves room"),
     (dict(target="sphere"), r"^parameter 'target' must be one of wall, box, cylinder"),

@@ -2,7 +2,7 @@
 
 lidar_wall (minimal generator): the robot (radius 0.2 m) spawns at the origin, a
 box wall occupies x in [2.0, 2.1], y in [-2, 2], z in [0, 1]; the task's goal is
-(2.0, 2.466667) and its reference path is the straight segment to it.
+(2.0, 2.5) and its reference path is the straight segment to it.
 """
 
 import hashlib
@@ -19,7 +19,7 @@ from worldgen.errors import ParameterError
 from worldgen.oracles_eval import evaluate, load_criteria
 from worldgen.presets import generate_preset
 
-GOAL = (2.0, 2.466667)
+GOAL = (2.0, 2.5)
 REF_LENGTH = math.hypot(*GOAL)
 
 
@@ -41,7 +41,7 @@ def line(a, b, t0, t1, n=11):
 def test_straight_line_to_goal(wall):
     run = line((0, 0), GOAL, 0.0, 10.0)
     assert oracles.path_length(run) == pytest.approx(REF_LENGTH, abs=1e-9)
-    assert oracles.path_efficiency(run, wall) == pytest.approx(REF_LENGTH / 3.175602, abs=1e-6)
+    assert oracles.path_efficiency(run, wall) == pytest.approx(REF_LENGTH / 3.201562, abs=1e-6)
     assert oracles.reached_goal(run, wall)
     # The first sample within 0.2 m of the goal: 9/10 of the way is 0.318 m short, 10/10 is on it.
     assert oracles.time_to_goal(run, wall) == pytest.approx(10.0)
@@ -73,7 +73,7 @@ def test_in_out_in_is_two_contacts(wall):
 
 def test_run_that_stops_short(wall):
     run = line((0, 0), (0.8 * GOAL[0], 0.8 * GOAL[1]), 0.0, 8.0)
-    assert oracles.path_efficiency(run, wall) == pytest.approx(0.8 * REF_LENGTH / 3.175602, abs=1e-6)
+    assert oracles.path_efficiency(run, wall) == pytest.approx(0.8 * REF_LENGTH / 3.201562, abs=1e-6)
     assert not oracles.reached_goal(run, wall)
     assert oracles.time_to_goal(run, wall) is None
     fig = oracles.run(run, wall)

@@ -293,7 +293,8 @@ def test_oracles_take_pack_worlds_in_a_folder_and_in_an_archive(built, tmp_path,
         drive = np.column_stack([np.linspace(0.0, 10.0, len(xy)), xy])
         regenerated = worldgen.generate(w.generator, w.seed, **w.params)
         assert oracles.collisions(drive, w) == oracles.collisions(drive, regenerated) == []
-        assert oracles.path_efficiency(drive, w) == pytest.approx(1.0, abs=1e-5)
+        # The written polyline rounds arcs on circumscribed polygons: a hair longer than the exact length.
+        assert 1.0 - 1e-6 <= oracles.path_efficiency(drive, w) <= 1.005
         assert oracles.min_clearance(drive, w) == pytest.approx(oracles.min_clearance(drive, regenerated), abs=1e-6)
         assert oracles.reached_goal(drive, w)
         # A drive straight through the first obstacle is a collision here as in the regenerated world.

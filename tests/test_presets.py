@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from test_cli import run, world_dirs
-from test_corridor import PASSAGE_CELLS, recheck
+from test_corridor import recheck
 from test_minimal import ray
 import worldgen
 from worldgen import presets
@@ -57,7 +57,7 @@ def test_narrow_corridor_is_0_8_m_wide_and_says_so():
     world = worldgen.generate_preset("narrow_corridor")
     recheck(world)
     report = world.feasibility
-    assert 0.8 - PASSAGE_CELLS * report.resolution <= report.narrowest_passage <= 0.8 + 1e-6
+    assert report.narrowest_passage == pytest.approx(0.8, abs=5e-6)
     assert world.metadata["feasibility"]["narrowest_passage"] == pytest.approx(report.narrowest_passage, abs=1e-6)
     (x0, y0), (x1, y1) = world.scene.bounds
     assert y1 - y0 == pytest.approx(0.8) and x1 - x0 == pytest.approx(10.0)
@@ -186,9 +186,8 @@ CLAIMS = {
         (rf"radius {N} m, clearance\s+{N} m", lambda w, r, c: (w.robot.radius, w.robot.clearance) == (r, c)),
         (rf"leaves {N} m on each side",
          lambda w, side: (_extent(w)[1] - 2 * w.robot.inflation) / 2 == pytest.approx(side, abs=1e-9)),
-        (rf"narrowest_passage is {N} m, reported to\s+within {N} feasibility grid cells below",
-         lambda w, width, cells: cells == pytest.approx(PASSAGE_CELLS, abs=5e-3)
-         and width - cells * w.feasibility.resolution <= w.metadata["metrics"]["narrowest_passage"] <= width + 1e-6),
+        (rf"narrowest_passage is {N} m, the exact gap\s+between the walls \(to within {N} m",
+         lambda w, width, tol: w.metadata["metrics"]["narrowest_passage"] == pytest.approx(width, abs=tol)),
     ],
     "room_5_obstacles": [
         (rf"{N} x {N} m walled room", lambda w, a, b: _extent(w) == (a, b) and len(roles(w, "wall")) == 4),

@@ -191,7 +191,7 @@ def _feasibility(meta: dict, world) -> None:
         if colliders is None:  # reference paths go through doors at their open limit, as the checker plans
             colliders = Colliders(open_scene(world.scene))
         # The path a test will use is the recorded one: prove it, not only the re-run's.
-        nearest, _ = verify_path(colliders, robot, np.asarray(task["path"]["waypoints"], dtype=float))
+        nearest = verify_path(colliders, robot, np.asarray(task["path"]["waypoints"], dtype=float))
         if report.feasible and nearest.distance < robot.clearance - 1e-6:
             raise _Fail("feasibility", f"{task['id']} recorded path comes {nearest.distance:.6f} m from "
                                        f"{nearest.name}, under the clearance {robot.clearance} m")

@@ -1,17 +1,16 @@
-"""Feasibility: prove a drawn world drivable for the robot footprint, with FCL.
+"""Feasibility: prove a drawn world drivable for the robot footprint, exactly, and verify it with FCL.
 
 ``check(scene, tasks, robot)`` returns a :class:`FeasibilityReport`. The modules,
 in the order the data flows through them:
 
 - ``geometry``: footprints as arrays; exact point/segment distances to them;
-- ``field``: the exact clearance of every grid cell centre;
-- ``portals``: exactly checked crossings of gaps too narrow for the grid to prove;
-- ``planner``: grid search (16-connected, field-proven moves, plus portals) and string-pulling;
-- ``taut``: tightening to the exact taut path (tangents and arcs);
-- ``visibility``: an exact local visibility graph, where tightening fails;
-- ``passage``: the narrowest passage (bottleneck) of a task;
+- ``cspace``: the configuration space: obstacles grown by the robot's disc (corner
+  circles with their cones), the bounds shrunk by it, exact segment and arc clearances;
+- ``tangents``: common tangents between corner circles, the edges of the tangent graph;
+- ``planner``: the exact shortest path (lazy A* over the tangent graph) and its polyline;
+- ``passage``: the exact narrowest passage (the widest disc that gets through);
 - ``collision``: FCL objects and broad-phased distance queries;
-- ``verify``: sampling a path and proving it with FCL;
+- ``verify``: the FCL proof of a path, on the volume the footprint sweeps along it;
 - ``check``: running it all and assembling the report.
 """
 

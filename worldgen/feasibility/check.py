@@ -2,60 +2,44 @@
 
 Per task: the spawn and goal discs lie inside the bounds; the footprint
 cylinder at spawn and goal keeps ``robot.clearance`` from every collider (FCL);
-a path exists for the disc of radius ``robot.inflation``; and that path, sampled
-every ``robot.radius / 4``, keeps the clearance everywhere (FCL). Results are
-aggregated over tasks: a check passes only if it passes for every task, its
-value is the worst figure, and its detail names the task that set it.
+the exact shortest path exists for the disc of radius ``robot.inflation``
+(:mod:`~worldgen.feasibility.planner`, in the configuration space of
+:mod:`~worldgen.feasibility.cspace`); and the written path keeps the clearance
+along its whole length, proven by FCL on the volume the footprint sweeps
+(:mod:`~worldgen.feasibility.verify`). Results are aggregated over tasks: a
+check passes only if it passes for every task, its value is the worst figure,
+and its detail names the task that set it.
 
-The path is planned in the plane (clearance field, grid search with portals
-through narrow gaps, string-pulling, tightening, and where tightening fails an
-exact local visibility graph; see the sibling modules) with a small safety margin
-:data:`SAFETY` on top of the inflation radius, so rounding the written
-waypoints to 6 decimals can never bring the footprint closer than required.
+The planner keeps a small safety margin :data:`SAFETY` on top of the inflation
+radius: FCL counts touching as collision, and the written waypoints are rounded
+to 6 decimals. Half of it pays for the polygons written round arcs.
 """
 
 from __future__ import annotations
 
-import math
 from typing import Optional, Sequence
 
 import numpy as np
 
 from worldgen.doors import door_joints, fixed_scene, open_scene
 from worldgen.feasibility.collision import Colliders
-from worldgen.feasibility.field import distance_field, grid_for
+from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
-from worldgen.feasibility.passage import bottleneck_radius, exact_width, extend_field
-from worldgen.feasibility.planner import grid_path, string_pull
-from worldgen.feasibility.portals import find_portals
-from worldgen.feasibility.visibility import encloses, local_shortest
+from worldgen.feasibility.passage import narrowest_passage
+from worldgen.feasibility.planner import Planner, waypoints
 from worldgen.feasibility.report import Check, FeasibilityReport, TaskPath
-from worldgen.feasibility.taut import tighten
 from worldgen.feasibility.verify import verify_path
 from worldgen.floats import DECIMALS
-from worldgen.footprint import scene_footprints
+from worldgen.footprint import robot_footprints
 from worldgen.scene import Robot, Scene, Task
 
-__all__ = ["check", "resolution_for", "SAFETY"]
+__all__ = ["check", "SAFETY"]
 
-#: Extra margin (m) the planner keeps on top of the inflation radius: far above
-#: the 6-decimal rounding of waypoints and FCL's solver tolerance, far below any
-#: length that matters (it lengthens a path by well under 0.1 %).
+#: Extra margin (m) the planner keeps on top of the inflation radius: far above the
+#: 6-decimal rounding of waypoints and FCL's solver tolerance, far below any length
+#: that matters (it lengthens a path by well under 0.1 %). A passage is refused only
+#: when it is narrower than 2 x (inflation + SAFETY).
 SAFETY = 1e-4
-#: Grid cell size as a fraction of the inflation radius, and its limits (m).
-RESOLUTION_FRACTION = 1.0 / 3.0
-RESOLUTION_LIMITS = (0.01, 0.25)
-#: How far from the reference path (m) the fallback visibility graph looks for obstacles.
-LOCAL_REACH = 0.5
-#: Largest grid (cells); bigger floors get coarser cells instead.
-MAX_CELLS = 1_000_000
-
-
-def resolution_for(robot: Robot, bounds) -> float:
-    """The grid cell size (m) used for ``robot`` on a floor of ``bounds``."""
-    (x0, y0), (x1, y1) = bounds
-    h = min(max(robot.inflation * RESOLUTION_FRACTION, RESOLUTION_LIMITS[0]), RESOLUTION_LIMITS[1])
-    return max(h, math.sqrt((x1 - x0) * (y1 - y0) / MAX_CELLS))
 
 
 def _bounds_margin(bounds, xy: np.ndarray) -> np.ndarray:
@@ -82,7 +66,7 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     bounds = scene.bounds
     colliders = Colliders(scene)
     initial_colliders = colliders if scene is initial else Colliders(initial)
-    obstacles = Obstacles2D.from_footprints(scene_footprints(scene, robot.height + robot.clearance))
+    obstacles = Obstacles2D.from_footprints(robot_footprints(scene, robot))
     spawns = np.array([[t.spawn.x, t.spawn.y] for t in tasks], dtype=float).reshape(-1, 2)
     goals = np.array([[t.goal.x, t.goal.y] for t in tasks], dtype=float).reshape(-1, 2)
     radius = robot.inflation + SAFETY
@@ -109,21 +93,11 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
                 f"(needs >= {robot.clearance:g} m)"),
             lambda v: f"smallest clearance {v:.4f} m")
 
-    # Planning in the plane.
-    h = resolution_for(robot, bounds)
-    grid = grid_for(bounds, h)
-    ends = np.vstack([spawns, goals])
-    clear2d = np.minimum(obstacles.points_distance(ends)[0], _bounds_margin(bounds, ends))
-    start_clear, goal_clear = clear2d[: len(tasks)], clear2d[len(tasks):]
-    endpoint_clear = np.minimum(start_clear, goal_clear)
-    plannable = endpoint_clear > radius
-    # Exact values are needed only near the inflation radius (planning proves moves
-    # against it); the passage search reads farther out from a cheap extension.
-    cap = radius + 2.5 * h
-    field = distance_field(obstacles, bounds, grid, cap)
-    wide = None  # the field extended beyond cap, made on first need
-    portals = find_portals(obstacles, bounds, radius, h)
-
+    # The exact shortest path of each task in the configuration space of the disc.
+    cspace = ConfigSpace.build(obstacles, radius, bounds)
+    planner = Planner(cspace)
+    slack = cspace.points_clearance(np.vstack([spawns, goals]))
+    start_slack, goal_slack = slack[: len(tasks)], slack[len(tasks):]
     paths: list[Optional[TaskPath]] = []
     passages: list[float] = []
     no_path: list[str] = []
@@ -131,54 +105,28 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     clearance_detail: dict[int, str] = {}
     for i, task in enumerate(tasks):
         s, g = spawns[i], goals[i]
-        if not plannable[i]:
+        if start_slack[i] < 0 or goal_slack[i] < 0:
             paths.append(None)
-            which = "spawn" if start_clear[i] <= radius else "goal"
+            which = "spawn" if start_slack[i] < 0 else "goal"
             no_path.append(f"{task.id}: the {which} is not free for a {robot.inflation:g} m disc")
             continue
-        raw = grid_path(field, s, g, radius, obstacles, bounds, portals)
-        if raw is None:
+        route = planner.shortest(s, g)
+        if route is None:
             paths.append(None)
-            no_path.append(f"{task.id}: no path for a {robot.inflation:g} m disc from {_p(s)} to {_p(g)} "
-                           f"(grid {grid.hx:.3f} m)")
+            no_path.append(f"{task.id}: no path for a {robot.inflation:g} m disc from {_p(s)} to {_p(g)}")
             continue
-        ref = string_pull(field, raw, radius)
-        taut = tighten(obstacles, ref, radius, bounds, near=3 * h)
-        if taut is None or _length(taut) >= _length(ref) or encloses(taut, ref, obstacles):
-            # Tightening gave up, went nowhere, or settled round the wrong side of an obstacle
-            # (then the grid's choice of way round is lost): search the obstacles around the
-            # path with an exact local visibility graph instead. Rare, and slower.
-            around = local_shortest(obstacles, ref, radius, bounds, reach=LOCAL_REACH)
-            if around is not None:
-                again = tighten(obstacles, around, radius, bounds, near=3 * h)
-                if again is not None and _length(again) < _length(around) and not encloses(again, around, obstacles):
-                    around = again
-                if taut is None or _length(around) < _length(taut):
-                    taut = around
-        best = ref if taut is None or _length(taut) > _length(ref) else taut
-        waypoints = np.round(best, DECIMALS)
-        waypoints[0], waypoints[-1] = s, g
-        nearest, samples = verify_path(colliders, robot, waypoints)
+        line = np.round(waypoints(cspace, route, SAFETY / 2), DECIMALS)
+        line[0], line[-1] = s, g
+        nearest = verify_path(colliders, robot, line)
         clearance = nearest.distance
         if not np.isfinite(clearance):  # nothing to hit: the floor's edge is the only limit
-            clearance = float(_bounds_margin(bounds, samples).min() - robot.radius)
+            clearance = float(_bounds_margin(bounds, line).min() - robot.radius)
         clearances[i] = clearance
         if clearance < robot.clearance:
-            at = samples[nearest.index]
-            clearance_detail[i] = (f"{task.id}: the path passes {clearance:.4f} m from {nearest.name} at {_p(at)} "
-                                   f"(needs >= {robot.clearance:g} m)")
-        paths.append(TaskPath(task.id, waypoints, _length(waypoints), clearance))
-        high = float(endpoint_clear[i])
-        if high > field.cap and wide is None:
-            wide = extend_field(field)
-        on = field if high <= field.cap else wide
-        passage = exact_width(2.0 * bottleneck_radius(on, s, g, radius, high), on, obstacles, s, g)
-        # A gap the grid cannot see (a portal) on the path is measured exactly: where the grid
-        # found no route at all (passage stuck at its lower bound) the portal is the bottleneck.
-        through = [p.width for p in portals if _passes(raw, p)]
-        if through:
-            passage = min(through) if passage <= 2 * radius + 1e-9 else max(passage, min(through))
-        passages.append(passage)
+            clearance_detail[i] = (f"{task.id}: the path passes {clearance:.4f} m from {nearest.name} at "
+                                   f"{_p(nearest.where)} (needs >= {robot.clearance:g} m)")
+        paths.append(TaskPath(task.id, line, route.length, clearance))
+        passages.append(narrowest_passage(obstacles, bounds, s, g))
 
     found = [p for p in paths if p is not None]
     path_exists = Check("path_exists", not no_path,
@@ -192,13 +140,13 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     else:
         path_clearance = _aggregate("path_clearance", tasks, clearances, clearances >= robot.clearance,
                                     lambda i: clearance_detail.get(i, ""),
-                                    lambda v: f"smallest FCL clearance {v:.4f} m along the sampled paths")
+                                    lambda v: f"smallest FCL clearance {v:.4f} m along the swept paths")
     checks = (inside, free["spawn"], free["goal"], path_exists, path_clearance)
     narrowest = min(passages) if passages and not no_path else None
     informational = ()
     if door_joints(initial):
         informational = (_reachable_initial(initial, tasks, robot),)
-    return FeasibilityReport(checks, tuple(paths), narrowest, "fcl", grid.hx, informational)
+    return FeasibilityReport(checks, tuple(paths), narrowest, "fcl", None, informational)
 
 
 def _reachable_initial(initial: Scene, tasks, robot: Robot) -> Check:
@@ -215,15 +163,6 @@ def _reachable_initial(initial: Scene, tasks, robot: Robot) -> Check:
     failed = "; ".join(f"{c.name}: {c.detail}" for c in report.failed())
     return Check("reachable_initial_state", False, None,
                  f"not with the doors as they start ({failed}); informational: the reference path opens them")
-
-
-def _passes(points: np.ndarray, portal) -> bool:
-    """True when the grid path ``points`` runs through ``portal`` (holds both its ends)."""
-    return all(bool(np.any(np.all(points == end, axis=1))) for end in portal.ends)
-
-
-def _length(points: np.ndarray) -> float:
-    return float(np.hypot(*np.diff(points, axis=0).T).sum())
 
 
 def _aggregate(name: str, tasks, values: np.ndarray, ok: np.ndarray, fail_detail, ok_detail) -> Check:

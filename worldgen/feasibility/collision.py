@@ -25,16 +25,18 @@ __all__ = ["Colliders", "Nearest"]
 
 @dataclass(frozen=True)
 class Nearest:
-    """The smallest FCL distance (m, negative = penetration depth) over a set of robot positions.
+    """The smallest FCL distance (m, negative = penetration depth) over a set of robot positions or pieces.
 
-    ``index`` is the position it occurred at, ``name`` the collider; ``distance``
-    is inf and ``name`` None when there is nothing to hit.
+    ``index`` is the position (piece) it occurred at and ``where`` a point (x, y)
+    there, ``name`` the collider; ``distance`` is inf and ``name`` None when
+    there is nothing to hit.
     """
 
     distance: float
     index: int
     name: Optional[str]
     queries: int
+    where: Optional[tuple[float, float]] = None
 
 
 def _geometry(node):
@@ -84,7 +86,8 @@ class Colliders:
         body.setTranslation(np.array([x, y, robot.height / 2]))
 
     def distance(self, body: fcl.CollisionObject, robot: Robot, c: int) -> float:
-        """FCL's signed distance (m, negative = penetration depth) from the placed body to collider ``c``.
+        """FCL's signed distance (m, negative = penetration depth) from the placed body (standing on the
+        floor, ``robot.height`` tall) to collider ``c``.
 
         Asked unsigned first (GJK alone) and signed only for pairs in contact. A pair
         that touches only across a horizontal plane (a robot exactly as tall as the
@@ -111,43 +114,118 @@ class Colliders:
 
     def lower_bounds(self, robot: Robot, xy: np.ndarray) -> np.ndarray:
         """(n, m) lower bound of the distance from the robot at each of the (n, 2) points to each collider."""
-        x = xy[:, 0, None]
-        y = xy[:, 1, None]
-        gx = np.maximum(np.maximum(self.lo[None, :, 0] - x, x - self.hi[None, :, 0]), 0.0)
-        gy = np.maximum(np.maximum(self.lo[None, :, 1] - y, y - self.hi[None, :, 1]), 0.0)
+        xy = np.asarray(xy, dtype=float).reshape(-1, 2)
+        d = _point_box(xy[:, None, :], self.lo[None, :, :2], self.hi[None, :, :2])
         gz = np.maximum(np.maximum(self.lo[:, 2] - robot.height, -self.hi[:, 2]), 0.0)
-        return np.maximum(np.sqrt(gx * gx + gy * gy) - robot.radius, gz[None, :])
+        return np.maximum(d - robot.radius, gz[None, :])
+
+    def segment_lower_bounds(self, robot: Robot, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """(n, m) lower bound of the distance from the volume the robot sweeps along each segment
+        a[i]b[i] ((n, 2) each; a point where a == b) to each collider: the 2-D distance from the
+        segment to the collider's box less the radius, or the vertical gap, whichever is larger."""
+        a = np.asarray(a, dtype=float).reshape(-1, 2)
+        b = np.asarray(b, dtype=float).reshape(-1, 2)
+        lo, hi = self.lo[None, :, :2], self.hi[None, :, :2]
+        d = np.minimum(_point_box(a[:, None, :], lo, hi), _point_box(b[:, None, :], lo, hi))
+        moving = np.flatnonzero(np.any(a != b, axis=1))
+        if len(moving):
+            # Where the segment moves, a box corner may be nearer than either end, or the segment may cross it.
+            am, bm = a[moving][:, None, :], b[moving][:, None, :]
+            ds = d[moving]
+            for cx in (0, 1):
+                for cy in (0, 1):
+                    corner = np.stack([np.where(cx, self.hi[:, 0], self.lo[:, 0]),
+                                       np.where(cy, self.hi[:, 1], self.lo[:, 1])], axis=1)[None, :, :]
+                    ds = np.minimum(ds, _point_segment(corner, am, bm))
+            ds = np.where(_crosses_box(am, bm, lo, hi), 0.0, ds)
+            d[moving] = ds
+        gz = np.maximum(np.maximum(self.lo[:, 2] - robot.height, -self.hi[:, 2]), 0.0)
+        return np.maximum(d - robot.radius, gz[None, :])
 
     def nearest(self, robot: Robot, xy: np.ndarray, expect: float = 0.0) -> Nearest:
-        """Smallest FCL distance from the robot cylinder at any of the (n, 2) points to any collider.
-
-        Exact: pairs are measured in order of their lower bound until the bound
-        reaches the best distance found. ``expect`` is a guess of the answer
-        (e.g. the clearance the path was planned for); pairs whose bound is
-        below it are gathered first, which keeps the sort small.
-        """
+        """Smallest FCL distance from the robot cylinder at any of the (n, 2) points to any collider."""
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
-        if len(self) == 0 or len(xy) == 0:
-            return Nearest(float("inf"), 0, None, 0)
-        bounds = self.lower_bounds(robot, xy)
-        best, where, who, queries = float("inf"), 0, None, 0
         body = self.body(robot)
+
+        def measure(p: int, c: int) -> float:
+            self.place(body, robot, xy[p, 0], xy[p, 1])
+            return self.distance(body, robot, c)
+
+        if len(self) == 0 or len(xy) == 0:
+            return Nearest(float("inf"), 0, None, 0, None)
+        return self._nearest(self.lower_bounds(robot, xy), measure, robot, expect, xy)
+
+    def nearest_pieces(self, robot: Robot, pieces: list, a: np.ndarray, b: np.ndarray,
+                       expect: float = 0.0) -> Nearest:
+        """Smallest FCL distance from any of the placed robot ``pieces`` to any collider; piece i
+        lies within the robot radius of segment a[i]b[i] (see :meth:`segment_lower_bounds`)."""
+        if len(self) == 0 or len(pieces) == 0:
+            return Nearest(float("inf"), 0, None, 0, None)
+
+        def measure(p: int, c: int) -> float:
+            return self.distance(pieces[p], robot, c)
+
+        return self._nearest(self.segment_lower_bounds(robot, a, b), measure, robot, expect, (a + b) / 2)
+
+    def _nearest(self, bounds: np.ndarray, measure, robot: Robot, expect: float, where: np.ndarray) -> Nearest:
+        """The smallest of ``measure(p, c)`` over every (piece, collider) pair, exactly.
+
+        Pairs are measured in order of their lower bound ``bounds[p, c]`` until the
+        bound reaches the best distance found. ``expect`` is a guess of the answer
+        (e.g. the clearance the path was planned for); pairs whose bound is below
+        it are gathered first, which keeps the sort small.
+        """
+        best, at, who, queries = float("inf"), 0, None, 0
         threshold = expect + max(robot.radius / 2, 1e-3)
         while True:
             pi, ci = np.nonzero(bounds < threshold)
             order = np.argsort(bounds[pi, ci], kind="stable")
             for k in order:
-                lb = bounds[pi[k], ci[k]]
-                if lb >= best:
+                if bounds[pi[k], ci[k]] >= best:
                     break
                 p, c = int(pi[k]), int(ci[k])
-                self.place(body, robot, xy[p, 0], xy[p, 1])
-                d = self.distance(body, robot, c)
+                d = measure(p, c)
                 queries += 1
                 if d < best:
-                    best, where, who = float(d), p, self.names[c]
+                    best, at, who = float(d), p, self.names[c]
                 bounds[p, c] = np.inf  # measured: never again
             if best < threshold or np.all(np.isinf(bounds)):
-                return Nearest(best, where, who, queries)
+                return Nearest(best, at, who, queries, tuple(float(v) for v in where[at]))
             # Nothing close enough: widen to every pair (rare: wide-open worlds).
             threshold = np.inf
+
+
+def _point_box(p: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Distance from points to axis-aligned rectangles (0 inside); arrays broadcast, last axis (x, y)."""
+    g = np.maximum(np.maximum(lo - p, p - hi), 0.0)
+    return np.sqrt(g[..., 0] ** 2 + g[..., 1] ** 2)
+
+
+def _point_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    ab = b - a
+    den = np.maximum(ab[..., 0] ** 2 + ab[..., 1] ** 2, 1e-300)
+    t = np.clip(((p - a) * ab).sum(axis=-1) / den, 0.0, 1.0)
+    d = p - a - t[..., None] * ab
+    return np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
+
+
+def _crosses_box(a: np.ndarray, b: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """True where segment ab meets the rectangle [lo, hi] (Liang-Barsky clipping); arrays broadcast."""
+    d = b - a
+    t0 = np.zeros(np.broadcast_shapes(a.shape, lo.shape)[:-1])
+    t1 = np.ones_like(t0)
+    ok = np.ones_like(t0, dtype=bool)
+    for k in (0, 1):
+        dk = np.broadcast_to(d[..., k], t0.shape)
+        ak = np.broadcast_to(a[..., k], t0.shape)
+        lok = np.broadcast_to(lo[..., k], t0.shape)
+        hik = np.broadcast_to(hi[..., k], t0.shape)
+        still = dk == 0
+        ok &= ~still | ((ak >= lok) & (ak <= hik))
+        safe = np.where(still, 1.0, dk)
+        ta, tb = (lok - ak) / safe, (hik - ak) / safe
+        enter = np.where(still, -np.inf, np.minimum(ta, tb))
+        leave = np.where(still, np.inf, np.maximum(ta, tb))
+        t0 = np.maximum(t0, enter)
+        t1 = np.minimum(t1, leave)
+    return ok & (t0 <= t1)

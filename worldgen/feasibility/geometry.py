@@ -1,7 +1,6 @@
-"""Exact 2-D distances between the robot's path and obstacle footprints, vectorised.
+"""Obstacle footprints as flat arrays, and exact 2-D point and segment distances, vectorised.
 
-The planner asks two questions many times: how far is a point from the nearest
-obstacle, and how close does a straight segment come to one. Footprints are
+Footprints are
 discs or convex polygons (see :mod:`worldgen.footprint`); here they are kept as
 flat numpy arrays (disc centres and radii; every polygon edge with its owner)
 so one call answers for many points or segments without a Python loop per
@@ -20,7 +19,7 @@ from shapely.geometry.polygon import orient
 
 from worldgen.footprint import Footprint
 
-__all__ = ["Obstacles2D", "point_segment_distance", "segment_segment_distance", "inside_bounds"]
+__all__ = ["Obstacles2D", "point_segment_distance", "segment_segment_distance"]
 
 
 def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -33,16 +32,6 @@ def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nd
     dx = apx - t * abx
     dy = apy - t * aby
     return np.sqrt(dx * dx + dy * dy)
-
-
-def inside_bounds(bounds, pts: np.ndarray, radius: float) -> np.ndarray:
-    """(n,) bool: the disc of ``radius`` round each of the (n, 2) points lies within ``bounds``.
-
-    The bounds are convex, so a segment whose two ends pass keeps the disc inside throughout.
-    """
-    (x0, y0), (x1, y1) = bounds
-    return ((pts[:, 0] - radius >= x0) & (pts[:, 0] + radius <= x1)
-            & (pts[:, 1] - radius >= y0) & (pts[:, 1] + radius <= y1))
 
 
 def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -72,8 +61,7 @@ class Obstacles2D:
     vertex rings ``poly_vertices`` (list of (k, 2)), their edges flattened into
     ``edge_a``/``edge_b`` (ne, 2) with ``edge_owner`` (ne,) polygon index and
     ``edge_start`` (np + 1,) offsets; ``boxes`` (n, 4) minx, miny, maxx, maxy
-    per obstacle id; ``names`` per obstacle id; ``is_rect`` (np,) True for
-    polygons that are rectangles (yawed boxes), which have cheaper distances.
+    per obstacle id; ``names`` per obstacle id.
     """
 
     disc_xy: np.ndarray
@@ -85,7 +73,6 @@ class Obstacles2D:
     edge_start: np.ndarray
     boxes: np.ndarray
     names: tuple
-    is_rect: np.ndarray
 
     @classmethod
     def from_footprints(cls, footprints: list[Footprint]) -> "Obstacles2D":
@@ -107,14 +94,7 @@ class Obstacles2D:
         owner = np.repeat(np.arange(len(rings)), counts)
         boxes = np.array([f.bounds() for f in discs] + [f.bounds() for f in polys], dtype=float).reshape(-1, 4)
         names = tuple(f.name for f in discs) + tuple(f.name for f in polys)
-        is_rect = np.zeros(len(rings), dtype=bool)
-        four = np.nonzero(counts == 4)[0]
-        if len(four):
-            e = np.stack([edge_b[start[k]:start[k] + 4] - edge_a[start[k]:start[k] + 4] for k in four])
-            dots = np.abs(np.einsum("kij,kij->ki", e, np.roll(e, -1, axis=1)))
-            scale = np.einsum("kij,kij->ki", e, e).max(axis=1)
-            is_rect[four] = np.all(dots <= 1e-9 * scale[:, None], axis=1)
-        return cls(disc_xy, disc_r, tuple(rings), edge_a, edge_b, owner, start, boxes, names, is_rect)
+        return cls(disc_xy, disc_r, tuple(rings), edge_a, edge_b, owner, start, boxes, names)
 
     @property
     def n_discs(self) -> int:
@@ -183,10 +163,6 @@ class Obstacles2D:
         """
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         return self.segments_distance(xy, xy, np.inf)
-
-    def corners(self, obstacle: int) -> np.ndarray:
-        """(k, 2) vertices of polygon obstacle ``obstacle`` (an obstacle id)."""
-        return self.poly_vertices[obstacle - self.n_discs]
 
 
 def _take_min(best: np.ndarray, which: np.ndarray, rows: np.ndarray, ids: np.ndarray, d: np.ndarray) -> None:

@@ -1,126 +1,165 @@
-"""The narrowest passage of a task: the widest disc that can still get from spawn to goal.
+"""The narrowest passage of a task: the widest disc that can still get from spawn to goal, exactly.
 
-A disc of radius r can travel where the clearance field is at least r, so the
-bottleneck radius is the largest r for which the spawn's and the goal's cells
-lie in one connected region of ``field >= r`` (never more than the clearance
-of the spawn or the goal themselves). It is found by bisection over r, each
-step one connected-component labelling of the grid.
+A disc of radius r fits wherever its centre keeps r from every footprint and
+from the bounds' edges. As r grows, the footprints grown by r (and the outside
+of the bounds, grown inwards) start to touch, pair by pair, each pair at half
+its gap. Spawn and goal become separated exactly when the grown pieces that
+touch form a closed chain with the spawn on one side and the goal on the other:
+a cycle whose winding number about the spawn differs from that about the goal.
 
-Accuracy: the field is exact at cell centres, but connectivity is judged
-between neighbouring centres (8-connected), so the grid's width (2 x radius)
-is good to about one grid resolution ``h`` (the report's ``resolution``; a
-little more was measured, up to 1.2 h). :func:`exact_width` then snaps it to
-the exact gap between the two obstacles that explain it, so a corridor of width
-w reports w; where no pair explains it, the grid's figure stands.
+So: sort every gap narrower than the ends' own clearance, join the pieces in
+that order (Kruskal), and carry along each join the angle that a curve through
+the two pieces (piece anchor -> touching point -> piece anchor, inside the
+grown pieces) sweeps about the spawn minus the angle about the goal. A union-find
+keeps these angles as potentials; the first join that closes a cycle with a
+non-zero total (a multiple of 2 pi) separates the ends, and half its gap is the
+bottleneck radius. Without such a join, the ends' clearance is. Exact up to the
+gaps' own floating-point distances (GEOS for polygons, closed forms for discs).
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from scipy import ndimage
+import shapely
 
-from worldgen.feasibility.field import DistanceField
-from worldgen.feasibility.portals import gaps
+from worldgen.feasibility.geometry import Obstacles2D
 
-__all__ = ["bottleneck_radius", "extend_field", "exact_width"]
-
-_EIGHT = np.ones((3, 3), dtype=bool)
-#: Probes along a gap, each way, in cells, looking for a free point on the route (see exact_width).
-_PROBES = 12
+__all__ = ["narrowest_passage"]
 
 
-def extend_field(field: DistanceField) -> DistanceField:
-    """The field with the cells it capped filled in from a Euclidean distance transform.
+def narrowest_passage(obstacles: Obstacles2D, bounds, start, goal) -> float:
+    """Diameter (m) of the widest disc that can travel from ``start`` to ``goal`` (0 if none fits at either)."""
+    (x0, y0), (x1, y1) = bounds
+    ends = np.array([start, goal], dtype=float).reshape(2, 2)
+    box_gap = np.minimum(np.minimum(ends[:, 0] - x0, x1 - ends[:, 0]), np.minimum(ends[:, 1] - y0, y1 - ends[:, 1]))
+    obs_gap = obstacles.points_distance(ends)[0]
+    limit = float(np.min(np.minimum(box_gap, obs_gap)))
+    if limit <= 0:
+        return 0.0
+    joins = _joins(obstacles, bounds, 2 * limit)
+    s, g = ends
+    n = len(obstacles) + 4
+    parent = list(range(n))
+    potential = [0.0] * n  # angle from a piece to its parent
 
-    A capped cell c gets D(q) + |c - q|, where q is the nearest cell of the exact
-    band (values below cap) and D(q) its exact clearance: an upper bound on c's
-    clearance (distance is 1-Lipschitz) that is tight when q lies on the way from
-    c to its nearest obstacle, as it does up to the grid's resolution. One C pass
-    over the grid instead of exact distances to every obstacle far out; the
-    passage figure stays accurate to about a grid cell.
-    """
-    g = field.grid
-    capped = field.values >= field.cap
-    if not capped.any() or capped.all():
-        return field
-    reach, (qi, qj) = ndimage.distance_transform_edt(capped, sampling=(g.hx, g.hy), return_indices=True)
-    values = np.where(capped, field.values[qi, qj] + reach, field.values)
-    return DistanceField(g, values, float(values.max()))
+    def find(u: int) -> tuple[int, float]:
+        total = 0.0
+        path = []
+        while parent[u] != u:
+            path.append(u)
+            total += potential[u]
+            u = parent[u]
+        # Compress: every piece on the way points at the root with its summed angle.
+        acc = total
+        for v in path:
+            step = potential[v]
+            parent[v], potential[v] = u, acc
+            acc -= step
+        return u, total
 
-
-def bottleneck_radius(field: DistanceField, start: np.ndarray, goal: np.ndarray, low: float, high: float) -> float:
-    """Largest r in [low, high] with start and goal connected through cells of clearance >= r.
-
-    ``low`` must be a radius known to connect them (e.g. the inflation radius of
-    a found path) and ``high`` an upper bound (the smaller of the endpoints'
-    exact clearances, and at most the field's cap). Returns ``low`` if even a
-    hair more does not connect.
-    """
-    g = field.grid
-    si, sj = (int(v[0]) for v in g.cell_of(start))
-    gi, gj = (int(v[0]) for v in g.cell_of(goal))
-    tol = min(g.hx, g.hy) / 8
-
-    def connected(r: float) -> bool:
-        labels, _ = ndimage.label(field.values >= r, structure=_EIGHT)
-        a = labels[max(si - 1, 0):si + 2, max(sj - 1, 0):sj + 2]
-        b = labels[max(gi - 1, 0):gi + 2, max(gj - 1, 0):gj + 2]
-        common = np.intersect1d(a[a > 0], b[b > 0])
-        return len(common) > 0
-
-    if high <= low:
-        return high
-    if connected(high):
-        return high
-    while high - low > tol:
-        mid = 0.5 * (low + high)
-        if connected(mid):
-            low = mid
-        else:
-            high = mid
-    return low
+    for gap, a, b, anchor_a, touch, anchor_b in joins:
+        if gap >= 2 * limit:
+            break
+        turn = (_sweep(anchor_a, touch, s) + _sweep(touch, anchor_b, s)) - (
+            _sweep(anchor_a, touch, g) + _sweep(touch, anchor_b, g))
+        ra, pa = find(a)
+        rb, pb = find(b)
+        if ra == rb:
+            if abs(pa + turn - pb) > math.pi:
+                return max(gap, 0.0)
+            continue
+        # potential[u] = phi(u) - phi(parent); the join asks phi(b) = phi(a) + turn.
+        parent[rb] = ra
+        potential[rb] = pa + turn - pb
+    return 2 * limit
 
 
-def exact_width(width: float, field: DistanceField, obstacles, start: np.ndarray, goal: np.ndarray) -> float:
-    """The grid's passage ``width`` snapped to the exact gap between two obstacles that explains it.
+def _sweep(a, b, z) -> float:
+    """Angle (rad) the segment from ``a`` to ``b`` sweeps about ``z`` (counter-clockwise positive)."""
+    ax, ay = a[0] - z[0], a[1] - z[1]
+    bx, by = b[0] - z[0], b[1] - z[1]
+    return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
 
-    With convex obstacles, the narrowest point of the widest route is the gap
-    between two of them (the segment between their closest points), so the true
-    width is one of those gaps. The grid's figure is within about a cell of it:
-    take the gap in that band whose midpoint lies on the spawn-goal side of the
-    field at that level, is no nearer any third obstacle, and is closest to the
-    grid's figure plus half a cell (its usual shortfall). Where no gap fits (the
-    bottleneck is the edge of the bounds, say), the grid's figure stands.
-    """
-    g = field.grid
-    cell = max(g.hx, g.hy)
-    lo, hi = width - 1.5 * cell, width + 2.5 * cell
-    found = [(w, m, n) for w, m, n in gaps(obstacles, hi) if w >= lo]
-    if not found:
-        return width
-    labels, _ = ndimage.label(field.values >= max(width / 2 - cell, 0.0), structure=_EIGHT)
-    si, sj = (int(v[0]) for v in g.cell_of(start))
-    gi, gj = (int(v[0]) for v in g.cell_of(goal))
-    a = labels[max(si - 1, 0):si + 2, max(sj - 1, 0):sj + 2]
-    b = labels[max(gi - 1, 0):gi + 2, max(gj - 1, 0):gj + 2]
-    route = np.intersect1d(a[a > 0], b[b > 0])
-    widths = np.array([w for w, _, _ in found])
-    # Closest points are not unique between parallel walls, and the pair found may sit at a
-    # corridor's closed end: probe along the gap (its normal) for a point of the same clearance.
-    shifts = np.arange(-_PROBES, _PROBES + 1) * cell
-    probes = np.concatenate([m + shifts[:, None] * n for _, m, n in found])
-    owner = np.repeat(np.arange(len(found)), len(shifts))
-    pi, pj = g.cell_of(probes)
-    (x0, y0) = g.origin
-    inside = ((probes[:, 0] > x0) & (probes[:, 0] < x0 + g.nx * g.hx)
-              & (probes[:, 1] > y0) & (probes[:, 1] < y0 + g.ny * g.hy))
-    on_route = inside & np.isin(labels[pi, pj], route) & (labels[pi, pj] > 0)
-    # A third obstacle nearer the probe than half the gap closes the gap there.
-    # (A bounded query: only obstacles within half the widest gap can close one.)
-    free = obstacles.segments_distance(probes, probes, float(widths.max()) / 2)[0] >= widths[owner] / 2 - 1e-9
-    keep = np.zeros(len(found), dtype=bool)
-    np.logical_or.at(keep, owner, on_route & free)
-    if not keep.any():
-        return width
-    widths = widths[keep]
-    return float(widths[np.argmin(np.abs(widths - (width + 0.5 * cell)))])
+
+def _joins(obstacles: Obstacles2D, bounds, reach: float):
+    """(gap, piece a, piece b, anchor a, touching point, anchor b) for every pair of pieces closer than
+    ``reach``, sorted by gap. Pieces: the obstacles, then the outside of the bounds beyond each edge
+    (left, bottom, right, top), each a half-plane."""
+    (x0, y0), (x1, y1) = bounds
+    n = len(obstacles)
+    nd = obstacles.n_discs
+    far = (x1 - x0) + (y1 - y0) + 1.0
+    xc, yc = (x0 + x1) / 2, (y0 + y1) / 2
+    anchors = [tuple(obstacles.disc_xy[i]) for i in range(nd)]
+    anchors += [tuple(ring.mean(axis=0)) for ring in obstacles.poly_vertices]
+    anchors += [(x0 - far, yc), (xc, y0 - far), (x1 + far, yc), (xc, y1 + far)]
+    out = []
+    # Neighbouring half-planes always meet, at the bounds' corners.
+    corners = ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+    for k in range(4):
+        a, b = n + k, n + (k + 1) % 4
+        out.append((0.0, a, b, anchors[a], corners[k], anchors[b]))
+    boxes = obstacles.boxes
+    # Obstacles and the bounds: the gap between the obstacle's extreme point and the edge.
+    for k, (axis, sign, edge) in enumerate(((0, -1, x0), (1, -1, y0), (0, 1, x1), (1, 1, y1))):
+        extreme = boxes[:, axis] if sign < 0 else boxes[:, axis + 2]
+        gap = (extreme - edge) * -sign
+        for i in np.flatnonzero(gap < reach):
+            point = _extreme_point(obstacles, int(i), axis, sign)
+            touch = list(point)
+            touch[axis] = edge - sign * gap[i] / 2 if gap[i] > 0 else point[axis]
+            out.append((float(gap[i]), int(i), n + k, anchors[i], tuple(touch), anchors[n + k]))
+    # Obstacle pairs: candidates by their boxes, then exact gaps and the midpoint of the closest pair.
+    if n > 1:
+        lo, hi = boxes[:, :2], boxes[:, 2:]
+        envelopes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
+        tree = shapely.STRtree(envelopes)
+        grown = shapely.box(lo[:, 0] - reach, lo[:, 1] - reach, hi[:, 0] + reach, hi[:, 1] + reach)
+        qi, ti = tree.query(grown)
+        keep = qi < ti
+        for i, j, gap, touch in zip(*_pair_gaps(obstacles, qi[keep], ti[keep])):
+            if gap < reach:
+                out.append((gap, int(i), int(j), anchors[i], touch, anchors[j]))
+    out.sort(key=lambda e: (e[0], e[1], e[2]))
+    return out
+
+
+def _extreme_point(obstacles: Obstacles2D, i: int, axis: int, sign: int) -> tuple[float, float]:
+    """The point of footprint ``i`` farthest along ``sign`` on ``axis``."""
+    nd = obstacles.n_discs
+    if i < nd:
+        c = obstacles.disc_xy[i].copy()
+        c[axis] += sign * obstacles.disc_r[i]
+        return (float(c[0]), float(c[1]))
+    ring = obstacles.poly_vertices[i - nd]
+    k = int(np.argmax(sign * ring[:, axis]))
+    return (float(ring[k, 0]), float(ring[k, 1]))
+
+
+def _pair_gaps(obstacles: Obstacles2D, i: np.ndarray, j: np.ndarray):
+    """(i, j, gap, touching point) per pair of obstacle ids: the exact gap between the footprints
+    (negative or 0 where they overlap) and the point where their grown copies first touch."""
+    shapes = np.array([shapely.Point(c) for c in obstacles.disc_xy]
+                      + [shapely.Polygon(r) for r in obstacles.poly_vertices], dtype=object)
+    radius = np.concatenate([obstacles.disc_r, np.zeros(len(obstacles.poly_vertices))])
+    gaps, touches = [], []
+    if len(i):
+        lines = shapely.shortest_line(shapes[i], shapes[j])
+        coords = shapely.get_coordinates(lines).reshape(-1, 2, 2)
+    else:
+        coords = np.zeros((0, 2, 2))
+    for k in range(len(i)):
+        p, q = coords[k]  # nearest points of the two cores (a disc's core is its centre)
+        d = float(math.hypot(q[0] - p[0], q[1] - p[1]))
+        ra, rb = radius[i[k]], radius[j[k]]
+        gap = d - ra - rb
+        u = (q - p) / d if d > 0 else np.zeros(2)
+        if gap > 0:  # the midpoint of the footprints' nearest points, where the grown copies meet
+            touch = (p + ra * u + q - rb * u) / 2
+        else:  # a point of both footprints
+            touch = p + min(ra, d) * u
+        gaps.append(gap)
+        touches.append((float(touch[0]), float(touch[1])))
+    return i, j, gaps, touches

@@ -1,202 +1,467 @@
-"""Graph search on the clearance field, then string-pulling: a safe, nearly taut path.
+"""The exact shortest path for a disc: A* over the tangent visibility graph, built lazily.
 
-The grid search only has to find *which way round* the obstacles the shortest
-path goes; :mod:`worldgen.feasibility.taut` then makes it exact. Moves are
-16-connected (the 8 neighbours plus the knight moves), so the grid path's
-length is within about 2.7 % of the straight line in any direction, and an edge
-is allowed only when the field proves the whole move free:
+Nodes are the points where a common tangent (see :mod:`~worldgen.feasibility.tangents`)
+touches a corner circle, together with the side the path winds round it.
+From a node the path follows the circle's arc the way it winds (an arc inside
+the circle's cone, clear of every other obstacle) and leaves on another tangent
+of the same side: to another obstacle, to the goal, or (for a polygon corner)
+along the grown edge to the next corner. The graph holds every taut path, so
+the search returns the true optimum; its length counts the arcs exactly.
 
-    distance is 1-Lipschitz, so along a move of length L between centres with
-    clearances da and db, the clearance never drops below (da + db - L) / 2.
+Nothing is built ahead:
 
-String-pulling keeps the path provably free the same way: a shortcut is taken
-only where samples along it, each bounded from its cell's exact value, stay
-above the inflation radius.
-
-That proof needs about two cells to spare, so gaps between obstacles that are
-only a little wider than the disc would be invisible to the search; the
-portals of :mod:`worldgen.feasibility.portals` (checked with exact distances)
-are added to the graph as extra nodes so that the search can use them.
+- A node asks for tangents only to the obstacles that could still lie on a
+  path of length ``f`` through it (``g + |p - x| + |x - goal|`` over the
+  obstacle's bounding disc), and comes back for the others when the search
+  reaches their bound (partial expansion).
+- Tangents between two obstacles are computed once and shared by every node on them.
+- A node reached no cheaper than an already expanded node on the same circle
+  can reach it along the arc is skipped (it is dominated).
+- Nodes whose keys lie within :data:`BATCH` of the smallest are expanded
+  together, so that the geometry runs in few, large vectorised calls. Expanding
+  a node a little early never loses the optimum: every node stays reachable,
+  and the search stops only when no key left is below the best path found.
 """
 
 from __future__ import annotations
 
+import heapq
 import math
-from typing import Optional, Sequence
+from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
-from scipy.sparse import csr_matrix
-from scipy.sparse.csgraph import dijkstra
 
-from worldgen.feasibility.field import DistanceField, Grid
-from worldgen.feasibility.geometry import Obstacles2D
-from worldgen.feasibility.portals import LINK_CELLS, Portal, exact_links
+from worldgen.feasibility.cspace import ConfigSpace
+from worldgen.feasibility.tangents import Tangents, every_side, tangents
 
-__all__ = ["MOVES", "grid_path", "field_clear", "string_pull"]
+__all__ = ["Contact", "Route", "Planner", "waypoints", "MAX_ARC_STEP"]
 
-#: The 16 moves (di, dj) of the search, both directions of each.
-MOVES = np.array(
-    [(1, 0), (0, 1), (1, 1), (1, -1), (2, 1), (1, 2), (2, -1), (1, -2)]
-    + [(-1, 0), (0, -1), (-1, -1), (-1, 1), (-2, -1), (-1, -2), (-2, 1), (-1, 2)],
-    dtype=np.int64,
-)
+#: Slack (m) added to a node's bound when it asks for tangents, so that one
+#: request covers the obstacles just beyond it.
+BAND = 0.25
+#: At least this many obstacles per request, for the same reason.
+MIN_BATCH = 16
+#: Nodes whose keys lie within this (m) of the smallest are expanded together.
+BATCH = 0.5
+#: Largest angle (rad) one straight piece of a written arc may turn: the polygon round an arc
+#: is then at most 0.33 % longer than the arc.
+MAX_ARC_STEP = math.pi / 16
 
 
+@dataclass(frozen=True)
+class Contact:
+    """The path winding round ``circle`` on ``side`` (+1 counter-clockwise) from outward normal angle
+    ``start`` (rad) over ``sweep`` (rad, >= 0), in the direction of travel."""
 
-def field_clear(field: DistanceField, a: np.ndarray, b: np.ndarray, radius: float) -> np.ndarray:
-    """(m,) bool: True where the field proves segment ``a[k]b[k]`` keeps more than ``radius``.
+    circle: int
+    side: int
+    start: float
+    sweep: float
 
-    Samples at spacing <= one cell; each sample's clearance is bounded below by
-    its cell's exact value minus the distance to that cell's centre, and between
-    samples by half the spacing.
+
+@dataclass(frozen=True)
+class Route:
+    """A taut path: the straight legs' ends ``points`` (k, 2) (spawn, then for each contact its
+    arrival and departure point, then goal), ``contacts`` between them, and the exact ``length``."""
+
+    points: np.ndarray
+    contacts: tuple[Contact, ...]
+    length: float
+
+
+class _Node:
+    __slots__ = ("circle", "side", "normal", "point", "g", "parent", "lb", "done", "rel")
+
+    def __init__(self, circle, side, normal, point, g, parent):
+        self.circle = circle
+        self.side = side
+        self.normal = normal
+        self.point = point
+        self.g = g
+        self.parent = parent  # (parent node index, departure normal, departure point); None at the start
+        self.lb = None  # per-obstacle bounds, once expanded
+        self.done = -math.inf  # bound up to which tangents were taken
+        self.rel = 0.0  # the arrival's angle within the circle's cone
+
+
+class _Candidates:
+    """Ways out of expanded nodes, gathered for one vectorised pass: parallel lists of arrays."""
+
+    def __init__(self):
+        self.parts: list[tuple] = []
+
+    def add(self, node_index: np.ndarray, tans: Tangents) -> None:
+        if len(tans):
+            self.parts.append((node_index, tans))
+
+    def merged(self):
+        if not self.parts:
+            return None, None
+        idx = np.concatenate([p[0] for p in self.parts])
+        return idx, Tangents.concat([p[1] for p in self.parts])
+
+
+class Planner:
+    """Shortest paths in one configuration space; tangents between obstacles are shared by every query."""
+
+    def __init__(self, cs: ConfigSpace):
+        self.cs = cs
+        n = len(cs.obstacles)
+        self._have: dict[int, np.ndarray] = {}
+        self._parts: dict[int, list[Tangents]] = {}
+        self._table_cache: dict[int, Tangents] = {}
+        self._angle0 = np.arctan2(cs.cone_a[:, 1], cs.cone_a[:, 0])
+        self._full = cs.full
+        self._hull_max = float(cs.hull_r.max()) if n else 0.0
+        self._arc_free = self._lonely_circles()
+        self._edges = self._grown_edges()
+
+    # -- the search --------------------------------------------------------
+    def shortest(self, start, goal) -> Optional[Route]:
+        """The shortest path from ``start`` to ``goal`` ((2,) each, both free), or None if there is none."""
+        cs = self.cs
+        start = np.asarray(start, dtype=float)
+        goal = np.asarray(goal, dtype=float)
+        if cs.segments_clear(start[None], goal[None])[0]:
+            return Route(np.array([start, goal]), (), float(np.hypot(*(goal - start))))
+        self._goal = goal
+        self._nodes: list[_Node] = [_Node(-1, 0, None, start, 0.0, None)]
+        self._heap = [(float(np.hypot(*(goal - start))), 0, 0)]
+        self._tie = 1
+        self._expanded: dict[tuple[int, int], list[tuple[float, float]]] = {}
+        self._best = (math.inf, None)
+        heap = self._heap
+        while heap and heap[0][0] < self._best[0] - 1e-12:
+            limit = heap[0][0] + BATCH
+            batch = []
+            while heap and heap[0][0] <= limit and heap[0][0] < self._best[0] - 1e-12:
+                key, _, i = heapq.heappop(heap)
+                batch.append((key, i))
+            self._expand(batch)
+        if self._best[1] is None:
+            return None
+        return self._route(start, goal)
+
+    def _push(self, node: _Node) -> None:
+        self._nodes.append(node)
+        key = node.g + math.hypot(self._goal[0] - node.point[0], self._goal[1] - node.point[1])
+        heapq.heappush(self._heap, (key, self._tie, len(self._nodes) - 1))
+        self._tie += 1
+
+    def _expand(self, batch: list[tuple[float, int]]) -> None:
+        cs, nodes, goal = self.cs, self._nodes, self._goal
+        live = []
+        fresh_circles = []
+        for key, i in batch:
+            node = nodes[i]
+            if node.lb is None:
+                if node.circle >= 0:
+                    node.rel = self._rel(node.circle, node.normal)
+                    if self._dominated(node):
+                        continue
+                    self._expanded.setdefault((node.circle, node.side), []).append((node.rel, node.g))
+                    fresh_circles.append(i)
+                node.lb = self._bounds(node)
+            live.append((key, i))
+        out = _Candidates()
+        goals = _Candidates()
+        # Fresh nodes on circles: straight to the goal, and along the grown edge to the next corner.
+        if fresh_circles:
+            idx = np.array(fresh_circles)
+            circles = np.array([nodes[i].circle for i in fresh_circles])
+            sides = np.array([nodes[i].side for i in fresh_circles])
+            # Tangents to the goal once per (circle, side); every node there may take them.
+            key = circles * 2 + (sides < 0)
+            uniq, first = np.unique(key, return_index=True)
+            among = self._blockers([nodes[i] for i in fresh_circles], None)
+            tans = tangents(cs, circles[first], np.full(len(first), -1), sides[first],
+                            np.ones(len(first), dtype=np.int64), dst_xy=goal, among=among)
+            if len(tans):
+                tkey = tans.src * 2 + (tans.s1 < 0)
+                for k in range(len(idx)):
+                    rows = np.flatnonzero(tkey == key[k])
+                    goals.add(np.full(len(rows), idx[k]), tans.take(rows))
+            edge_rows = self._edges.pick(circles, sides)
+            keep = edge_rows >= 0
+            out.add(idx[keep], self._edges.tans.take(edge_rows[keep]))
+        # Departures to the obstacles in each node's band.
+        requests = []
+        for key, i in live:
+            node = nodes[i]
+            band, upto = self._band(node, key + BAND)
+            node.done = upto
+            rest = node.lb[node.lb > upto]
+            if len(rest):
+                heapq.heappush(self._heap, (float(rest.min()), self._tie, i))
+                self._tie += 1
+            if len(band):
+                requests.append((i, band, upto))
+        if requests:
+            self._fill_tables(requests)
+            for i, band, _ in requests:
+                node = nodes[i]
+                if node.circle < 0:
+                    dst = _circles_of(cs, band)
+                    src, dst, s1, s2 = every_side(np.full(len(dst), -1), dst, (1,), (1, -1))
+                    tans = tangents(cs, src, dst, s1, s2, src_xy=node.point, among=self._blockers([node], None))
+                    out.add(np.full(len(tans), i), tans)
+                    continue
+                table = self._table_cache[int(cs.owner[node.circle])]
+                wanted = np.zeros(len(cs.obstacles), dtype=bool)
+                wanted[band] = True
+                rows = np.flatnonzero((table.src == node.circle) & (table.s1 == node.side)
+                                      & wanted[cs.owner[table.dst]])
+                out.add(np.full(len(rows), i), table.take(rows))
+        idx, tans = goals.merged()
+        if idx is not None:
+            g = self._leave(idx, tans)
+            k = int(np.argmin(g))
+            if g[k] < self._best[0]:
+                self._best = (float(g[k]), (int(idx[k]), tans.nq[k], tans.q[k]))
+        idx, tans = out.merged()
+        if idx is not None:
+            g = self._leave(idx, tans)
+            for r in np.flatnonzero(np.isfinite(g)):
+                self._push(_Node(int(tans.dst[r]), int(tans.s2[r]), tans.nt[r], tans.t[r], float(g[r]),
+                                 (int(idx[r]), tans.nq[r], tans.q[r])))
+
+    def _leave(self, idx: np.ndarray, tans: Tangents) -> np.ndarray:
+        """(m,) cost at the far end of each tangent, leaving node ``idx[k]`` along its arc (inf if blocked)."""
+        nodes = self._nodes
+        g = np.array([nodes[i].g for i in idx]) + tans.length
+        on = np.flatnonzero(tans.src >= 0)
+        if len(on) == 0:
+            return g
+        circle = tans.src[on]
+        side = tans.s1[on]
+        rel_in = np.array([nodes[i].rel for i in idx[on]])
+        rel_out = self._rel_many(circle, tans.nq[on])
+        sweep = (rel_out - rel_in) * side
+        full = self._full[circle]
+        sweep = np.where(full, np.mod(sweep, 2 * np.pi), sweep)
+        sweep = np.where(full & (sweep > 2 * np.pi - 1e-9), 0.0, sweep)
+        sweep = np.where(~full & (sweep < 0) & (sweep > -1e-9), 0.0, sweep)
+        ok = sweep >= 0
+        check = np.flatnonzero(ok & (sweep > 0) & ~self._arc_free[circle])
+        if len(check):
+            start = self._angle0[circle[check]] + np.where(side[check] > 0, rel_in[check], rel_out[check])
+            slack = self.cs.arc_clearance(circle[check], start, sweep[check])
+            ok[check[slack < -1e-9]] = False
+        g[on] = np.where(ok, g[on] + self.cs.rho[circle] * np.maximum(sweep, 0.0), np.inf)
+        return g
+
+    # -- bounds, bands and tables --------------------------------------------
+    def _bounds(self, node: _Node) -> np.ndarray:
+        """(N,) lower bound on the length of any path through ``node`` whose next obstacle is each obstacle.
+
+        The path goes on through a point x of the obstacle's bounding disc (centre c,
+        radius r), so it is at least g + |p - x| + |x - goal|, which is at least both
+        |p - c| + |c - goal| - 2 r and, for x at distance d >= (distance from c to the
+        line p-goal) - r from that line, 2 sqrt((|p - goal| / 2)^2 + d^2).
+        """
+        cs, goal = self.cs, self._goal
+        p = node.point
+        dx, dy = cs.hull_c[:, 0] - p[0], cs.hull_c[:, 1] - p[1]
+        gx, gy = cs.hull_c[:, 0] - goal[0], cs.hull_c[:, 1] - goal[1]
+        via = np.sqrt(dx * dx + dy * dy) + np.sqrt(gx * gx + gy * gy) - 2 * cs.hull_r
+        ux, uy = goal[0] - p[0], goal[1] - p[1]
+        span = math.hypot(ux, uy)
+        if span > 0:
+            off = np.maximum(np.abs(dx * uy - dy * ux) / span - cs.hull_r, 0.0)
+            via = np.maximum(via, 2 * np.sqrt(span * span / 4 + off * off))
+        lb = node.g + np.maximum(via, span)
+        if node.circle >= 0:
+            lb[cs.owner[node.circle]] = np.inf
+        return lb
+
+    def _band(self, node: _Node, hi: float) -> tuple[np.ndarray, float]:
+        """The obstacles whose bound lies in (node.done, hi], at least :data:`MIN_BATCH` of them when there
+        are; and the bound up to which obstacles are then taken."""
+        todo = node.lb > node.done
+        band = np.flatnonzero(todo & (node.lb <= hi))
+        if len(band) < MIN_BATCH:
+            rest = np.flatnonzero(todo & np.isfinite(node.lb))
+            if len(rest) <= MIN_BATCH:
+                band = rest
+            else:
+                band = rest[np.argpartition(node.lb[rest], MIN_BATCH - 1)[:MIN_BATCH]]
+        upto = max(hi, float(node.lb[band].max())) if len(band) else hi
+        return band, upto
+
+    def _blockers(self, nodes: list[_Node], upto: Optional[float]) -> np.ndarray:
+        """Ids of the obstacles that can meet a tangent leaving any of ``nodes``' obstacles towards one
+        whose bound is at most ``upto`` (each node's own ``done`` when None), or towards the goal.
+
+        With phi(x) = |p - x| + |x - goal| (convex), such a tangent runs between a point
+        of the node's obstacle's bounding disc and one of the other's (or the goal),
+        where phi is at most (upto - g) + 4 r_max (r_max: the largest bounding radius);
+        so does any obstacle it meets, whose bound is then at most upto + 4 r_max.
+        """
+        near = np.zeros(len(self.cs.obstacles), dtype=bool)
+        for node in nodes:
+            reach = node.done if upto is None else upto
+            reach = max(reach, node.g + math.hypot(self._goal[0] - node.point[0], self._goal[1] - node.point[1]))
+            near |= node.lb <= reach + 4 * self._hull_max
+        return np.flatnonzero(near)
+
+    def _fill_tables(self, requests) -> None:
+        """Compute, in one call, every tangent the requests need that no earlier request did."""
+        cs = self.cs
+        src_parts, dst_parts, nodes = [], [], []
+        by_obstacle: dict[int, list[np.ndarray]] = {}
+        for i, band, _ in requests:
+            node = self._nodes[i]
+            if node.circle < 0:
+                continue
+            a = int(cs.owner[node.circle])
+            have = self._have.setdefault(a, np.zeros(len(cs.obstacles), dtype=bool))
+            todo = band[~have[band]]
+            if len(todo):
+                have[todo] = True
+                by_obstacle.setdefault(a, []).append(todo)
+                nodes.append(node)
+        if not by_obstacle:
+            return
+        for a, lists in by_obstacle.items():
+            todo = np.concatenate(lists)
+            src_c = np.arange(cs.first[a], cs.first[a + 1])
+            dst_c = _circles_of(cs, todo)
+            src_parts.append(np.repeat(src_c, len(dst_c)))
+            dst_parts.append(np.tile(dst_c, len(src_c)))
+        src, dst, s1, s2 = every_side(np.concatenate(src_parts), np.concatenate(dst_parts))
+        tans = tangents(cs, src, dst, s1, s2, among=self._blockers(nodes, None))
+        owner = cs.owner[tans.src]
+        for a in by_obstacle:
+            self._parts.setdefault(a, []).append(tans.take(np.flatnonzero(owner == a)))
+            self._table_cache[a] = Tangents.concat(self._parts[a])
+
+    # -- arcs --------------------------------------------------------------
+    def _rel(self, circle: int, normal: np.ndarray) -> float:
+        return float(self._rel_many(np.array([circle]), normal[None])[0])
+
+    def _rel_many(self, circle: np.ndarray, normals: np.ndarray) -> np.ndarray:
+        """Angle (rad) of each outward normal from its circle's cone start, counter-clockwise."""
+        ang = np.mod(np.arctan2(normals[:, 1], normals[:, 0]) - self._angle0[circle], 2 * np.pi)
+        # A normal a hair before a polygon cone's start is its start.
+        return np.where(~self._full[circle] & (ang > self.cs.cone_w[circle] + 1e-6), 0.0, ang)
+
+    def _dominated(self, node: _Node) -> bool:
+        seen = self._expanded.get((node.circle, node.side))
+        if not seen:
+            return False
+        c, rho, full = node.circle, self.cs.rho[node.circle], self._full[node.circle]
+        for rel0, g0 in seen:
+            sweep = (node.rel - rel0) * node.side
+            if full:
+                sweep %= 2 * math.pi
+            if sweep < -1e-9 or g0 + rho * max(sweep, 0.0) > node.g + 1e-9:
+                continue
+            if sweep <= 0 or self._arc_free[c]:
+                return True
+            start = self._angle0[c] + (rel0 if node.side > 0 else node.rel)
+            if self.cs.arc_clearance(np.array([c]), np.array([start]), np.array([sweep]))[0] >= -1e-9:
+                return True
+        return False
+
+    def _lonely_circles(self) -> np.ndarray:
+        """(C,) bool: circles none of whose arcs can be blocked (no neighbour, disc inside the box)."""
+        cs = self.cs
+        lo, hi = cs.centre - cs.rho[:, None], cs.centre + cs.rho[:, None]
+        x0, y0, x1, y1 = cs.box
+        inside = (lo[:, 0] >= x0) & (lo[:, 1] >= y0) & (hi[:, 0] <= x1) & (hi[:, 1] <= y1)
+        return inside & (cs.nb_start[1:] == cs.nb_start[:-1])[cs.owner]
+
+    def _grown_edges(self) -> "_Edges":
+        """The grown edges between neighbouring corners, as tangents each way, where clear."""
+        cs = self.cs
+        corner = np.flatnonzero(cs.nxt >= 0)
+        nxt = cs.nxt[corner]
+        n = cs.cone_b[corner]
+        a = cs.centre[corner] + cs.rho[corner, None] * n
+        b = cs.centre[nxt] + cs.rho[nxt, None] * n
+        ok = cs.inside_box(a) & cs.inside_box(b)
+        row, o = cs.neighbour_pairs(corner)
+        ok[row[cs._pairs_hit(a[row], b[row], o)]] = False
+        corner, nxt, n, a, b = corner[ok], nxt[ok], n[ok], a[ok], b[ok]
+        length = np.hypot(*(b - a).T)
+        one = np.ones(len(corner), dtype=np.int64)
+        # Winding counter-clockwise (side +1) the path goes from a corner to the next; clockwise, back.
+        tans = Tangents.concat([Tangents(corner, nxt, one, one, a, b, n, n, length),
+                                Tangents(nxt, corner, -one, -one, b, a, n, n, length)])
+        return _Edges(tans, cs.n_circles)
+
+    # -- the answer --------------------------------------------------------
+    def _route(self, start, goal) -> Route:
+        nodes = self._nodes
+        g, (i, n_out, q_out) = self._best
+        points = [goal, q_out]
+        contacts = []
+        out_normal = n_out
+        while i > 0:
+            node = nodes[i]
+            rel_out = self._rel(node.circle, out_normal)
+            sweep = (rel_out - node.rel) * node.side
+            if self._full[node.circle]:
+                sweep %= 2 * math.pi
+                if sweep > 2 * math.pi - 1e-9:
+                    sweep = 0.0
+            contacts.append(Contact(node.circle, node.side,
+                                    float(math.atan2(node.normal[1], node.normal[0])), max(float(sweep), 0.0)))
+            points.append(node.point)
+            i, out_normal, q = node.parent
+            if i > 0:
+                points.append(q)
+        points.append(start)
+        return Route(np.array(points[::-1], dtype=float), tuple(contacts[::-1]), float(g))
+
+
+class _Edges:
+    """Grown polygon edges as tangents, looked up by (circle, side)."""
+
+    def __init__(self, tans: Tangents, n_circles: int):
+        self.tans = tans
+        self.index = np.full((n_circles, 2), -1, dtype=np.int64)
+        self.index[tans.src, (tans.s1 < 0).astype(np.int64)] = np.arange(len(tans))
+
+    def pick(self, circles: np.ndarray, sides: np.ndarray) -> np.ndarray:
+        return self.index[circles, (sides < 0).astype(np.int64)]
+
+
+def _circles_of(cs: ConfigSpace, obstacles: np.ndarray) -> np.ndarray:
+    """Every circle id of the given obstacle ids, in order."""
+    lo, hi = cs.first[obstacles], cs.first[obstacles + 1]
+    counts = hi - lo
+    return np.repeat(lo, counts) + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
+
+
+def waypoints(cs: ConfigSpace, route: Route, spare: float) -> np.ndarray:
+    """(k, 2) a polyline along ``route`` that keeps the clearance: straight legs as they are, each arc
+    replaced by a polygon circumscribed about it (so no chord cuts into the obstacle it wraps).
+
+    Such a polygon bulges out of the arc by rho (1 / cos(step / 2) - 1); the step is
+    chosen so that the bulge stays within the arc's own slack to other obstacles
+    (measured exactly, up to a tenth of the radius) plus ``spare`` (m), a part of the
+    planner's safety margin.
     """
-    g = field.grid
-    a = np.asarray(a, dtype=float).reshape(-1, 2)
-    b = np.asarray(b, dtype=float).reshape(-1, 2)
-    length = np.hypot(*(b - a).T)
-    step = min(g.hx, g.hy)
-    n = np.maximum(np.ceil(length / step).astype(np.int64), 1)
-    seg = np.repeat(np.arange(len(a)), n + 1)
-    t = (np.arange(len(seg)) - np.repeat(np.cumsum(n + 1) - (n + 1), n + 1)) / np.repeat(n, n + 1)
-    pts = a[seg] + t[:, None] * (b - a)[seg]
-    i, j = g.cell_of(pts)
-    rel = pts - g.centre_of(i, j)
-    off = np.sqrt(rel[:, 0] ** 2 + rel[:, 1] ** 2)
-    bound = field.values[i, j] - off - (length / n / 2)[seg]
-    ok = np.ones(len(a), dtype=bool)
-    np.logical_and.at(ok, seg, bound > radius)
-    return ok
-
-
-#: Bounds on the grid path's length, as multiples of the straight spawn-goal
-#: distance, tried (each on a smaller grid) before searching the whole grid.
-ELLIPSE_FACTORS = (1.25, 1.8)
-
-
-def grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius: float,
-              obstacles: Obstacles2D, bounds, portals: Sequence[Portal] = ()) -> Optional[np.ndarray]:
-    """(k, 2) points: start, cell centres (and portal ends), goal; a proven path; None if none.
-
-    Moves between cells are proven by the field; the links of the start, the
-    goal and the portal ends into the grid, and the portals themselves, by
-    exact distances (see :mod:`worldgen.feasibility.portals`).
-
-    Every path of length <= L lies in the ellipse |p - start| + |p - goal| <= L,
-    so the search first runs on the cells of such an ellipse (a fraction of the
-    floor) and keeps the answer when it is no longer than L: it is then the
-    shortest on the whole grid. Otherwise L grows, and finally the whole grid is
-    searched. In cluttered rooms the first ellipse almost always suffices.
-    """
-    straight = float(np.hypot(*(goal - start)))
-    slack = 2 * (LINK_CELLS + 1) * math.hypot(field.grid.hx, field.grid.hy)
-    for factor in ELLIPSE_FACTORS:
-        limit = factor * straight + slack
-        sub = _ellipse_field(field, start, goal, limit)
-        if sub is None:
-            break  # the ellipse covers the whole grid anyway
-        found = _grid_path(sub, start, goal, radius, obstacles, bounds, portals)
-        if found is not None and found[1] <= limit:
-            return found[0]
-    found = _grid_path(field, start, goal, radius, obstacles, bounds, portals)
-    return None if found is None else found[0]
-
-
-def _ellipse_field(field: DistanceField, start: np.ndarray, goal: np.ndarray, limit: float) -> Optional[DistanceField]:
-    """The field cropped to the box around the ellipse of foci start, goal and major axis ``limit``,
-    with cells outside the ellipse blocked; None when the crop would be most of the grid."""
-    g = field.grid
-    centre = (start + goal) / 2
-    a = limit / 2
-    c = float(np.hypot(*(goal - start))) / 2
-    b = math.sqrt(max(a * a - c * c, 0.0))
-    cos, sin = ((goal - start) / (2 * c)) if c > 0 else (1.0, 0.0)
-    ex = math.sqrt((a * cos) ** 2 + (b * sin) ** 2)
-    ey = math.sqrt((a * sin) ** 2 + (b * cos) ** 2)
-    (i0,), (j0,) = g.cell_of(centre - [ex, ey])
-    (i1,), (j1,) = g.cell_of(centre + [ex, ey])
-    i1, j1 = i1 + 1, j1 + 1
-    if (i1 - i0) * (j1 - j0) > 0.6 * g.nx * g.ny:
-        return None
-    sub = Grid((g.origin[0] + i0 * g.hx, g.origin[1] + j0 * g.hy), g.hx, g.hy, int(i1 - i0), int(j1 - j0))
-    xs, ys = sub.centres()
-    dx_s, dy_s = xs[:, None] - start[0], ys[None, :] - start[1]
-    dx_g, dy_g = xs[:, None] - goal[0], ys[None, :] - goal[1]
-    inside = np.sqrt(dx_s * dx_s + dy_s * dy_s) + np.sqrt(dx_g * dx_g + dy_g * dy_g) <= limit
-    values = np.where(inside, field.values[i0:i1, j0:j1], -np.inf)
-    return DistanceField(sub, values, field.cap)
-
-
-def _grid_path(field: DistanceField, start: np.ndarray, goal: np.ndarray, radius: float,
-               obstacles: Obstacles2D, bounds, portals: Sequence[Portal]):
-    """(points, length) of the shortest proven path through the grid and the portals, or None.
-
-    Nodes: the cells (0 .. n-1), the start (n), the goal (n+1), then both ends
-    of every portal.
-    """
-    g = field.grid
-    n = g.nx * g.ny
-    if np.hypot(*(goal - start)) <= 1e-12:
-        return np.array([start, goal]), 0.0
-    ends = np.array([e for p in portals for e in p.ends], dtype=float).reshape(-1, 2)
-    special = np.vstack([start, goal, ends])  # node n + k for special point k
-    rows, cols, data = [], [], []
-    # The proof of a move is symmetric in its two cells, so the first half of
-    # MOVES (one direction of each) makes an undirected graph. Per move, on
-    # shifted views of the field (no gathers): which cells may take it?
-    half = MOVES[: len(MOVES) // 2]
-    steps = np.hypot(half[:, 0] * g.hx, half[:, 1] * g.hy)
-    pad = np.full((g.nx + 4, g.ny + 4), -np.inf)
-    pad[2:-2, 2:-2] = field.values
-    for k, (di, dj) in enumerate(half):
-        cells = np.flatnonzero(field.values + pad[2 + di:2 + di + g.nx, 2 + dj:2 + dj + g.ny] > 2 * radius + steps[k])
-        rows.append(cells)
-        cols.append(cells + (di * g.ny + dj))  # the padding kept every allowed move on the grid
-        data.append(np.full(len(cells), steps[k]))
-    which, cell, length = exact_links(field, obstacles, bounds, special, radius)
-    rows.append(n + which)
-    cols.append(cell)
-    data.append(length)
-    # Special points to each other: the portals themselves, and any short clear hop.
-    a, b = np.triu_indices(len(special), k=1)
-    span = np.hypot(*(special[b] - special[a]).T)
-    hop = span <= 2 * (LINK_CELLS + 1) * max(g.hx, g.hy)
-    hop |= (a >= 2) & (b == a + 1) & (a % 2 == 0)  # a portal's two ends
-    a, b, span = a[hop], b[hop], span[hop]
-    clear = obstacles.segments_distance(special[a], special[b], radius)[0] > radius
-    rows.append(n + a[clear])
-    cols.append(n + b[clear])
-    data.append(span[clear])
-    graph = csr_matrix((np.concatenate(data), (np.concatenate(rows), np.concatenate(cols))),
-                       shape=(n + len(special), n + len(special)))
-    dist, pred = dijkstra(graph, directed=False, indices=n, return_predecessors=True)
-    total = float(dist[n + 1])
-    if not np.isfinite(total):
-        return None
-    chain = [n + 1]
-    while pred[chain[-1]] != n:
-        chain.append(int(pred[chain[-1]]))
-    chain.append(n)
-    idx = np.array(chain[::-1])
-    pts = np.empty((len(idx), 2))
-    is_cell = idx < n
-    pts[is_cell] = g.centre_of(idx[is_cell] // g.ny, idx[is_cell] % g.ny)
-    pts[~is_cell] = special[idx[~is_cell] - n]
-    return pts, total
-
-
-def string_pull(field: DistanceField, path: np.ndarray, radius: float, window: int = 64) -> np.ndarray:
-    """Drop every waypoint that a field-proven straight shortcut makes unnecessary.
-
-    From each kept point, the farthest later point within ``window`` steps
-    reachable in one proven-free segment becomes the next one.
-    """
-    out = [0]
-    i, n = 0, len(path) - 1
-    while i < n:
-        js = np.arange(i + 1, min(n, i + window) + 1)
-        clear = field_clear(field, np.broadcast_to(path[i], (len(js), 2)), path[js], radius)
-        # The next grid point is always reachable: the search only used proven moves.
-        visible = js[clear]
-        i = int(visible[-1]) if len(visible) else i + 1
-        out.append(i)
-    return path[out]
+    pts = [route.points[0]]
+    for k, contact in enumerate(route.contacts):
+        arrive, depart = route.points[1 + 2 * k], route.points[2 + 2 * k]
+        pts.append(arrive)
+        if contact.sweep > 1e-9:
+            c, rho = cs.centre[contact.circle], float(cs.rho[contact.circle])
+            ccw_start = contact.start if contact.side > 0 else contact.start - contact.sweep
+            slack = float(cs.arc_clearance(np.array([contact.circle]), np.array([ccw_start]),
+                                           np.array([contact.sweep]))[0])
+            bulge = max(slack, 0.0) + spare
+            step = min(MAX_ARC_STEP, 2 * math.acos(1 / (1 + bulge / rho)))
+            n = max(1, math.ceil(contact.sweep / step - 1e-9))
+            piece = contact.sweep / n
+            out = rho / math.cos(piece / 2)
+            ang = contact.start + contact.side * (np.arange(n) + 0.5) * piece
+            pts.extend(c + out * np.stack([np.cos(ang), np.sin(ang)], axis=1))
+        pts.append(depart)
+    pts.append(route.points[-1])
+    pts = np.array(pts, dtype=float)
+    keep = np.r_[True, np.any(np.abs(np.diff(pts, axis=0)) > 1e-12, axis=1)]
+    return pts[keep]

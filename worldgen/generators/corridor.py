@@ -14,19 +14,14 @@ than :func:`proven_width`) to the opposite wall, and obstacles on one leg are at
 ``min_passage`` apart along it (and as far from the leg's corners, openings,
 spawn and goal), so every gap on the way is at least ``min_passage`` wide.
 
-Width and the feasibility grid: a corridor narrower than
-2 x (robot_radius + clearance) cannot be driven, and :func:`check` says so
-with the numbers (:class:`~worldgen.errors.InfeasibleError`). The checker
-proves a path on a grid of cell size h (about (robot_radius + clearance) / 3,
-see :func:`worldgen.feasibility.check.resolution_for`), and proves a move only
-where the clearance exceeds the inflation radius by half the move, so it can
-show passable only corridors a little wider than that minimum: widths below
-:func:`proven_width` (the minimum plus :data:`GRID_MARGIN_CELLS` cells) are
-refused with that explanation rather than retried in vain. With the default
-robot (0.2 m + 0.05 m) the minimum is 0.5 m and the proven width 0.75 m
-(measured: every shape passes from about 2.3 cells on; 3 cells leave a margin).
-``generate(..., allow_infeasible=True)`` still builds such a corridor, and its
-feasibility report then says which check failed.
+Width: a corridor narrower than 2 x (robot_radius + clearance) cannot be driven,
+and :func:`check` says so with the numbers (:class:`~worldgen.errors.InfeasibleError`).
+The checker plans exactly in the continuous plane with a safety margin of
+:data:`~worldgen.feasibility.check.SAFETY` (0.1 mm) on each side, so every
+corridor from :func:`proven_width` = 2 x (robot_radius + clearance + SAFETY)
+(plus the walls' rounding to 6 decimals) on is proven passable: 1 mm more than
+the footprint needs is enough. ``generate(..., allow_infeasible=True)`` still
+builds a narrower corridor, and its feasibility report then says which check failed.
 """
 
 from __future__ import annotations
@@ -37,7 +32,7 @@ from typing import Any, Mapping
 import numpy as np
 
 from worldgen.errors import InfeasibleError, ParameterError
-from worldgen.feasibility.check import SAFETY, resolution_for
+from worldgen.feasibility.check import SAFETY
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.registry import register
@@ -45,10 +40,10 @@ from worldgen.generators.room import FLOOR_RGBA, FLOOR_THICKNESS, WALL_RGBA
 from worldgen.params import Param
 from worldgen.scene import Box, Material, Node, Physics, Pose, Scene, Task
 
-__all__ = ["SPEC", "build", "check", "layout", "proven_width", "GRID_MARGIN_CELLS", "Layout"]
+__all__ = ["SPEC", "build", "check", "layout", "proven_width", "Layout"]
 
-#: Grid cells on top of 2 x (radius + clearance) that a corridor needs to be proven passable.
-GRID_MARGIN_CELLS = 3.0
+#: Room (m) on top of the checker's margin for the walls' coordinates, rounded to 6 decimals.
+WALL_ROUNDING = 1e-5
 #: Tries to place one obstacle or opening before the draw counts as too crowded.
 PLACEMENT_TRIES = 60
 #: Density (kg/m^3) for the obstacles' nominal mass: static, but inertia must be valid.
@@ -168,10 +163,9 @@ def layout(params: Mapping[str, Any]) -> Layout:
     return Layout(lengths, turns, params["width"])
 
 
-def proven_width(params: Mapping[str, Any], bounds) -> float:
-    """The narrowest corridor the feasibility checker can prove passable for this robot and floor."""
-    robot = robot_from_params(params)
-    return 2 * (robot.inflation + SAFETY) + GRID_MARGIN_CELLS * resolution_for(robot, bounds)
+def proven_width(params: Mapping[str, Any]) -> float:
+    """The narrowest corridor (or gap) the feasibility checker proves passable for this robot."""
+    return 2 * (robot_from_params(params).inflation + SAFETY) + WALL_ROUNDING
 
 
 def _end_offset(params: Mapping[str, Any]) -> float:
@@ -211,14 +205,14 @@ def check(params: Mapping[str, Any]) -> None:
                     f"change the turns, got turns={params['turns']!r}, segments={lay.lengths!r}")
     r, c = params["robot_radius"], params["clearance"]
     need = 2 * (r + c)
-    proven = proven_width(params, lay.bounds())
+    proven = proven_width(params)
     g = _passage(params, proven)
     # Obstacles need room beside the passage whether or not the corridor itself is passable:
     # --allow-infeasible skips only the InfeasibleErrors below, never a world that cannot be built.
     if params["n_obstacles"]:
         if g < proven <= w:
             raise ParameterError(
-                f"parameter 'min_passage' must be in [{proven:.3f}, {w:g}] (from the narrowest gap the checker "
+                f"parameter 'min_passage' must be in [{proven:.5f}, {w:g}] (from the narrowest gap the checker "
                 f"proves passable for this robot to the width), got {params['min_passage']!r}")
         if w - g < 0.05 and params["min_passage"] is not None:
             raise ParameterError(
@@ -227,7 +221,7 @@ def check(params: Mapping[str, Any]) -> None:
         if w - g < 0.05:
             raise ParameterError(
                 f"parameter 'n_obstacles' must be 0 in a corridor {w:g} m wide: obstacles need width >= passage + "
-                f"0.05 = {g + 0.05:.3f} m (or set 'min_passage' as low as {proven:.3f}), got {params['n_obstacles']!r}")
+                f"0.05 = {g + 0.05:.3f} m (or set 'min_passage' as low as {proven:.5f}), got {params['n_obstacles']!r}")
     if params["side_openings"] and params["opening_width"] > max(b - a for a, b in
                                                                  (lay.straight_part(i) for i in range(k))):
         raise ParameterError(f"parameter 'opening_width' must fit in a leg's straight part, got {params['opening_width']!r}")
@@ -237,8 +231,9 @@ def check(params: Mapping[str, Any]) -> None:
             f"corridor width {w:g} m cannot pass a {r:g} m radius robot with {c:g} m clearance (needs >= {_m(need)} m)")
     if w < proven:
         raise InfeasibleError(
-            f"corridor width {w:g} m is within the feasibility grid's resolution of the {need:g} m a {r:g} m radius "
-            f"robot with {c:g} m clearance needs; the checker proves corridors from {proven:.3f} m wide")
+            f"corridor width {w:g} m leaves less than the checker's {SAFETY * 1e3:g} mm safety margin on each side "
+            f"of the {need:g} m a {r:g} m radius robot with {c:g} m clearance needs; the checker proves corridors "
+            f"from {proven:.5f} m wide")
 
 
 def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
@@ -249,7 +244,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     bounds = lay.bounds()
     k = len(lay.lengths)
     e = _end_offset(params)
-    g = _passage(params, proven_width(params, bounds))
+    g = _passage(params, proven_width(params))
     inflation = params["robot_radius"] + params["clearance"]
     # Per leg: the along-leg intervals already taken (openings, obstacles) and where things may go.
     usable = []

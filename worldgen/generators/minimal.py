@@ -18,12 +18,10 @@ target's left of the ray (or its right when the left leaves the floor), level
 with the near face (a cylinder's axis) and clear of the target's side by the
 footprint (robot_radius + clearance) plus :func:`margin` plus 0.05 m.
 
-The feasibility checker proves a disc free on a grid of cell size h (about
-(robot_radius + clearance) / 3) and needs room to spare for that: measured, a
-spawn 1.4 cells farther from the target than the footprint still fails. So
-the spawn, a given goal and the target keep :func:`margin` = 2 cells more than
-the footprint from the target and the floor's edge; closer requests are refused
-with the numbers instead of failing every attempt.
+The spawn, a given goal and the target keep :func:`margin` (1 mm) more than
+the footprint from the target and the floor's edge: room for the feasibility
+checker's 0.1 mm safety margin and the 6-decimal rounding of what is written.
+Closer requests are refused with the numbers instead of failing every attempt.
 """
 
 from __future__ import annotations
@@ -34,7 +32,6 @@ from typing import Any, Mapping
 import numpy as np
 
 from worldgen.errors import ParameterError
-from worldgen.feasibility.check import resolution_for
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.registry import register
@@ -55,8 +52,8 @@ GOAL_GAP = 0.05
 #: Angles are accepted up to pi written with 4 decimals: world.json rounds pi to 3.141593,
 #: and the params it records must generate the same world again.
 ANGLE_LIMIT = 3.1416
-#: Grid cells the checker needs beyond the footprint to prove a disc free (1.4 measured).
-MARGIN_CELLS = 2.0
+#: Room (m) beyond the footprint that spawn, goal and target keep (see the module docs).
+MARGIN = 1e-3
 #: Density (kg/m^3) for the target's nominal mass: static, but inertia must be valid.
 TARGET_DENSITY = 300.0
 TARGET_RGBA = (0.85, 0.30, 0.25, 1.0)
@@ -90,7 +87,7 @@ PARAMS = (
 
 def margin(params: Mapping[str, Any]) -> float:
     """Room (m) beyond robot_radius + clearance that spawn and goal keep from the target and floor edge."""
-    return MARGIN_CELLS * resolution_for(robot_from_params(params), room_bounds(params["size"]))
+    return MARGIN
 
 
 def _size(params: Mapping[str, Any], name: str) -> float:
@@ -179,14 +176,14 @@ def check(params: Mapping[str, Any]) -> None:
     # The robot at the spawn keeps its clearance from the target, with the checker's margin.
     if params["target_distance"] < keep:
         raise ParameterError(
-            f"parameter 'target_distance' must be at least robot_radius + clearance + 2 feasibility grid cells "
+            f"parameter 'target_distance' must be at least robot_radius + clearance + 1 mm "
             f"= {keep:.3f} m, got {params['target_distance']!r}")
     (sx, sy, _), _, u = target_layout(params)
     spawn_xy = np.array([sx, sy])
     (x0, y0), (x1, y1) = room_bounds(params["size"])
     floor = f"[{x0:g}, {x1:g}] x [{y0:g}, {y1:g}]"
     if not (x0 + keep <= sx <= x1 - keep and y0 + keep <= sy <= y1 - keep):
-        raise ParameterError(f"parameter 'spawn' must keep the robot's {inflation:g} m disc and 2 grid cells "
+        raise ParameterError(f"parameter 'spawn' must keep the robot's {inflation:g} m disc and 1 mm "
                              f"({keep:.3f} m) inside the floor {floor}, got {params['spawn']!r}")
     left = np.array([-u[1], u[0]])
     half = _target_half_width(params)
@@ -198,7 +195,7 @@ def check(params: Mapping[str, Any]) -> None:
             f"off the floor {floor}; enlarge 'size' or move the target, got {params['target_distance']!r}")
     goal = params["goal"]
     if goal is not None and not (x0 + keep <= goal[0] <= x1 - keep and y0 + keep <= goal[1] <= y1 - keep):
-        raise ParameterError(f"parameter 'goal' must keep the robot's {inflation:g} m disc and 2 grid cells "
+        raise ParameterError(f"parameter 'goal' must keep the robot's {inflation:g} m disc and 1 mm "
                              f"({keep:.3f} m) inside the floor {floor}, got {goal!r}")
     if goal is None and _default_goal(params, spawn_xy, u) is None:
         raise ParameterError(f"parameter 'goal' must be given: neither side of the target leaves room for the "

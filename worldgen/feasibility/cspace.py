@@ -1,0 +1,351 @@
+"""The robot's configuration space in the plane: obstacles grown by a disc, bounds shrunk by it.
+
+The robot's centre must stay ``radius`` (inflation plus the planner's safety
+margin) away from every footprint and inside the bounds shrunk by the same.
+Growing a footprint by a disc (a Minkowski sum) gives a disc of the larger
+radius, or a *rounded* convex polygon: its edges pushed out by ``radius`` and
+joined at every vertex by an arc of radius ``radius`` about that vertex. Those
+arcs are what a taut path wraps, so the configuration space is held here as
+**corner circles**: one per disc, one per polygon vertex, each usable only over
+its *cone* of outward normals (the angles between the normals of the vertex's
+two edges; every angle for a disc). A line touching a circle at a normal inside
+its cone touches the grown obstacle from outside (the grown obstacle is convex,
+so such a line is a supporting line); outside the cone it cuts into it.
+
+Indices: obstacle ids are those of :class:`~worldgen.feasibility.geometry.Obstacles2D`
+(discs first); circle ids run over all corner circles, grouped by obstacle
+(``first[o]`` to ``first[o + 1]``), a polygon's in counter-clockwise order.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+import shapely
+
+from worldgen.feasibility.geometry import Obstacles2D, point_segment_distance, segment_segment_distance
+
+__all__ = ["ConfigSpace", "TOUCH", "CONE_SLACK", "NEAR_MARGIN"]
+
+#: Distances within this of the required one count as touching, which is allowed (the
+#: required radius already carries the planner's safety margin).
+TOUCH = 1e-9
+#: Cone tests accept normals this far outside (sine of the angle): a line along a grown
+#: edge touches both of its corner circles exactly at their cones' common boundary.
+CONE_SLACK = 1e-9
+#: How far beyond touching (as a fraction of the radius) an obstacle's neighbours are kept.
+NEAR_MARGIN = 0.1
+#: Polygon vertices whose cone is narrower than this (rad) are collinear: no circle.
+_FLAT = 1e-12
+
+
+def _neighbours(obstacles: Obstacles2D, reach: float) -> tuple[np.ndarray, np.ndarray]:
+    """CSR (start (N + 1,), ids) of the other obstacles whose boxes lie within ``reach`` of each one's."""
+    n = len(obstacles)
+    if n < 2:
+        return np.zeros(n + 1, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    b = obstacles.boxes
+    tree = shapely.STRtree(shapely.box(b[:, 0], b[:, 1], b[:, 2], b[:, 3]))
+    qi, ti = tree.query(shapely.box(b[:, 0] - reach, b[:, 1] - reach, b[:, 2] + reach, b[:, 3] + reach))
+    keep = qi != ti
+    qi, ti = qi[keep], ti[keep]
+    order = np.lexsort((ti, qi))
+    qi, ti = qi[order], ti[order]
+    return np.searchsorted(qi, np.arange(n + 1)).astype(np.int64), ti.astype(np.int64)
+
+
+def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
+
+
+def _near(lo: np.ndarray, hi: np.ndarray, boxes: np.ndarray, reach: float) -> np.ndarray:
+    """(m, n) bool: query box m (corners ``lo``/``hi``) within ``reach`` of box n ((n, 4) minx, miny, maxx, maxy)."""
+    return ((lo[:, None, 0] - reach <= boxes[None, :, 2]) & (hi[:, None, 0] + reach >= boxes[None, :, 0])
+            & (lo[:, None, 1] - reach <= boxes[None, :, 3]) & (hi[:, None, 1] + reach >= boxes[None, :, 1]))
+
+
+@dataclass(frozen=True, eq=False)
+class ConfigSpace:
+    """Corner circles of the grown obstacles, the shrunk bounds, and exact clearance tests.
+
+    Per circle (C,): ``centre`` (C, 2), ``rho`` (grown radius), ``cone_a`` and
+    ``cone_b`` (C, 2) the cone's first and last outward normal (counter-clockwise),
+    ``cone_w`` its width (rad; 2 pi for a disc), ``full`` (disc), ``owner``
+    (obstacle id), ``nxt``/``prv`` the next/previous corner of the same polygon
+    (-1 for discs). Per obstacle (N,): ``first`` (N + 1,) circle offsets,
+    ``hull_c`` (N, 2) and ``hull_r`` (N,) a disc containing the grown obstacle,
+    ``core_r`` (N,) the radius of a disc about ``hull_c`` inside it (-1 if none);
+    ``nb_ids[nb_start[o]:nb_start[o + 1]]`` the obstacles whose boxes come within
+    (2 + :data:`NEAR_MARGIN`) x ``radius`` of obstacle o's: the only ones its grown
+    boundary can come within ``NEAR_MARGIN x radius`` of.
+    ``box`` = (x0, y0, x1, y1): where the robot's centre may be.
+    """
+
+    obstacles: Obstacles2D
+    radius: float
+    box: tuple[float, float, float, float]
+    centre: np.ndarray
+    rho: np.ndarray
+    cone_a: np.ndarray
+    cone_b: np.ndarray
+    cone_w: np.ndarray
+    owner: np.ndarray
+    nxt: np.ndarray
+    prv: np.ndarray
+    first: np.ndarray
+    hull_c: np.ndarray
+    hull_r: np.ndarray
+    core_r: np.ndarray
+    nb_start: np.ndarray
+    nb_ids: np.ndarray
+
+    @classmethod
+    def build(cls, obstacles: Obstacles2D, radius: float, bounds) -> "ConfigSpace":
+        (x0, y0), (x1, y1) = bounds
+        box = (x0 + radius, y0 + radius, x1 - radius, y1 - radius)
+        nd, n = obstacles.n_discs, len(obstacles)
+        # Polygon corners, all rings at once: edge k runs from vertex k to the next of its ring.
+        e = obstacles.edge_b - obstacles.edge_a
+        normals = np.stack([e[:, 1], -e[:, 0]], axis=1)
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
+        ring_start = obstacles.edge_start[obstacles.edge_owner]
+        ring_len = obstacles.edge_start[obstacles.edge_owner + 1] - ring_start
+        local = np.arange(len(e)) - ring_start
+        before = normals[ring_start + (local - 1) % np.maximum(ring_len, 1)]  # the edge ending at vertex k
+        width = np.arctan2(_cross(before, normals), np.einsum("ij,ij->i", before, normals))
+        keep = width > _FLAT
+        corner = np.flatnonzero(keep)
+        poly_owner = obstacles.edge_owner[corner] + nd
+        # Circle ids: the discs', then each polygon's kept corners in ring order.
+        count = np.concatenate([np.ones(nd, dtype=np.int64), np.bincount(poly_owner - nd, minlength=n - nd)])
+        first = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
+        ids = nd + np.arange(len(corner))
+        own_first = first[poly_owner]
+        own_count = count[poly_owner]
+        pos = ids - own_first
+        x_axis = np.tile([[1.0, 0.0]], (nd, 1))
+        centre = np.concatenate([obstacles.disc_xy, obstacles.edge_a[corner]])
+        rho = np.concatenate([obstacles.disc_r + radius, np.full(len(corner), float(radius))])
+        cone_a = np.concatenate([x_axis, before[corner]])
+        cone_b = np.concatenate([x_axis, normals[corner]])
+        cone_w = np.concatenate([np.full(nd, 2 * np.pi), width[corner]])
+        owner = np.concatenate([np.arange(nd), poly_owner]).astype(np.int64)
+        nxt = np.concatenate([np.full(nd, -1), own_first + (pos + 1) % np.maximum(own_count, 1)]).astype(np.int64)
+        prv = np.concatenate([np.full(nd, -1), own_first + (pos - 1) % np.maximum(own_count, 1)]).astype(np.int64)
+        lo, hi = obstacles.boxes[:, :2], obstacles.boxes[:, 2:]
+        hull_c = (lo + hi) / 2
+        hull_r = np.hypot(*(hi - lo).T) / 2 + radius
+        if nd:
+            hull_c[:nd] = obstacles.disc_xy
+            hull_r[:nd] = obstacles.disc_r + radius
+        # The core: the centre's distance to the nearest edge line, where it lies inside the polygon.
+        core_r = hull_r.copy()
+        if len(e):
+            inward = _cross(e, hull_c[nd + obstacles.edge_owner] - obstacles.edge_a) / np.maximum(
+                np.linalg.norm(e, axis=1), 1e-300)
+            depth = np.full(n - nd, np.inf)
+            np.minimum.at(depth, obstacles.edge_owner, inward)
+            core_r[nd:] = np.where(depth > 0, depth + radius, -1.0)
+        nb_start, nb_ids = _neighbours(obstacles, (2 + NEAR_MARGIN) * radius)
+        return cls(obstacles, float(radius), box, centre, rho, cone_a, cone_b, cone_w, owner, nxt, prv,
+                   first, hull_c, hull_r, core_r, nb_start, nb_ids)
+
+    @property
+    def n_circles(self) -> int:
+        return len(self.rho)
+
+    # -- cones and angles --------------------------------------------------
+    def in_cone(self, circle: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        """(m,) bool: the outward ``normal`` (m, 2) lies in the cone of ``circle`` (m,)."""
+        a, b = self.cone_a[circle], self.cone_b[circle]
+        inside = (_cross(a, normal) >= -CONE_SLACK) & (_cross(normal, b) >= -CONE_SLACK)
+        return self.full[circle] | inside
+
+    @property
+    def full(self) -> np.ndarray:
+        """(C,) bool: the circle is a disc obstacle's, usable at every angle."""
+        return self.cone_w >= 2 * np.pi
+
+    def rel_angle(self, circle: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        """(m,) angle (rad) from the cone's first normal counter-clockwise to ``normal``, in [0, 2 pi)."""
+        a = self.cone_a[circle]
+        ang = np.arctan2(_cross(a, normal), np.einsum("ij,ij->i", a, normal))
+        ang = np.where(ang < 0, ang + 2 * np.pi, ang)
+        # A normal a hair before a polygon cone's start (within CONE_SLACK) is its start.
+        return np.where(~self.full[circle] & (ang > self.cone_w[circle] + 1e-6), 0.0, ang)
+
+    # -- clearance tests ---------------------------------------------------
+    def inside_box(self, pts: np.ndarray) -> np.ndarray:
+        """(n,) bool: the (n, 2) points lie where the robot's centre may be."""
+        x0, y0, x1, y1 = self.box
+        t = TOUCH
+        return (pts[:, 0] >= x0 - t) & (pts[:, 0] <= x1 + t) & (pts[:, 1] >= y0 - t) & (pts[:, 1] <= y1 + t)
+
+    def segments_clear(self, a: np.ndarray, b: np.ndarray, skip1: Optional[np.ndarray] = None,
+                       skip2: Optional[np.ndarray] = None, among: Optional[np.ndarray] = None) -> np.ndarray:
+        """(m,) bool: segment ``a[i]b[i]`` keeps ``radius`` from every obstacle but ``skip1[i]``, ``skip2[i]``
+        (ids; -1 for none) and stays inside the box.
+
+        The obstacles to skip are those the segment is tangent to: it touches them by
+        construction, at a normal inside their cone, so it cannot cut into them.
+        ``among`` (ids) limits the test to obstacles the caller knows to hold every
+        one that could come near the segments.
+        """
+        a = np.asarray(a, dtype=float).reshape(-1, 2)
+        b = np.asarray(b, dtype=float).reshape(-1, 2)
+        ok = self.inside_box(a) & self.inside_box(b)
+        if len(self.obstacles) == 0 or not ok.any():
+            return ok
+        rows = np.flatnonzero(ok)
+        ids = np.arange(len(self.obstacles)) if among is None else np.asarray(among, dtype=np.int64)
+        seg, k = np.nonzero(_near(np.minimum(a[rows], b[rows]), np.maximum(a[rows], b[rows]),
+                                  self.obstacles.boxes[ids], self.radius))
+        seg, o = rows[seg], ids[k]
+        if skip1 is not None:
+            keep = o != skip1[seg]
+            if skip2 is not None:
+                keep &= o != skip2[seg]
+            seg, o = seg[keep], o[keep]
+        ok[seg[self._pairs_hit(a[seg], b[seg], o)]] = False
+        return ok
+
+    def _pairs_hit(self, a: np.ndarray, b: np.ndarray, o: np.ndarray) -> np.ndarray:
+        """(m,) bool per (segment a[i]b[i], obstacle o[i]) pair: closer than ``radius``.
+
+        Most pairs are settled by the obstacle's bounding and core discs; polygon edges are
+        measured only for segments that pass between the two.
+        """
+        obs = self.obstacles
+        r = self.radius - TOUCH
+        d = point_segment_distance(self.hull_c[o], a, b)
+        hit = d < self.core_r[o] - TOUCH  # through the core (for a disc: exactly the test)
+        unsure = np.flatnonzero(~hit & (d < self.hull_r[o] - TOUCH) & (o >= obs.n_discs))
+        if len(unsure) == 0:
+            return hit
+        p = o[unsure] - obs.n_discs
+        counts = obs.edge_start[p + 1] - obs.edge_start[p]
+        pair = np.repeat(np.arange(len(unsure)), counts)
+        e = obs.edge_start[p][pair] + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
+        ap, bp = a[unsure][pair], b[unsure][pair]
+        close = segment_segment_distance(ap, bp, obs.edge_a[e], obs.edge_b[e]) < r
+        # A segment wholly inside a polygon crosses no edge: its start lies left of every edge.
+        left = _cross(obs.edge_b[e] - obs.edge_a[e], ap - obs.edge_a[e]) >= 0
+        any_close = np.zeros(len(unsure), dtype=bool)
+        np.logical_or.at(any_close, pair, close)
+        inside = np.ones(len(unsure), dtype=bool)
+        np.logical_and.at(inside, pair, left)
+        hit[unsure] = any_close | inside
+        return hit
+
+    def neighbour_pairs(self, circle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(row, obstacle id) for each of ``circle`` (m,) and each neighbour of the circle's obstacle."""
+        own = self.owner[circle]
+        counts = self.nb_start[own + 1] - self.nb_start[own]
+        row = np.repeat(np.arange(len(circle)), counts)
+        k = self.nb_start[own][row] + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
+        return row, self.nb_ids[k]
+
+    def points_clearance(self, pts: np.ndarray) -> np.ndarray:
+        """(n,) exact distance from each point to the nearest footprint or the bounds' edge, minus ``radius``
+        on the bounds side: the slack (m) a disc of ``radius`` has there (negative where it does not fit)."""
+        pts = np.asarray(pts, dtype=float).reshape(-1, 2)
+        d_obs = self.obstacles.points_distance(pts)[0] - self.radius
+        x0, y0, x1, y1 = self.box
+        d_box = np.minimum(np.minimum(pts[:, 0] - x0, x1 - pts[:, 0]), np.minimum(pts[:, 1] - y0, y1 - pts[:, 1]))
+        return np.minimum(d_obs, d_box)
+
+    # -- arcs ---------------------------------------------------------------
+    def arc_clearance(self, circle: np.ndarray, start: np.ndarray, sweep: np.ndarray) -> np.ndarray:
+        """(m,) slack (m) of the arcs on ``circle`` (m,) from outward angle ``start`` counter-clockwise over
+        ``sweep`` (rad): the smallest distance from the arc to any other footprint minus ``radius``, and to
+        the box's edges; exact up to ``NEAR_MARGIN x radius``, which it never exceeds (farther
+        obstacles are not measured).
+
+        The arc's own obstacle is skipped (the arc lies on its grown boundary). Exact:
+        the nearest pair between an arc and a segment is an end of one of them, the
+        foot of the perpendicular from the arc's centre on the segment, or a crossing.
+        """
+        circle = np.asarray(circle, dtype=np.int64)
+        m = len(circle)
+        slack = np.full(m, NEAR_MARGIN * self.radius)
+        if m == 0:
+            return slack
+        c = self.centre[circle]
+        rho = self.rho[circle]
+        start = np.asarray(start, dtype=float)
+        sweep = np.asarray(sweep, dtype=float)
+        # The box: the arc's extreme points are its ends and the axis directions it sweeps over.
+        x0, y0, x1, y1 = self.box
+        for k, (ux, uy) in enumerate(((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))):
+            ang = k * np.pi / 2
+            swept = np.mod(ang - start, 2 * np.pi) <= sweep
+            px, py = c[:, 0] + rho * ux, c[:, 1] + rho * uy
+            margin = np.minimum(np.minimum(px - x0, x1 - px), np.minimum(py - y0, y1 - py))
+            slack = np.where(swept, np.minimum(slack, margin), slack)
+        ends = [c + rho[:, None] * np.stack([np.cos(t), np.sin(t)], axis=1) for t in (start, start + sweep)]
+        for e in ends:
+            slack = np.minimum(slack, np.minimum(np.minimum(e[:, 0] - x0, x1 - e[:, 0]),
+                                                 np.minimum(e[:, 1] - y0, y1 - e[:, 1])))
+        obs = self.obstacles
+        row, o = self.neighbour_pairs(circle)
+        if len(row) == 0:
+            return slack
+        nd = obs.n_discs
+        disc = o < nd
+        if disc.any():
+            r, k = row[disc], o[disc]
+            q = obs.disc_xy[k]
+            d = _point_arc_distance(q, c[r], rho[r], start[r], sweep[r], ends[0][r], ends[1][r]) - obs.disc_r[k]
+            np.minimum.at(slack, r, d - self.radius)
+        if (~disc).any():
+            r, p = row[~disc], o[~disc] - nd
+            counts = obs.edge_start[p + 1] - obs.edge_start[p]
+            r_e = np.repeat(r, counts)
+            offsets = np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts)
+            e = np.repeat(obs.edge_start[p], counts) + offsets
+            d = _segment_arc_distance(obs.edge_a[e], obs.edge_b[e], c[r_e], rho[r_e], start[r_e], sweep[r_e],
+                                      ends[0][r_e], ends[1][r_e])
+            np.minimum.at(slack, r_e, d - self.radius)
+        return slack
+
+
+def _in_sweep(direction: np.ndarray, start: np.ndarray, sweep: np.ndarray) -> np.ndarray:
+    ang = np.arctan2(direction[:, 1], direction[:, 0])
+    return np.mod(ang - start, 2 * np.pi) <= sweep
+
+
+def _point_arc_distance(p, c, rho, start, sweep, e0, e1) -> np.ndarray:
+    """(m,) distance from points ``p`` to arcs (centre ``c``, radius ``rho``, angles start..start+sweep)."""
+    v = p - c
+    dist_c = np.hypot(v[:, 0], v[:, 1])
+    radial = np.abs(dist_c - rho)
+    ends = np.minimum(np.hypot(*(p - e0).T), np.hypot(*(p - e1).T))
+    return np.where(_in_sweep(v, start, sweep) & (dist_c > 0), radial, ends)
+
+
+def _segment_arc_distance(a, b, c, rho, start, sweep, e0, e1) -> np.ndarray:
+    """(m,) distance between segments ``ab`` and arcs (see :func:`_point_arc_distance`)."""
+    d = np.minimum(point_segment_distance(e0, a, b), point_segment_distance(e1, a, b))
+    d = np.minimum(d, _point_arc_distance(a, c, rho, start, sweep, e0, e1))
+    d = np.minimum(d, _point_arc_distance(b, c, rho, start, sweep, e0, e1))
+    ab = b - a
+    den = np.einsum("ij,ij->i", ab, ab)
+    den = np.where(den > 0, den, 1.0)
+    t = np.einsum("ij,ij->i", c - a, ab) / den
+    foot = a + t[:, None] * ab
+    on = (t >= 0) & (t <= 1)
+    d = np.where(on, np.minimum(d, _point_arc_distance(foot, c, rho, start, sweep, e0, e1)), d)
+    # Crossings of the segment's line with the circle, within the segment and the arc.
+    h = foot - c
+    h2 = np.einsum("ij,ij->i", h, h)
+    under = rho * rho - h2
+    cut = under >= 0
+    half = np.sqrt(np.where(cut, under, 0.0) / den)
+    for sign in (-1.0, 1.0):
+        s = t + sign * half
+        x = a + s[:, None] * ab
+        crossing = cut & (s >= 0) & (s <= 1) & _in_sweep(x - c, start, sweep)
+        d = np.where(crossing, 0.0, d)
+    return d

@@ -1,0 +1,123 @@
+"""Common tangent segments between corner circles: the edges of the tangent visibility graph.
+
+A shortest path for a disc among grown convex obstacles is taut: straight
+segments, each tangent to the circles at its two ends, joined by arcs of those
+circles. A segment leaves circle 1 with the circle on its left (side ``s1 = +1``,
+the path then winds counter-clockwise round it) or on its right (``s1 = -1``),
+and meets circle 2 on side ``s2``. With ``l`` the unit normal to the left of the
+direction of travel, the touching points are ``q = c1 - s1 r1 l`` and
+``t = c2 - s2 r2 l``, and the line is tangent to both exactly when
+``l . (c2 - c1) = s2 r2 - s1 r1``; of the two solutions, the one with the
+direction of travel pointing from circle 1 to circle 2 is
+``angle(l) = angle(c2 - c1) + acos(k / |c2 - c1|)``.
+
+A point (the spawn, the goal) is a circle of radius 0 with a full cone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from worldgen.feasibility.cspace import ConfigSpace
+
+__all__ = ["Tangents", "tangents", "every_side", "SIDES"]
+
+#: The four kinds of common tangent (s1, s2): both circles on the left, left-right, ...
+SIDES = ((1, 1), (1, -1), (-1, -1), (-1, 1))
+
+
+@dataclass(frozen=True, eq=False)
+class Tangents:
+    """Free tangent segments (m,) from circles ``src`` to circles ``dst`` (ids; -1 for a point).
+
+    ``s1``/``s2`` the sides (+1 left, -1 right), ``q``/``t`` (m, 2) the touching
+    points, ``nq``/``nt`` (m, 2) the outward normals there (zero for a point),
+    ``length`` (m,).
+    """
+
+    src: np.ndarray
+    dst: np.ndarray
+    s1: np.ndarray
+    s2: np.ndarray
+    q: np.ndarray
+    t: np.ndarray
+    nq: np.ndarray
+    nt: np.ndarray
+    length: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.src)
+
+    def take(self, rows: np.ndarray) -> "Tangents":
+        return Tangents(*(getattr(self, f)[rows] for f in _FIELDS))
+
+    @staticmethod
+    def concat(parts: list["Tangents"]) -> "Tangents":
+        return Tangents(*(np.concatenate([getattr(p, f) for p in parts]) for f in _FIELDS))
+
+
+_FIELDS = ("src", "dst", "s1", "s2", "q", "t", "nq", "nt", "length")
+
+
+def every_side(src: np.ndarray, dst: np.ndarray, src_sides=(1, -1), dst_sides=(1, -1)):
+    """(src, dst, s1, s2) with every pair repeated for each combination of the given sides."""
+    src = np.asarray(src, dtype=np.int64)
+    dst = np.asarray(dst, dtype=np.int64)
+    sides = [(a, b) for a, b in SIDES if a in src_sides and b in dst_sides]
+    n = len(src)
+    s1 = np.repeat(np.array([a for a, _ in sides], dtype=np.int64), n)
+    s2 = np.repeat(np.array([b for _, b in sides], dtype=np.int64), n)
+    return np.tile(src, len(sides)), np.tile(dst, len(sides)), s1, s2
+
+
+def tangents(cs: ConfigSpace, src: np.ndarray, dst: np.ndarray, s1: np.ndarray, s2: np.ndarray,
+             src_xy=None, dst_xy=None, among=None) -> Tangents:
+    """The free common tangent from circle ``src[k]`` on side ``s1[k]`` to circle ``dst[k]`` on side ``s2[k]``.
+
+    Circle ids of -1 stand for points: ``src_xy``/``dst_xy`` ((2,) or (m, 2)) give them.
+    Kept: tangents that touch each circle inside its cone, run from the first to
+    the second, and keep the clearance from every other obstacle (and the box);
+    ``among`` (ids), if given, holds every obstacle that could come near them.
+    """
+    src = np.asarray(src, dtype=np.int64)
+    dst = np.asarray(dst, dtype=np.int64)
+    m = len(src)
+    sf1 = np.asarray(s1, dtype=float)
+    sf2 = np.asarray(s2, dtype=float)
+    if src_xy is None:
+        c1, r1 = cs.centre[src], cs.rho[src]
+    else:
+        c1, r1 = np.broadcast_to(np.asarray(src_xy, dtype=float), (m, 2)), np.zeros(m)
+    if dst_xy is None:
+        c2, r2 = cs.centre[dst], cs.rho[dst]
+    else:
+        c2, r2 = np.broadcast_to(np.asarray(dst_xy, dtype=float), (m, 2)), np.zeros(m)
+    delta = c2 - c1
+    dist = np.sqrt(delta[:, 0] * delta[:, 0] + delta[:, 1] * delta[:, 1])
+    k = sf2 * r2 - sf1 * r1
+    ok = np.abs(k) < dist
+    safe = np.where(ok, dist, 1.0)
+    cos = np.where(ok, k / safe, 0.0)
+    sin = np.sqrt(1.0 - cos * cos)
+    ux, uy = delta[:, 0] / safe, delta[:, 1] / safe
+    l = np.stack([cos * ux - sin * uy, sin * ux + cos * uy], axis=1)
+    nq = -sf1[:, None] * l
+    nt = -sf2[:, None] * l
+    if src_xy is None:
+        ok &= cs.in_cone(src, nq)
+    if dst_xy is None:
+        ok &= cs.in_cone(dst, nt)
+    rows = np.flatnonzero(ok)
+    q = c1[rows] + r1[rows, None] * nq[rows]
+    t = c2[rows] + r2[rows, None] * nt[rows]
+    own1 = cs.owner[src[rows]] if src_xy is None else np.full(len(rows), -1)
+    own2 = cs.owner[dst[rows]] if dst_xy is None else np.full(len(rows), -1)
+    free = cs.segments_clear(q, t, own1, own2, among=among)
+    keep = rows[free]
+    q, t = q[free], t[free]
+    seg = t - q
+    return Tangents(src[keep], dst[keep], np.asarray(s1)[keep], np.asarray(s2)[keep], q, t,
+                    np.where(src_xy is None, 1.0, 0.0) * nq[keep], np.where(dst_xy is None, 1.0, 0.0) * nt[keep],
+                    np.sqrt(seg[:, 0] * seg[:, 0] + seg[:, 1] * seg[:, 1]))
