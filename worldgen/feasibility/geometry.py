@@ -13,9 +13,10 @@ then polygons.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
-from shapely.geometry.polygon import orient
+import shapely
 
 from worldgen.footprint import Footprint
 
@@ -80,10 +81,7 @@ class Obstacles2D:
         polys = [f for f in footprints if not f.is_disc]
         disc_xy = np.array([f.centre for f in discs], dtype=float).reshape(-1, 2)
         disc_r = np.array([f.radius for f in discs], dtype=float)
-        rings = []
-        for f in polys:
-            ring = np.asarray(orient(f.polygon, 1.0).exterior.coords, dtype=float)[:-1]
-            rings.append(ring)
+        rings = _ccw_rings([f.polygon for f in polys])
         counts = np.array([len(r) for r in rings], dtype=np.int64)
         start = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
         if rings:
@@ -95,6 +93,12 @@ class Obstacles2D:
         boxes = np.array([f.bounds() for f in discs] + [f.bounds() for f in polys], dtype=float).reshape(-1, 4)
         names = tuple(f.name for f in discs) + tuple(f.name for f in polys)
         return cls(disc_xy, disc_r, tuple(rings), edge_a, edge_b, owner, start, boxes, names)
+
+    @cached_property
+    def cores(self) -> np.ndarray:
+        """(N,) shapely geometries by obstacle id: each polygon, and each disc's centre point."""
+        return np.array([shapely.Point(c) for c in self.disc_xy] + [shapely.Polygon(r) for r in self.poly_vertices],
+                        dtype=object)
 
     @property
     def n_discs(self) -> int:
@@ -163,6 +167,22 @@ class Obstacles2D:
         """
         xy = np.asarray(xy, dtype=float).reshape(-1, 2)
         return self.segments_distance(xy, xy, np.inf)
+
+
+def _ccw_rings(polygons: list) -> list[np.ndarray]:
+    """Each (convex) polygon's exterior as a counter-clockwise (k, 2) ring without the closing point."""
+    if not polygons:
+        return []
+    coords, index = shapely.get_coordinates(shapely.get_exterior_ring(polygons), return_index=True)
+    last = np.r_[index[1:] != index[:-1], True]  # each ring's closing point
+    pts, owner = coords[~last], index[~last]
+    start = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    count = np.diff(np.r_[start, len(owner)])
+    nxt = np.arange(len(pts)) + 1
+    nxt[start + count - 1] = start  # each ring's last point wraps to its first
+    twice_area = np.add.reduceat(pts[:, 0] * pts[nxt, 1] - pts[:, 1] * pts[nxt, 0], start)
+    rings = np.split(pts, start[1:])
+    return [r if a > 0 else r[::-1].copy() for r, a in zip(rings, twice_area)]
 
 
 def _take_min(best: np.ndarray, which: np.ndarray, rows: np.ndarray, ids: np.ndarray, d: np.ndarray) -> None:

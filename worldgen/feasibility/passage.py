@@ -38,11 +38,13 @@ def narrowest_passage(obstacles: Obstacles2D, bounds, start, goal) -> float:
     limit = float(np.min(np.minimum(box_gap, obs_gap)))
     if limit <= 0:
         return 0.0
-    joins = _joins(obstacles, bounds, 2 * limit)
+    gap, a, b, anchor_a, touch, anchor_b = _joins(obstacles, bounds, 2 * limit)
     s, g = ends
+    turn = (_sweep(anchor_a, touch, s) + _sweep(touch, anchor_b, s)) - (
+        _sweep(anchor_a, touch, g) + _sweep(touch, anchor_b, g))
     n = len(obstacles) + 4
     parent = list(range(n))
-    potential = [0.0] * n  # angle from a piece to its parent
+    potential = [0.0] * n  # potential[u] = phi(u) - phi(parent of u)
 
     def find(u: int) -> tuple[int, float]:
         total = 0.0
@@ -59,107 +61,108 @@ def narrowest_passage(obstacles: Obstacles2D, bounds, start, goal) -> float:
             acc -= step
         return u, total
 
-    for gap, a, b, anchor_a, touch, anchor_b in joins:
-        if gap >= 2 * limit:
-            break
-        turn = (_sweep(anchor_a, touch, s) + _sweep(touch, anchor_b, s)) - (
-            _sweep(anchor_a, touch, g) + _sweep(touch, anchor_b, g))
-        ra, pa = find(a)
-        rb, pb = find(b)
+    for k in range(len(gap)):
+        ra, pa = find(int(a[k]))
+        rb, pb = find(int(b[k]))
         if ra == rb:
-            if abs(pa + turn - pb) > math.pi:
-                return max(gap, 0.0)
+            if abs(pa + turn[k] - pb) > math.pi:
+                return max(float(gap[k]), 0.0)
             continue
-        # potential[u] = phi(u) - phi(parent); the join asks phi(b) = phi(a) + turn.
-        parent[rb] = ra
-        potential[rb] = pa + turn - pb
+        parent[rb] = ra  # the join asks phi(b) = phi(a) + turn
+        potential[rb] = pa + turn[k] - pb
     return 2 * limit
 
 
-def _sweep(a, b, z) -> float:
-    """Angle (rad) the segment from ``a`` to ``b`` sweeps about ``z`` (counter-clockwise positive)."""
-    ax, ay = a[0] - z[0], a[1] - z[1]
-    bx, by = b[0] - z[0], b[1] - z[1]
-    return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
+def _sweep(a: np.ndarray, b: np.ndarray, z: np.ndarray) -> np.ndarray:
+    """(m,) angle (rad) each segment a[i] -> b[i] sweeps about the point ``z`` (counter-clockwise positive)."""
+    ax, ay = a[:, 0] - z[0], a[:, 1] - z[1]
+    bx, by = b[:, 0] - z[0], b[:, 1] - z[1]
+    return np.arctan2(ax * by - ay * bx, ax * bx + ay * by)
 
 
 def _joins(obstacles: Obstacles2D, bounds, reach: float):
-    """(gap, piece a, piece b, anchor a, touching point, anchor b) for every pair of pieces closer than
-    ``reach``, sorted by gap. Pieces: the obstacles, then the outside of the bounds beyond each edge
+    """Arrays (gap, piece a, piece b, anchor a, touching point, anchor b) of every pair of pieces closer
+    than ``reach``, sorted by gap. Pieces: the obstacles, then the outside of the bounds beyond each edge
     (left, bottom, right, top), each a half-plane."""
     (x0, y0), (x1, y1) = bounds
-    n = len(obstacles)
-    nd = obstacles.n_discs
+    n, nd = len(obstacles), obstacles.n_discs
     far = (x1 - x0) + (y1 - y0) + 1.0
     xc, yc = (x0 + x1) / 2, (y0 + y1) / 2
-    anchors = [tuple(obstacles.disc_xy[i]) for i in range(nd)]
-    anchors += [tuple(ring.mean(axis=0)) for ring in obstacles.poly_vertices]
-    anchors += [(x0 - far, yc), (xc, y0 - far), (x1 + far, yc), (xc, y1 + far)]
-    out = []
+    starts = obstacles.edge_start[:-1]
+    counts = np.diff(obstacles.edge_start)
+    means = (np.add.reduceat(obstacles.edge_a, starts) / counts[:, None]) if len(starts) else np.zeros((0, 2))
+    anchors = np.vstack([obstacles.disc_xy.reshape(-1, 2), means,
+                         [(x0 - far, yc), (xc, y0 - far), (x1 + far, yc), (xc, y1 + far)]])
+    gaps, pa, pb, touches = [np.zeros(4)], [n + np.arange(4)], [n + (np.arange(4) + 1) % 4], []
     # Neighbouring half-planes always meet, at the bounds' corners.
-    corners = ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
-    for k in range(4):
-        a, b = n + k, n + (k + 1) % 4
-        out.append((0.0, a, b, anchors[a], corners[k], anchors[b]))
+    touches.append(np.array([(x0, y0), (x1, y0), (x1, y1), (x0, y1)], dtype=float))
     boxes = obstacles.boxes
+    lo, hi = extreme_points(obstacles)
     # Obstacles and the bounds: the gap between the obstacle's extreme point and the edge.
-    for k, (axis, sign, edge) in enumerate(((0, -1, x0), (1, -1, y0), (0, 1, x1), (1, 1, y1))):
-        extreme = boxes[:, axis] if sign < 0 else boxes[:, axis + 2]
-        gap = (extreme - edge) * -sign
-        for i in np.flatnonzero(gap < reach):
-            point = _extreme_point(obstacles, int(i), axis, sign)
-            touch = list(point)
-            touch[axis] = edge - sign * gap[i] / 2 if gap[i] > 0 else point[axis]
-            out.append((float(gap[i]), int(i), n + k, anchors[i], tuple(touch), anchors[n + k]))
-    # Obstacle pairs: candidates by their boxes, then exact gaps and the midpoint of the closest pair.
+    for k, (axis, low, edge) in enumerate(((0, True, x0), (1, True, y0), (0, False, x1), (1, False, y1))):
+        point = lo[axis] if low else hi[axis]
+        gap = point[:, axis] - edge if low else edge - point[:, axis]
+        near = np.flatnonzero(gap < reach)
+        touch = point[near].copy()
+        shift = np.where(gap[near] > 0, gap[near] / 2, 0.0)
+        touch[:, axis] = np.where(gap[near] > 0, edge + (shift if low else -shift), touch[:, axis])
+        gaps.append(gap[near])
+        pa.append(near)
+        pb.append(np.full(len(near), n + k))
+        touches.append(touch)
+    # Obstacle pairs: candidates by their boxes, then exact gaps and where their grown copies first touch.
     if n > 1:
-        lo, hi = boxes[:, :2], boxes[:, 2:]
-        envelopes = shapely.box(lo[:, 0], lo[:, 1], hi[:, 0], hi[:, 1])
-        tree = shapely.STRtree(envelopes)
-        grown = shapely.box(lo[:, 0] - reach, lo[:, 1] - reach, hi[:, 0] + reach, hi[:, 1] + reach)
-        qi, ti = tree.query(grown)
+        env_lo, env_hi = boxes[:, :2], boxes[:, 2:]
+        tree = shapely.STRtree(shapely.box(env_lo[:, 0], env_lo[:, 1], env_hi[:, 0], env_hi[:, 1]))
+        qi, ti = tree.query(shapely.box(env_lo[:, 0] - reach, env_lo[:, 1] - reach,
+                                        env_hi[:, 0] + reach, env_hi[:, 1] + reach))
         keep = qi < ti
-        for i, j, gap, touch in zip(*_pair_gaps(obstacles, qi[keep], ti[keep])):
-            if gap < reach:
-                out.append((gap, int(i), int(j), anchors[i], touch, anchors[j]))
-    out.sort(key=lambda e: (e[0], e[1], e[2]))
-    return out
+        i, j = qi[keep], ti[keep]
+        gap, touch = _pair_gaps(obstacles, i, j)
+        near = gap < reach
+        gaps.append(gap[near])
+        pa.append(i[near])
+        pb.append(j[near])
+        touches.append(touch[near])
+    gap, a, b = np.concatenate(gaps), np.concatenate(pa), np.concatenate(pb)
+    touch = np.concatenate(touches)
+    order = np.lexsort((b, a, gap))
+    a, b = a[order], b[order]
+    return gap[order], a, b, anchors[a], touch[order], anchors[b]
 
 
-def _extreme_point(obstacles: Obstacles2D, i: int, axis: int, sign: int) -> tuple[float, float]:
-    """The point of footprint ``i`` farthest along ``sign`` on ``axis``."""
-    nd = obstacles.n_discs
-    if i < nd:
-        c = obstacles.disc_xy[i].copy()
-        c[axis] += sign * obstacles.disc_r[i]
-        return (float(c[0]), float(c[1]))
-    ring = obstacles.poly_vertices[i - nd]
-    k = int(np.argmax(sign * ring[:, axis]))
-    return (float(ring[k, 0]), float(ring[k, 1]))
+def extreme_points(obstacles: Obstacles2D) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Per axis (x, y): the (N, 2) point of each footprint lowest and highest along it."""
+    lows, highs = [], []
+    verts, owner = obstacles.edge_a, obstacles.edge_owner
+    for axis in (0, 1):
+        step = np.zeros((len(obstacles.disc_r), 2))
+        step[:, axis] = obstacles.disc_r
+        found = []
+        for sign in (1.0, -1.0):
+            # Sorted by polygon, then by the coordinate: each polygon's first row is its extreme vertex.
+            order = np.lexsort((sign * verts[:, axis], owner))
+            first = order[np.r_[True, owner[order][1:] != owner[order][:-1]]] if len(order) else order
+            found.append(np.vstack([obstacles.disc_xy - sign * step, verts[first]]))
+        lows.append(found[0])
+        highs.append(found[1])
+    return lows, highs
 
 
-def _pair_gaps(obstacles: Obstacles2D, i: np.ndarray, j: np.ndarray):
-    """(i, j, gap, touching point) per pair of obstacle ids: the exact gap between the footprints
-    (negative or 0 where they overlap) and the point where their grown copies first touch."""
-    shapes = np.array([shapely.Point(c) for c in obstacles.disc_xy]
-                      + [shapely.Polygon(r) for r in obstacles.poly_vertices], dtype=object)
+def _pair_gaps(obstacles: Obstacles2D, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(gap (m,), touching point (m, 2)) per pair of obstacle ids: the exact gap between the footprints
+    (negative or 0 where they overlap) and the point where their grown copies first touch (a point of
+    both where they overlap)."""
+    if len(i) == 0:
+        return np.zeros(0), np.zeros((0, 2))
+    shapes = obstacles.cores
     radius = np.concatenate([obstacles.disc_r, np.zeros(len(obstacles.poly_vertices))])
-    gaps, touches = [], []
-    if len(i):
-        lines = shapely.shortest_line(shapes[i], shapes[j])
-        coords = shapely.get_coordinates(lines).reshape(-1, 2, 2)
-    else:
-        coords = np.zeros((0, 2, 2))
-    for k in range(len(i)):
-        p, q = coords[k]  # nearest points of the two cores (a disc's core is its centre)
-        d = float(math.hypot(q[0] - p[0], q[1] - p[1]))
-        ra, rb = radius[i[k]], radius[j[k]]
-        gap = d - ra - rb
-        u = (q - p) / d if d > 0 else np.zeros(2)
-        if gap > 0:  # the midpoint of the footprints' nearest points, where the grown copies meet
-            touch = (p + ra * u + q - rb * u) / 2
-        else:  # a point of both footprints
-            touch = p + min(ra, d) * u
-        gaps.append(gap)
-        touches.append((float(touch[0]), float(touch[1])))
-    return i, j, gaps, touches
+    coords = shapely.get_coordinates(shapely.shortest_line(shapes[i], shapes[j])).reshape(-1, 2, 2)
+    p, q = coords[:, 0], coords[:, 1]  # nearest points of the two cores (a disc's core is its centre)
+    d = np.hypot(*(q - p).T)
+    ra, rb = radius[i], radius[j]
+    gap = d - ra - rb
+    u = (q - p) / np.where(d > 0, d, 1.0)[:, None]
+    apart = ((p + ra[:, None] * u) + (q - rb[:, None] * u)) / 2  # midway between the footprints
+    overlap = p + np.minimum(ra, d)[:, None] * u  # in both: discs come before polygons in the ids
+    return gap, np.where((gap > 0)[:, None], apart, overlap)

@@ -255,7 +255,19 @@ class Scene:
         return matrix_to_pose(self.world_matrix(name))
 
     def aabb(self, name: str) -> np.ndarray:
-        """(2, 3) world-frame axis-aligned box [[min], [max]] of node ``name``'s shape."""
+        """(2, 3) world-frame axis-aligned box [[min], [max]] of node ``name``'s shape (read-only)."""
+        cache = self._aabb_cache
+        if name not in cache:
+            box = self._aabb(name)
+            box.flags.writeable = False
+            cache[name] = box
+        return cache[name]
+
+    @cached_property
+    def _aabb_cache(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def _aabb(self, name: str) -> np.ndarray:
         node = self._by_name[name]
         if node.shape is None:
             p = self.world_matrix(name)[:3, 3]
