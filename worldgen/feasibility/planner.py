@@ -153,12 +153,12 @@ class Planner:
         cs, nodes, goal = self.cs, self._nodes, self._goal
         live = []
         fresh_circles = []
+        dominated = self._dominated([i for _, i in batch if nodes[i].lb is None and nodes[i].circle >= 0])
         for key, i in batch:
             node = nodes[i]
             if node.lb is None:
                 if node.circle >= 0:
-                    node.rel = self._rel(node.circle, node.normal)
-                    if self._dominated(node):
+                    if i in dominated:
                         continue
                     self._expanded.setdefault((node.circle, node.side), []).append((node.rel, node.g))
                     fresh_circles.append(i)
@@ -346,23 +346,34 @@ class Planner:
         # A normal a hair before a polygon cone's start is its start.
         return np.where(~self._full[circle] & (ang > self.cs.cone_w[circle] + 1e-6), 0.0, ang)
 
-    def _dominated(self, node: _Node) -> bool:
-        seen = self._expanded.get((node.circle, node.side))
-        if not seen:
-            return False
-        c, rho, full = node.circle, self.cs.rho[node.circle], self._full[node.circle]
-        for rel0, g0 in seen:
-            sweep = (node.rel - rel0) * node.side
-            if full:
-                sweep %= 2 * math.pi
-            if sweep < -1e-9 or g0 + rho * max(sweep, 0.0) > node.g + 1e-9:
+    def _dominated(self, fresh: list[int]) -> set[int]:
+        """Those of the ``fresh`` nodes that a node already expanded on the same circle and side reaches
+        along its arc no dearer (the arcs to check go to the geometry in one call)."""
+        nodes, out = self._nodes, set()
+        asks = []  # (node index, circle, start angle, sweep) of arcs that decide a dominance
+        for i in fresh:
+            node = nodes[i]
+            node.rel = self._rel(node.circle, node.normal)
+            seen = self._expanded.get((node.circle, node.side))
+            if not seen:
                 continue
-            if sweep <= 0 or self._arc_free[c]:
-                return True
-            start = self._angle0[c] + (rel0 if node.side > 0 else node.rel)
-            if self.cs.arc_clearance(np.array([c]), np.array([start]), np.array([sweep]))[0] >= -1e-9:
-                return True
-        return False
+            c, rho, full = node.circle, self.cs.rho[node.circle], self._full[node.circle]
+            for rel0, g0 in seen:
+                sweep = (node.rel - rel0) * node.side
+                if full:
+                    sweep %= 2 * math.pi
+                if sweep < -1e-9 or g0 + rho * max(sweep, 0.0) > node.g + 1e-9:
+                    continue
+                if sweep <= 0 or self._arc_free[c]:
+                    out.add(i)
+                    break
+                asks.append((i, c, self._angle0[c] + (rel0 if node.side > 0 else node.rel), sweep))
+        asks = [a for a in asks if a[0] not in out]
+        if asks:
+            i, c, start, sweep = (np.array(v) for v in zip(*asks))
+            free = self.cs.arc_clearance(c.astype(np.int64), start, sweep) >= -1e-9
+            out.update(int(k) for k in i[free])
+        return out
 
     def _lonely_circles(self) -> np.ndarray:
         """(C,) bool: circles none of whose arcs can be blocked (no neighbour, disc inside the box)."""
