@@ -141,13 +141,14 @@ class NavigationEnv(gym.Env):
         world, where = self._next_world(options)
         t1 = time.perf_counter()
         cfg = self.config
-        self._substeps = cfg.substeps(_step_size(world.mjcf))
-        add_robot(world.mjcf, world.robot.radius, world.robot.height, cfg.linear_velocity, cfg.angular_velocity)
         spawn = world.task["spawn"]
         movers = MoverScript(world.movers)
-        self._sim = sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), sorted(world.floor),
-                                        [m["name"] for m in world.movers])
+        add_robot(world.mjcf, world.robot.radius, world.robot.height, cfg.linear_velocity, cfg.angular_velocity)
+        sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), sorted(world.floor),
+                            [m["name"] for m in world.movers])
         world.mjcf = None  # the tree is compiled: let it go
+        self._substeps = cfg.substeps(float(sim.model.opt.timestep))
+        self._sim = sim
         t2 = time.perf_counter()
         self._movers = movers
         if len(movers):
@@ -285,12 +286,3 @@ class NavigationEnv(gym.Env):
         self._painter = None
         super().close()
 
-
-def _step_size(root) -> float:
-    """The world's physics step (MJCF ``<option timestep>``), s."""
-    option = root.find("option")
-    return float(option.get("timestep", 0.002)) if option is not None else 0.002
-
-
-#: Every keyword NavigationEnv takes besides the world source and render_mode (for the docs and tests).
-SETTING_NAMES = tuple(p.name for p in SETTINGS) + ("reward_fn",)
