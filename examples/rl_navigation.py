@@ -27,7 +27,6 @@ import time
 from pathlib import Path
 
 import gymnasium
-import numpy as np
 
 import worldgen.envs  # noqa: F401  (registers worldgen/Navigation-v0)
 from worldgen.envs.policies import PathFollower, RandomPolicy

@@ -6,7 +6,6 @@ missing, except under CI, where they fail (conftest.missing_tool).
 
 from __future__ import annotations
 
-import hashlib
 import math
 import subprocess
 import sys

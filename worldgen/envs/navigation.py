@@ -54,7 +54,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from worldgen.envs.config import SETTINGS, resolve
+from worldgen.envs.config import resolve
 from worldgen.envs.deps import require_gymnasium
 from worldgen.envs.episode import Episode
 from worldgen.envs.lidar import Lidar

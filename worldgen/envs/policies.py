@@ -23,7 +23,7 @@ __all__ = ["PathFollower", "RandomPolicy"]
 class PathFollower:
     """Pure pursuit along ``waypoints`` ((k, 2) m) within ``v_max`` m/s and ``w_max`` rad/s."""
 
-    def __init__(self, waypoints: Sequence[Sequence[float]], v_max: float, w_max: float, lookahead: float = 0.3,
+    def __init__(self, waypoints: Sequence[Sequence[float]], v_max: float, w_max: float, lookahead: float = 0.15,
                  gain: float = 3.0, turn_in_place: float = 0.35):
         self.path = np.asarray(waypoints, dtype=float).reshape(-1, 2)
         if len(self.path) == 1:
