@@ -34,6 +34,16 @@ __all__ = ["Lidar", "VISUAL_GROUP"]
 VISUAL_GROUP = 2
 
 
+def _has_normals() -> bool:
+    """Whether this MuJoCo's ``mj_multiRay`` takes the ``normal`` output (newer releases) before ``nray``."""
+    import mujoco
+
+    return "normal" in (mujoco.mj_multiRay.__doc__ or "")
+
+
+_MULTIRAY_NORMALS = _has_normals()
+
+
 class Lidar:
     """A scan of ``beams`` rays over ``fov`` (rad) from ``angle_min`` (None: centred ahead)."""
 
@@ -71,8 +81,12 @@ class Lidar:
         vec[:, 0] = self._cos * c - self._sin * s
         vec[:, 1] = self._sin * c + self._cos * s
         self._pnt[:] = (x, y, height)
-        mujoco.mj_multiRay(model, data, self._pnt, vec.reshape(-1), self._groups, 1, exclude_body,
-                           self._geom, self._dist, None, self.beams, self.range_max)
+        if _MULTIRAY_NORMALS:
+            mujoco.mj_multiRay(model, data, self._pnt, vec.reshape(-1), self._groups, 1, exclude_body,
+                               self._geom, self._dist, None, self.beams, self.range_max)
+        else:  # MuJoCo releases before mj_multiRay's ``normal`` output
+            mujoco.mj_multiRay(model, data, self._pnt, vec.reshape(-1), self._groups, 1, exclude_body,
+                               self._geom, self._dist, self.beams, self.range_max)
         d = self._dist
         ranges = np.where((d < 0.0) | (d > self.range_max), self.range_max, d)
         np.maximum(ranges, self.range_min, out=ranges)
