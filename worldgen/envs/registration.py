@@ -14,7 +14,10 @@ How Gymnasium finds it, by version:
 - Gymnasium 0.26 to 0.29 loaded the ``gymnasium.envs`` entry points when it
   was imported, calling each one inside its namespace; worldgen declares
   ``worldgen = "worldgen.envs.registration:register_envs"`` in that group, so
-  there ``gymnasium.make("worldgen/Navigation-v0")`` works with no import.
+  there ``gymnasium.make("worldgen/Navigation-v0")`` would work with no import.
+  Those releases are not tested here (the ``rl`` extra asks for Gymnasium 1.x,
+  and 0.29 predates NumPy 2); the tests check that the entry point resolves to
+  this function and that calling it registers the id.
 
 The entry point names the environment class by its import path, so registering
 imports neither MuJoCo nor the environment's modules.
