@@ -4,6 +4,7 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
+RL_STAMP := $(VENV)/.installed-rl
 DEMO_OUT ?= demo-worlds
 
 .PHONY: demo test bench fuzz clean
@@ -17,6 +18,10 @@ $(TEST_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[test]'
 	touch $@
 
+$(RL_STAMP): $(STAMP)
+	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[rl]'
+	touch $@
+
 ## demo: install, then generate worlds from the cluttered generator's defaults and say where they are
 demo: $(STAMP)
 	$(VENV)/bin/worldgen generate cluttered --seed 0 --count 3 --out $(DEMO_OUT)
@@ -26,9 +31,11 @@ demo: $(STAMP)
 test: $(TEST_STAMP)
 	$(PY) -m pytest -q
 
-## bench: per-stage medians for cluttered worlds; table on stdout, JSON in benchmarks/results/
-bench: $(STAMP)
+## bench: per-stage medians for cluttered worlds, then the RL environment's steps/s and reset split;
+## tables on stdout, JSON in benchmarks/results/
+bench: $(RL_STAMP)
 	$(PY) benchmarks/bench_pipeline.py
+	$(PY) benchmarks/bench_env.py
 
 ## fuzz: the long fuzz sweep over every generator's full parameter ranges (a table; reproducers of defects)
 fuzz: $(TEST_STAMP)

@@ -9,8 +9,22 @@ import pytest
 EXAMPLES = sorted((Path(__file__).resolve().parent.parent / "examples").glob("*.py"))
 
 
+#: Examples that need an optional extra, and the module that tells whether it is installed.
+NEEDS = {"rl_navigation.py": "gymnasium"}
+
+
+def _need_extra(script: Path) -> None:
+    import importlib.util
+
+    module = NEEDS.get(script.name)
+    if module and importlib.util.find_spec(module) is None:
+        from conftest import missing_tool
+        missing_tool(f"{module} (pip install 'worldgen[rl]'), for {script.name}")
+
+
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
 def test_example_runs(script, tmp_path):
+    _need_extra(script)
     run = subprocess.run([sys.executable, str(script), str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr
     assert "Traceback" not in run.stderr
@@ -27,6 +41,24 @@ def test_diffdrive_example_report(tmp_path):
     assert report["passed"] is True and report["summary"]["runs"] == 20 and report["summary"]["collision_count"] == 0
     assert (tmp_path / "report.csv").read_text().startswith("criterion,required,measured,verdict,margin\n")
     assert run.stdout.splitlines()[-2] == "20 runs, 20 succeeded: PASS"
+
+
+def test_rl_navigation_example_reports_both_policies(tmp_path):
+    """The Gymnasium example: the path follower meets every criterion with SPL near 1, the random policy does not."""
+    import json
+
+    script = EXAMPLES[0].parent / "rl_navigation.py"
+    _need_extra(script)
+    run = subprocess.run([sys.executable, str(script), str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    follower = json.loads((tmp_path / "report-follower.json").read_text())
+    random = json.loads((tmp_path / "report-random.json").read_text())
+    assert follower["passed"] is True and follower["summary"]["runs"] == 10
+    assert random["summary"]["success_rate"] < 0.5
+    summaries = [line for line in run.stdout.splitlines() if line.startswith("success rate")]
+    assert len(summaries) == 2
+    assert summaries[0].startswith("success rate 1.00, mean SPL ") and float(summaries[0].split()[5].rstrip(",")) > 0.9
+    assert all(line.endswith("agree on success in 10 of 10 runs") for line in summaries)
 
 
 # -- the shipped recipes ---------------------------------------------------------------------

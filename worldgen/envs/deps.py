@@ -1,0 +1,38 @@
+"""The one optional dependency of worldgen.envs: Gymnasium, imported only when an environment is used.
+
+``import worldgen`` (and the pytest plugin) never imports Gymnasium; this module
+is where worldgen.envs asks for it, and where a missing install becomes one line.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+
+from worldgen.errors import WorldgenError
+
+__all__ = ["MissingDependencyError", "INSTALL_HINT", "gymnasium_available", "require_gymnasium"]
+
+#: What to install for the environments (the ``rl`` extra of worldgen's pyproject.toml).
+INSTALL_HINT = "pip install 'worldgen[rl]'"
+
+
+class MissingDependencyError(WorldgenError, ImportError):
+    """An optional dependency that a feature needs is not installed; the message says what to install."""
+
+
+def gymnasium_available() -> bool:
+    """True when Gymnasium can be imported (it is not imported by asking)."""
+    try:
+        return importlib.util.find_spec("gymnasium") is not None
+    except (ImportError, ValueError):  # a ``sys.modules['gymnasium'] = None`` block, or a broken entry
+        return False
+
+
+def require_gymnasium():
+    """The ``gymnasium`` module, or :class:`MissingDependencyError` with one line saying what to install."""
+    try:
+        return importlib.import_module("gymnasium")
+    except ImportError:
+        raise MissingDependencyError(
+            f"worldgen.envs needs Gymnasium, which is not installed: {INSTALL_HINT}") from None

@@ -1,0 +1,93 @@
+"""One episode's record, and its figures under the oracles' names once it ends.
+
+The record is the run as :mod:`worldgen.oracles` takes it: ``t, x, y, yaw``
+rows, one at the reset and one after every env step, plus every MuJoCo contact
+of the robot (one :class:`~worldgen.oracles.Contact` per contact that begins,
+naming the entity touched, as :func:`worldgen.oracles.collisions` reports them).
+
+:meth:`Episode.figures` gives the keys of :class:`worldgen.oracles.Run`
+(``world_id``, ``task``, ``reached_goal``, ``time_to_goal``, ``duration``,
+``path_length``, ``path_efficiency``, ``min_clearance``, ``collisions``,
+``min_separation``, ``max_velocity``; ``collisions`` as ``Run.as_dict`` writes
+them) plus ``success`` (evaluate's rule: goal reached within the time limit, no
+collision), ``spl`` (success weighted by path length: ``success * L / max(P, L)``
+with ``L`` the task's optimal path length and ``P`` the path travelled) and
+``reference_path_length`` (``L``). Every figure but ``collisions`` is computed by
+the oracles' own functions from the recorded trajectory; ``min_clearance`` is
+their FCL distance from the footprint to every collider along it (negative: a
+contact's depth). ``collisions`` are MuJoCo's contacts, which also ended the
+episode.
+"""
+
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+from worldgen.oracles import Contact
+
+__all__ = ["Episode", "spl"]
+
+
+def spl(success: bool, reference_length: float, path_length: float) -> float:
+    """Success weighted by (normalised inverse) path length: ``success * L / max(P, L)``, in [0, 1]."""
+    if not success:
+        return 0.0
+    longest = max(path_length, reference_length)
+    return 1.0 if longest <= 0.0 else float(reference_length / longest)
+
+
+class Episode:
+    """The record of one episode in ``world`` (an :class:`~worldgen.envs.source.EpisodeWorld`)."""
+
+    def __init__(self, world, x: float, y: float, yaw: float):
+        self.world = world
+        self.rows: list[tuple[float, float, float, float]] = [(0.0, x, y, yaw)]
+        self.contacts: list[Contact] = []
+        #: The entities the robot touched at the last physics step checked.
+        self.touching: frozenset = frozenset()
+        self.done = False
+
+    def record(self, t: float, x: float, y: float, yaw: float) -> None:
+        self.rows.append((t, x, y, yaw))
+
+    def touch(self, t: float, entities: frozenset) -> bool:
+        """Note the entities the robot touches at time ``t``; True when a contact begins."""
+        new = sorted(entities - self.touching)
+        self.touching = entities
+        self.contacts.extend(Contact(float(t), name) for name in new)
+        return bool(new)
+
+    @property
+    def trajectory(self) -> np.ndarray:
+        """(n, 4) ``t, x, y, yaw`` rows: the run as the oracles take it."""
+        return np.array(self.rows, dtype=float)
+
+    def figures(self) -> dict:
+        """The figures of the run so far, under the oracles' names (see the module's docstring)."""
+        from worldgen import oracles
+
+        ground = self.world.ground()
+        traj = self.trajectory
+        task = self.world.task
+        length = oracles.path_length(traj)
+        ref = self.world.reference_path_length
+        dt = np.diff(traj[:, 0])
+        step = np.hypot(*np.diff(traj[:, 1:3], axis=0).T)
+        moving = dt > 0
+        run = oracles.Run(
+            world_id=self.world.world_id, task=str(task["id"]),
+            reached_goal=oracles.reached_goal(traj, ground), time_to_goal=oracles.time_to_goal(traj, ground),
+            duration=float(traj[-1, 0] - traj[0, 0]), path_length=length,
+            path_efficiency=length / ref if ref > 0 else None,
+            min_clearance=oracles.min_clearance(traj, ground), collisions=tuple(self.contacts),
+            min_separation=oracles.min_separation(traj, ground),
+            max_velocity=float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0)
+        limit: Optional[float] = task.get("time_limit")
+        # evaluate's rule (worldgen.oracles_eval): the goal, within the scenario's max_time, and no collision.
+        ok = bool(run.reached_goal and not run.collisions and (limit is None or run.time_to_goal <= limit))
+        out = run.as_dict()
+        out.update(success=ok, spl=spl(ok, ref, length), reference_path_length=ref)
+        return out
+

@@ -1,0 +1,288 @@
+"""``worldgen/Navigation-v0``: point-goal navigation for a differential-drive robot in MuJoCo.
+
+    >>> import gymnasium, worldgen.envs
+    >>> env = gymnasium.make("worldgen/Navigation-v0", preset="drl_arena")
+    >>> obs, info = env.reset(seed=0)             # a new checked world, in memory
+    >>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+
+Worlds: ``generator`` and ``params`` (any registered generator), or ``preset``
+(a preset's name or file, ``params`` on top), a new world per episode; or
+``pack`` (a :class:`~worldgen.Pack` or its folder or archive), its worlds in
+order, again from the first after the last: a fixed benchmark set. Default:
+the ``drl_arena`` preset. Each episode drives the world's first task.
+
+Action: ``Box([v_min, -w_max], [v_max, w_max])``, float32: forward speed v (m/s)
+and turn rate w (rad/s, counter-clockwise), held for one control period
+(``control_period``, default 0.1 s = 50 physics steps at the usual 0.002 s).
+Values outside the box are clipped to it.
+
+Observation: ``Box`` of float32, length ``S + 4``:
+``[scan[0..S-1], goal_distance, goal_angle, last_v, last_w]`` where ``scan`` is the
+lidar (``lidar_beams`` ranges, or ``lidar_sectors`` minima) in m within
+``[lidar_range_min, lidar_range_max]``; ``goal_distance`` (m, >= 0) and
+``goal_angle`` (rad in [-pi, pi], counter-clockwise from the heading) are the
+goal in the robot's frame (polar); ``last_v``, ``last_w`` the action applied in
+the previous step (0 after a reset).
+
+Reward, termination, truncation: :mod:`worldgen.envs.reward` (by default +100 at
+the goal, -100 on a collision, else ``v/2 - |w|/2 - (1 - r)/2`` near obstacles);
+an episode terminates when the robot's centre is within the task's
+``goal_tolerance`` of the goal at the end of a step, or at its first contact
+with anything but the floor (MuJoCo contacts, checked every physics step;
+door leaves and movers count); it is truncated at the task's ``time_limit``.
+
+Info: at reset ``world_id``, ``task``, ``reference_path_length`` (the optimal
+path length, world.json ``tasks[].path.length``), ``time_limit``, and
+``world_seed`` (generated worlds) or ``world_index`` (packs); every step
+``time``; at an episode's end also the figures of
+:meth:`worldgen.envs.episode.Episode.figures`, under the oracles' names:
+``success``, ``spl``, ``path_length``, ``collisions``, ``min_clearance``,
+``duration``, ``time_to_goal``, ``reached_goal``, ...
+
+Seeding: ``reset(seed=s)`` reseeds two independent streams derived from s (one
+draws each episode's world seed, one the lidar noise), so the same seeds and
+actions give the same observations in any process. ``reset(options=...)``:
+``{"world_seed": n}`` drives that world of the generator, ``{"world_index": i}``
+that world of the pack (the next reset goes on from there).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any, Optional
+
+import numpy as np
+
+from worldgen.envs.config import resolve
+from worldgen.envs.deps import require_gymnasium
+from worldgen.envs.episode import Episode
+from worldgen.envs.lidar import Lidar
+from worldgen.envs.movers import MoverScript
+from worldgen.envs.reward import StepOutcome, reward
+from worldgen.envs.robot import add_robot, compile_world
+from worldgen.envs.source import PackSource, make_source
+from worldgen.errors import ParameterError
+
+gym = require_gymnasium()
+
+__all__ = ["NavigationEnv", "WORLD_STREAM", "NOISE_STREAM"]
+
+#: Spawn keys of the two random streams derived from a reset's seed.
+WORLD_STREAM, NOISE_STREAM = 0, 1
+_MAX_SEED = 2**63 - 1
+
+
+class NavigationEnv(gym.Env):
+    """Point-goal navigation in worldgen worlds (see the module's docstring for every space and rule)."""
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+
+    def __init__(self, generator: Optional[str] = None, params: Optional[dict] = None, preset: Optional[str] = None,
+                 pack=None, render_mode: Optional[str] = None, **settings: Any):
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ParameterError(f"parameter 'render_mode' must be one of None, "
+                                 f"{', '.join(self.metadata['render_modes'])}, got {render_mode!r}")
+        self.config = cfg = resolve(settings)
+        self.source = make_source(generator, params, preset, pack)
+        self.render_mode = render_mode
+        self.metadata = dict(self.metadata, render_fps=1.0 / cfg.control_period)
+        self.lidar = Lidar(cfg.lidar_beams, cfg.lidar_fov, cfg.lidar_angle_min, cfg.lidar_range_min,
+                           cfg.lidar_range_max, cfg.lidar_noise, cfg.lidar_sectors)
+        (v_lo, v_hi), w = cfg.linear_velocity, cfg.angular_velocity
+        self._act_lo = np.array([v_lo, -w], dtype=np.float32)
+        self._act_hi = np.array([v_hi, w], dtype=np.float32)
+        self.action_space = gym.spaces.Box(self._act_lo, self._act_hi, dtype=np.float32)
+        n = self.lidar.size
+        low = np.concatenate([np.full(n, cfg.lidar_range_min), [0.0, -math.pi], self._act_lo]).astype(np.float32)
+        high = np.concatenate([np.full(n, cfg.lidar_range_max), [np.inf, math.pi], self._act_hi]).astype(np.float32)
+        self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
+        self._world_rng: Optional[np.random.Generator] = None
+        self._noise_rng: Optional[np.random.Generator] = None
+        self._next_index = 0
+        self._sim = None
+        self.world = None
+        self.episode: Optional[Episode] = None
+        self._painter = None
+        self.reset_timings: dict = {}
+
+    # -- episode --------------------------------------------------------------------------------------------
+    def _reseed(self, seed: Optional[int]) -> None:
+        entropy = seed if seed is not None else int(self.np_random.integers(0, _MAX_SEED))
+        self._world_rng = np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(WORLD_STREAM,)))
+        self._noise_rng = np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(NOISE_STREAM,)))
+
+    def _next_world(self, options: dict):
+        if isinstance(self.source, PackSource):
+            index = options.get("world_index", self._next_index)
+            if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or not 0 <= index < len(self.source):
+                raise ParameterError(f"option 'world_index' must be an integer in [0, {len(self.source) - 1}], "
+                                     f"got {index!r}")
+            self._next_index = (int(index) + 1) % len(self.source)
+            return self.source.world(int(index)), {"world_index": int(index)}
+        seed = options.get("world_seed")
+        if seed is None:
+            seed = int(self._world_rng.integers(0, _MAX_SEED))
+        elif isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= _MAX_SEED:
+            raise ParameterError(f"option 'world_seed' must be an integer in [0, {_MAX_SEED}], got {seed!r}")
+        return self.source.world(seed), {"world_seed": seed}
+
+    def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
+        super().reset(seed=seed)
+        if seed is not None or self._world_rng is None:
+            self._reseed(seed)
+        options = dict(options or {})
+        known = "world_index" if isinstance(self.source, PackSource) else "world_seed"
+        unknown = sorted(set(options) - {known})
+        if unknown:
+            raise ParameterError(f"unknown reset option '{unknown[0]}' for worlds from a "
+                                 f"{'pack' if known == 'world_index' else 'generator'}; known options: {known}")
+        t0 = time.perf_counter()
+        world, where = self._next_world(options)
+        t1 = time.perf_counter()
+        cfg = self.config
+        spawn = world.task["spawn"]
+        movers = MoverScript(world.movers)
+        add_robot(world.mjcf, world.robot.radius, world.robot.height, cfg.linear_velocity, cfg.angular_velocity)
+        sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), sorted(world.floor),
+                            [m["name"] for m in world.movers])
+        world.mjcf = None  # the tree is compiled: let it go
+        self._substeps = cfg.substeps(float(sim.model.opt.timestep))
+        self._sim = sim
+        t2 = time.perf_counter()
+        self._movers = movers
+        if len(movers):
+            movers.place(sim.data, sim.mocap, movers.positions([0.0])[0])
+        import mujoco
+        mujoco.mj_forward(sim.model, sim.data)
+        self.world = world
+        self._goal = np.array(world.task["goal"][:2], dtype=float)
+        self._tolerance = float(world.task["goal_tolerance"])
+        self._time_limit = float(world.task["time_limit"])
+        self._lidar_height = cfg.lidar_height if cfg.lidar_height is not None else world.lidar_height
+        self._last_action = np.zeros(2)
+        self.episode = Episode(world, *sim.pose())
+        self._painter = None
+        obs = self._observe()
+        #: Seconds the last reset spent getting the world (generating or reading it), adding the robot and
+        #: compiling, and in all (benchmarks/bench_env.py reports them).
+        self.reset_timings = {"world": t1 - t0, "compile": t2 - t1, "total": time.perf_counter() - t0}
+        info = {"world_id": world.world_id, "task": str(world.task["id"]),
+                "reference_path_length": world.reference_path_length, "time_limit": self._time_limit, **where}
+        return obs, info
+
+    @property
+    def task(self) -> dict:
+        """The current episode's task, as world.json ``tasks[]`` has it (spawn, goal, path, time_limit, ...)."""
+        if self.world is None:
+            raise RuntimeError("call reset() first: there is no episode yet")
+        return self.world.task
+
+    @property
+    def robot_pose(self) -> tuple[float, float, float]:
+        """(x, y, yaw) of the robot now: m, m, rad (a scripted baseline's privileged view)."""
+        if self._sim is None:
+            raise RuntimeError("call reset() first: there is no episode yet")
+        return self._sim.pose()
+
+    # -- stepping -------------------------------------------------------------------------------------------
+    def step(self, action):
+        if self.episode is None or self.episode.done:
+            raise RuntimeError("call reset() first: the episode has not started or has ended")
+        a = np.asarray(action, dtype=np.float64).reshape(-1)
+        if a.shape != (2,) or not np.all(np.isfinite(a)):
+            raise ParameterError(f"parameter 'action' must be two finite numbers (v m/s, w rad/s), got {action!r}")
+        v, w = np.clip(a, self._act_lo, self._act_hi)
+        sim, ep = self._sim, self.episode
+        data = sim.data
+        data.ctrl[sim.ctrl] = (v, 0.0, w)
+        previous = self._goal_polar(*sim.pose())[0]
+        collided = self._simulate()
+        x, y, yaw = sim.pose()
+        ep.record(float(data.time), x, y, yaw)
+        self._last_action = np.array([v, w])
+        obs = self._observe()
+        distance, angle = float(obs[-4]), float(obs[-3])
+        reached = math.hypot(x - self._goal[0], y - self._goal[1]) <= self._tolerance
+        outcome = StepOutcome(float(v), float(w), reached, collided, float(self._ranges.min()), distance,
+                              previous, angle, float(data.time))
+        r = reward(outcome, self.config)
+        terminated = bool(reached or (collided and self.config.terminate_on_collision))
+        truncated = bool(not terminated and data.time >= self._time_limit - 1e-9)
+        info = {"time": float(data.time)}
+        if terminated or truncated:
+            ep.done = True
+            info.update(ep.figures())
+        return obs, r, terminated, truncated, info
+
+    def _simulate(self) -> bool:
+        """One control period of physics steps (movers driven before each); True when a contact began."""
+        import mujoco
+
+        sim, ep = self._sim, self.episode
+        model, data = sim.model, sim.data
+        n = self._substeps
+        movers = self._movers
+        xy = movers.positions(data.time + model.opt.timestep * np.arange(n)) if len(movers) else None
+        began = False
+        for k in range(n):
+            if xy is not None:
+                movers.place(data, sim.mocap, xy[k])
+            mujoco.mj_step(model, data)
+            if data.ncon or ep.touching:
+                if ep.touch(data.time, self._touching()):
+                    began = True
+                    if self.config.terminate_on_collision:
+                        break
+        return began
+
+    def _touching(self) -> frozenset:
+        """Names of the entities the robot's geom is in contact with now (the floor left out)."""
+        import mujoco
+
+        sim, data = self._sim, self._sim.data
+        if not data.ncon:
+            return frozenset()
+        pairs = data.contact.geom[: data.ncon]
+        mine = (pairs[:, 0] == sim.geom) | (pairs[:, 1] == sim.geom)
+        others = np.where(pairs[mine, 0] == sim.geom, pairs[mine, 1], pairs[mine, 0])
+        return frozenset(mujoco.mj_id2name(sim.model, mujoco.mjtObj.mjOBJ_GEOM, int(g)) or f"geom_{int(g)}"
+                         for g in others if int(g) not in sim.floor)
+
+    def _goal_polar(self, x: float, y: float, yaw: float) -> tuple[float, float]:
+        dx, dy = self._goal[0] - x, self._goal[1] - y
+        angle = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi
+        return math.hypot(dx, dy), angle
+
+    def _observe(self) -> np.ndarray:
+        sim = self._sim
+        x, y, yaw = sim.pose()
+        self._ranges = self.lidar.cast(sim.model, sim.data, x, y, yaw, self._lidar_height, sim.body)
+        scan = self.lidar.observe(self._ranges, self._noise_rng)
+        distance, angle = self._goal_polar(x, y, yaw)
+        obs = np.empty(self.lidar.size + 4, dtype=np.float32)
+        obs[:-4] = scan
+        obs[-4:] = (distance, angle, self._last_action[0], self._last_action[1])
+        return obs
+
+    # -- drawing --------------------------------------------------------------------------------------------
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() was called without a render_mode; pass render_mode='rgb_array' to the env")
+            return None
+        if self.episode is None:
+            raise RuntimeError("call reset() before render()")
+        from worldgen.envs.render import TopDown, mover_discs
+
+        if self._painter is None:
+            self._painter = TopDown(self.world.metadata())
+        traj = self.episode.trajectory
+        xy = self._movers.positions([self._sim.data.time])[0] if len(self._movers) else None
+        return self._painter.frame(self._sim.pose(), traj[:, 1:3], self.lidar.angles, self._ranges,
+                                   mover_discs(self.world.movers, xy), bool(self.episode.contacts))
+
+    def close(self):
+        self._sim = None
+        self._painter = None
+        super().close()
+

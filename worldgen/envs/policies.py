@@ -1,0 +1,86 @@
+"""Scripted baselines for the navigation environment: a reference-path follower and a random policy.
+
+:class:`PathFollower` is pure pursuit on the task's reference path (world.json
+``tasks[].path.waypoints``, the exact shortest path for the footprint): it steers
+toward the point ``lookahead`` metres further along the path than the robot's
+projection on it, turning on the spot while that point lies more than
+``turn_in_place`` radians off the heading. It reads the robot's true pose (an
+oracle baseline, not a learned policy) and scores SPL close to 1: an upper bound
+a learned policy can be compared with. :class:`RandomPolicy` samples the action
+space from its own seeded generator: the floor.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import numpy as np
+
+__all__ = ["PathFollower", "RandomPolicy"]
+
+
+class PathFollower:
+    """Pure pursuit along ``waypoints`` ((k, 2) m) within ``v_max`` m/s and ``w_max`` rad/s."""
+
+    def __init__(self, waypoints: Sequence[Sequence[float]], v_max: float, w_max: float, lookahead: float = 0.15,
+                 gain: float = 3.0, turn_in_place: float = 0.35):
+        self.path = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+        if len(self.path) == 1:
+            self.path = np.vstack([self.path, self.path])
+        self.v_max, self.w_max = float(v_max), float(w_max)
+        self.lookahead, self.gain, self.turn_in_place = float(lookahead), float(gain), float(turn_in_place)
+        self.segment = 0
+
+    @classmethod
+    def for_env(cls, env, **kwargs) -> "PathFollower":
+        """A follower of the current episode's reference path, within the env's action limits."""
+        env = env.unwrapped
+        return cls(env.task["path"]["waypoints"], float(env.action_space.high[0]), float(env.action_space.high[1]),
+                   **kwargs)
+
+    def _target(self, xy: np.ndarray) -> np.ndarray:
+        path = self.path
+        while True:  # the segment the robot is on: move on once past a segment's end
+            a, b = path[self.segment], path[self.segment + 1]
+            seg = b - a
+            s = float(np.clip(np.dot(xy - a, seg) / max(float(np.dot(seg, seg)), 1e-12), 0.0, 1.0))
+            if s < 1.0 or self.segment == len(path) - 2:
+                break
+            self.segment += 1
+        along = s * math.hypot(*seg) + self.lookahead
+        for k in range(self.segment, len(path) - 1):
+            length = math.hypot(*(path[k + 1] - path[k]))
+            if along <= length:
+                return path[k] + (path[k + 1] - path[k]) * (along / max(length, 1e-12))
+            along -= length
+        return path[-1]
+
+    def action(self, x: float, y: float, yaw: float) -> np.ndarray:
+        """(v, w) as float32 for the robot at (x, y) heading ``yaw``."""
+        xy = np.array([x, y])
+        target = self._target(xy)
+        dx, dy = target - xy
+        err = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi
+        w = float(np.clip(self.gain * err, -self.w_max, self.w_max))
+        if abs(err) > self.turn_in_place:
+            v = 0.0
+        else:
+            # Never faster than the turn rate allows on this curvature (pure pursuit: w = v * 2 sin(err) / d).
+            d = max(math.hypot(dx, dy), 1e-9)
+            curvature = abs(2.0 * math.sin(err) / d)
+            v = min(self.v_max, self.w_max / curvature if curvature > 1e-9 else self.v_max) * math.cos(err)
+            v = min(v, self.v_max * d / self.lookahead)  # ease in on the goal
+        return np.array([max(v, 0.0), w], dtype=np.float32)
+
+
+class RandomPolicy:
+    """Uniform actions in ``action_space`` from its own generator seeded with ``seed``."""
+
+    def __init__(self, action_space, seed: int = 0):
+        self.low = np.asarray(action_space.low, dtype=np.float64)
+        self.high = np.asarray(action_space.high, dtype=np.float64)
+        self.rng = np.random.default_rng(seed)
+
+    def action(self, *_ignored) -> np.ndarray:
+        return self.rng.uniform(self.low, self.high).astype(np.float32)

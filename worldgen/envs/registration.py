@@ -1,0 +1,44 @@
+"""Registering ``worldgen/Navigation-v0`` with Gymnasium.
+
+How Gymnasium finds it, by version:
+
+- Gymnasium 1.x (the ``rl`` extra) has no plugin system: its 1.0 release
+  removed the loading of the ``gymnasium.envs`` entry-point group. An id is
+  known once the module that registers it is imported, which ``gymnasium.make``
+  does itself for an id written ``"module:id"``::
+
+      gymnasium.make("worldgen.envs:worldgen/Navigation-v0", preset="drl_arena")
+
+  or, after ``import worldgen.envs`` (registration happens on import),
+  ``gymnasium.make("worldgen/Navigation-v0", ...)``.
+- Gymnasium 0.26 to 0.29 loaded the ``gymnasium.envs`` entry points when it
+  was imported, calling each one inside its namespace; worldgen declares
+  ``worldgen = "worldgen.envs.registration:register_envs"`` in that group, so
+  there ``gymnasium.make("worldgen/Navigation-v0")`` would work with no import.
+  Those releases are not tested here (the ``rl`` extra asks for Gymnasium 1.x,
+  and 0.29 predates NumPy 2); the tests check that the entry point resolves to
+  this function and that calling it registers the id.
+
+The entry point names the environment class by its import path, so registering
+imports neither MuJoCo nor the environment's modules.
+"""
+
+from __future__ import annotations
+
+__all__ = ["ENV_ID", "ENTRY_POINT", "register_envs"]
+
+#: The environment's Gymnasium id.
+ENV_ID = "worldgen/Navigation-v0"
+#: Where Gymnasium finds the class when it makes the environment.
+ENTRY_POINT = "worldgen.envs.navigation:NavigationEnv"
+
+
+def register_envs() -> None:
+    """Register :data:`ENV_ID` with Gymnasium (again: a no-op); needs Gymnasium installed."""
+    from worldgen.envs.deps import require_gymnasium
+
+    gym = require_gymnasium()
+    if ENV_ID in gym.envs.registry:
+        return
+    # No max_episode_steps: the environment truncates at each task's own time_limit.
+    gym.register(id=ENV_ID, entry_point=ENTRY_POINT)

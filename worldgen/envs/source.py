@@ -1,0 +1,212 @@
+"""Where the environment's worlds come from: a generator (or preset) per episode, or a built pack in order.
+
+A source hands the environment one :class:`EpisodeWorld` per episode: the
+world's MJCF as an lxml element (the env adds its robot to it), the footprint,
+the task as world.json describes it, the movers, and lazy access to the
+oracles' :class:`~worldgen.oracles.Ground` and to world.json (for drawing).
+
+- :class:`GeneratorSource`: ``worldgen.generate(generator, seed, **params)`` in
+  memory, a new seed per episode; nothing touches the disk. A preset is a
+  generator with its parameters (yours on top).
+- :class:`PackSource`: the worlds of a built pack (folder or archive) by index,
+  each read from its world.json and world.mjcf.xml (a pack built without MJCF is
+  regenerated from its recorded generator, seed and parameters, and must give
+  the recorded ``content_hash``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Mapping, Optional
+
+from worldgen.errors import ParameterError, quoted
+from worldgen.scene import Robot
+
+__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "make_source"]
+
+
+@dataclass(eq=False)
+class EpisodeWorld:
+    """One episode's world, as the environment needs it.
+
+    ``task`` has world.json's ``tasks[]`` shape (``spawn``, ``goal``,
+    ``goal_tolerance``, ``path`` with ``waypoints`` and ``length``,
+    ``time_limit``); ``movers`` world.json's ``dynamic_obstacles[]`` shape;
+    ``floor`` the names of the floor geoms (contacts with them are no collision).
+    """
+
+    world_id: str
+    mjcf: Any  # lxml root element of the world's MJCF; the environment may change it
+    robot: Robot
+    task: dict
+    movers: list
+    floor: frozenset
+    lidar_height: float
+    params: dict
+    _ground: Callable[[], Any] = field(repr=False)
+    _metadata: Callable[[], dict] = field(repr=False)
+    _cache: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def reference_path_length(self) -> float:
+        """The task's optimal path length for the footprint (world.json ``tasks[].path.length``), m."""
+        return float(self.task["path"]["length"])
+
+    def ground(self):
+        """The oracles' view of this world (FCL colliders built on first use), built once."""
+        if "ground" not in self._cache:
+            self._cache["ground"] = self._ground()
+        return self._cache["ground"]
+
+    def metadata(self) -> dict:
+        """world.json as a dict (for drawing), built once; costly for a generated world (it renders every file)."""
+        if "metadata" not in self._cache:
+            self._cache["metadata"] = self._metadata()
+        return self._cache["metadata"]
+
+
+def _checked_task(world_id: str, task: dict) -> dict:
+    if not task.get("path") or task.get("time_limit") is None:
+        raise ParameterError(f"world {world_id} has no reference path for task {task.get('id')!r} (it was made "
+                             "infeasible on purpose); the environment needs drivable worlds")
+    return task
+
+
+def _task_of_world(world) -> dict:
+    """world.json's ``tasks[0]`` of an in-memory World, without rendering any file."""
+    from worldgen.doors import door_joints, leaves_in_the_way
+    from worldgen.export.metadata import time_limit
+    from worldgen.params import COMMON_PARAMS
+
+    task = world.tasks[0]
+    path = world.feasibility.paths[0] if world.feasibility.paths else None
+    out = {"id": task.id, "spawn": task.spawn.as_list(), "goal": task.goal.as_list(),
+           "goal_tolerance": float(task.goal_tolerance), "path": None, "time_limit": None,
+           "straight_line_distance": math.hypot(task.goal.x - task.spawn.x, task.goal.y - task.spawn.y)}
+    if path is not None:
+        leaves = []
+        if door_joints(world.scene):
+            leaves = leaves_in_the_way(world.scene, path.waypoints, world.robot.radius, world.robot.height)
+        speed = world.params.get("robot_speed", next(p.default for p in COMMON_PARAMS if p.name == "robot_speed"))
+        out["path"] = {"waypoints": [[float(x), float(y)] for x, y in path.waypoints], "length": float(path.length),
+                       "min_clearance": float(path.min_clearance)}
+        out["time_limit"] = time_limit(float(path.length), speed, len(leaves))
+    return _checked_task(world.world_id, out)
+
+
+def episode_world(world) -> EpisodeWorld:
+    """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
+    from worldgen.export import mjcf
+    from worldgen.movers import metadata_entry
+    from worldgen.oracles import Ground
+
+    task = _task_of_world(world)
+    movers = [metadata_entry(m) for m in world.scene.movers]
+    robot = world.robot
+    light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": movers,
+             "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance}}
+    return EpisodeWorld(
+        world_id=world.world_id, mjcf=mjcf.to_mjcf(world.scene, name=world.world_id).getroot(), robot=robot,
+        task=task, movers=movers, floor=frozenset(n.name for n in world.scene.nodes if n.role == "floor"),
+        lidar_height=float(world.params.get("lidar_height", 0.3)), params=dict(world.params),
+        _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}))
+
+
+class GeneratorSource:
+    """A fresh world per episode from ``generator`` and ``params`` (or a preset), checked up front."""
+
+    def __init__(self, generator: Optional[str] = None, params: Optional[Mapping[str, Any]] = None,
+                 preset: Optional[str] = None):
+        from worldgen.generators import get
+
+        if params is not None and not isinstance(params, Mapping):
+            raise ParameterError(f"parameter 'params' must be a mapping of generator parameters, got {quoted(params)}")
+        params = dict(params or {})
+        self.preset = None
+        if preset is not None:
+            from worldgen.presets import load
+            if generator is not None:
+                raise ParameterError("parameters 'generator' and 'preset' exclude each other; a preset names its "
+                                     f"generator, got generator={generator!r} and preset={preset!r}")
+            p = load(preset)
+            self.preset, generator, params = p.name, p.generator, p.merged(params)
+        if not isinstance(generator, str):
+            raise ParameterError(f"parameter 'generator' must be a generator's name, got {quoted(generator)}")
+        self.generator = generator
+        self.params = params
+        get(generator).resolve(params)  # bad parameters fail now, not at the first reset
+
+    def __len__(self) -> int:
+        return 0  # unbounded: any seed
+
+    def world(self, seed: int) -> EpisodeWorld:
+        from worldgen.api import generate
+
+        world = generate(self.generator, seed, **self.params)
+        world.preset = self.preset
+        return episode_world(world)
+
+
+class PackSource:
+    """The worlds of a built pack (a :class:`~worldgen.Pack`, or its folder or archive path), by index."""
+
+    def __init__(self, pack):
+        from worldgen.pack import Pack
+
+        if isinstance(pack, (str, Path)):
+            pack = Pack.open(pack)
+        if not isinstance(pack, Pack):
+            raise ParameterError(f"parameter 'pack' must be a worldgen.Pack or a pack folder or archive, got {quoted(pack)}")
+        if len(pack) == 0:
+            raise ParameterError(f"parameter 'pack' must hold at least one world, got pack {pack.name!r} with none")
+        self.pack = pack
+
+    def __len__(self) -> int:
+        return len(self.pack)
+
+    def world(self, index: int) -> EpisodeWorld:
+        from worldgen.export.xml import safe_parser
+        from worldgen.oracles import load as ground_of
+        from worldgen.scene import Robot as _Robot
+        from lxml import etree
+
+        pw = self.pack[index]
+        meta = pw.metadata
+        task = _checked_task(pw.world_id, meta["tasks"][0])
+        if "mjcf" in meta.get("files", {}):
+            root = etree.fromstring(pw.read(meta["files"]["mjcf"]["path"]), safe_parser())
+        else:
+            root = self._regenerated_mjcf(pw, meta)
+        r = meta["robot"]
+        params = dict(meta.get("params", {}))
+        return EpisodeWorld(
+            world_id=pw.world_id, mjcf=root, robot=_Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
+            task=task, movers=list(meta.get("dynamic_obstacles") or []),
+            floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
+            lidar_height=float(params.get("lidar_height", 0.3)), params=params,
+            _ground=lambda: ground_of(pw), _metadata=lambda: meta)
+
+    @staticmethod
+    def _regenerated_mjcf(pw, meta):
+        from worldgen.api import generate
+        from worldgen.export import mjcf
+
+        world = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
+                         **meta["params"])
+        if world.content_hash != meta["content_hash"]:
+            raise ParameterError(f"pack world {pw.world_id} has no MJCF and does not regenerate with this worldgen "
+                                 f"version ({world.content_hash} != {meta['content_hash']}); build the pack with mjcf")
+        return mjcf.to_mjcf(world.scene, name=world.world_id).getroot()
+
+
+def make_source(generator=None, params=None, preset=None, pack=None):
+    """The source for the environment's arguments: a pack, a preset, a generator; the ``drl_arena`` preset by default."""
+    if pack is not None:
+        if generator is not None or preset is not None or params:
+            raise ParameterError("parameter 'pack' excludes 'generator', 'preset' and 'params': a pack's worlds are fixed")
+        return PackSource(pack)
+    if generator is None and preset is None:
+        preset = "drl_arena"
+    return GeneratorSource(generator, params, preset)
