@@ -119,28 +119,32 @@ class Colliders:
         gz = np.maximum(np.maximum(self.lo[:, 2] - robot.height, -self.hi[:, 2]), 0.0)
         return np.maximum(d - robot.radius, gz[None, :])
 
-    def segment_lower_bounds(self, robot: Robot, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    def segment_lower_bounds(self, robot: Robot, a: np.ndarray, b: np.ndarray, refine: float = np.inf) -> np.ndarray:
         """(n, m) lower bound of the distance from the volume the robot sweeps along each segment
         a[i]b[i] ((n, 2) each; a point where a == b) to each collider: the 2-D distance from the
-        segment to the collider's box less the radius, or the vertical gap, whichever is larger."""
+        segment to the collider's box less the radius, or the vertical gap, whichever is larger.
+
+        Pairs whose boxes alone already put them ``refine`` or more apart keep that coarser bound.
+        """
         a = np.asarray(a, dtype=float).reshape(-1, 2)
         b = np.asarray(b, dtype=float).reshape(-1, 2)
         lo, hi = self.lo[None, :, :2], self.hi[None, :, :2]
-        d = np.minimum(_point_box(a[:, None, :], lo, hi), _point_box(b[:, None, :], lo, hi))
-        moving = np.flatnonzero(np.any(a != b, axis=1))
-        if len(moving):
-            # Where the segment moves, a box corner may be nearer than either end, or the segment may cross it.
-            am, bm = a[moving][:, None, :], b[moving][:, None, :]
-            ds = d[moving]
+        gz = np.maximum(np.maximum(self.lo[:, 2] - robot.height, -self.hi[:, 2]), 0.0)[None, :]
+        seg_lo, seg_hi = np.minimum(a, b)[:, None, :], np.maximum(a, b)[:, None, :]
+        gap = np.maximum(np.maximum(lo - seg_hi, seg_lo - hi), 0.0)
+        bound = np.maximum(np.sqrt(gap[..., 0] ** 2 + gap[..., 1] ** 2) - robot.radius, gz)
+        p, c = np.nonzero(bound < refine)
+        if len(p):
+            # Exact for these: a box corner may be nearer than either end, or the segment may cross the box.
+            ap, bp, lc, hc = a[p], b[p], self.lo[c, :2], self.hi[c, :2]
+            d = np.minimum(_point_box(ap, lc, hc), _point_box(bp, lc, hc))
             for cx in (0, 1):
                 for cy in (0, 1):
-                    corner = np.stack([np.where(cx, self.hi[:, 0], self.lo[:, 0]),
-                                       np.where(cy, self.hi[:, 1], self.lo[:, 1])], axis=1)[None, :, :]
-                    ds = np.minimum(ds, _point_segment(corner, am, bm))
-            ds = np.where(_crosses_box(am, bm, lo, hi), 0.0, ds)
-            d[moving] = ds
-        gz = np.maximum(np.maximum(self.lo[:, 2] - robot.height, -self.hi[:, 2]), 0.0)
-        return np.maximum(d - robot.radius, gz[None, :])
+                    corner = np.stack([np.where(cx, hc[:, 0], lc[:, 0]), np.where(cy, hc[:, 1], lc[:, 1])], axis=1)
+                    d = np.minimum(d, _point_segment(corner, ap, bp))
+            d = np.where(_crosses_box(ap, bp, lc, hc), 0.0, d)
+            bound[p, c] = np.maximum(d - robot.radius, gz[0, c])
+        return bound
 
     def nearest(self, robot: Robot, xy: np.ndarray, expect: float = 0.0) -> Nearest:
         """Smallest FCL distance from the robot cylinder at any of the (n, 2) points to any collider."""
@@ -165,7 +169,8 @@ class Colliders:
         def measure(p: int, c: int) -> float:
             return self.distance(pieces[p], robot, c)
 
-        return self._nearest(self.segment_lower_bounds(robot, a, b), measure, robot, expect, (a + b) / 2)
+        bounds = self.segment_lower_bounds(robot, a, b, refine=expect + max(robot.radius / 2, 1e-3))
+        return self._nearest(bounds, measure, robot, expect, (a + b) / 2)
 
     def _nearest(self, bounds: np.ndarray, measure, robot: Robot, expect: float, where: np.ndarray) -> Nearest:
         """The smallest of ``measure(p, c)`` over every (piece, collider) pair, exactly.

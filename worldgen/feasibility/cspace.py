@@ -38,7 +38,7 @@ TOUCH = 1e-9
 #: edge touches both of its corner circles exactly at their cones' common boundary.
 CONE_SLACK = 1e-9
 #: From this many obstacles on, segments are tested through a grid rather than against every box.
-GRID_FROM = 120
+GRID_FROM = 250
 #: Samples along each segment in the first round of the grid's walk (half a cell apart; doubling).
 WALK = 4
 #: How far beyond touching (as a fraction of the radius) an obstacle's neighbours are kept.

@@ -455,16 +455,21 @@ def waypoints(cs: ConfigSpace, route: Route, spare: float) -> np.ndarray:
     (measured exactly, up to a tenth of the radius) plus ``spare`` (m), a part of the
     planner's safety margin.
     """
+    arcs = [k for k, c in enumerate(route.contacts) if c.sweep > 1e-9]
+    slack = {}
+    if arcs:
+        contacts = [route.contacts[k] for k in arcs]
+        circle = np.array([c.circle for c in contacts], dtype=np.int64)
+        ccw_start = np.array([c.start if c.side > 0 else c.start - c.sweep for c in contacts])
+        measured = cs.arc_clearance(circle, ccw_start, np.array([c.sweep for c in contacts]))
+        slack = dict(zip(arcs, measured.tolist()))
     pts = [route.points[0]]
     for k, contact in enumerate(route.contacts):
         arrive, depart = route.points[1 + 2 * k], route.points[2 + 2 * k]
         pts.append(arrive)
-        if contact.sweep > 1e-9:
+        if k in slack:
             c, rho = cs.centre[contact.circle], float(cs.rho[contact.circle])
-            ccw_start = contact.start if contact.side > 0 else contact.start - contact.sweep
-            slack = float(cs.arc_clearance(np.array([contact.circle]), np.array([ccw_start]),
-                                           np.array([contact.sweep]))[0])
-            bulge = max(slack, 0.0) + spare
+            bulge = max(slack[k], 0.0) + spare
             step = min(MAX_ARC_STEP, 2 * math.acos(1 / (1 + bulge / rho)))
             n = max(1, math.ceil(contact.sweep / step - 1e-9))
             piece = contact.sweep / n
