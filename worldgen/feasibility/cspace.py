@@ -117,6 +117,9 @@ class _Grid:
         i = np.clip(np.floor((pts[:, 0] - self.origin[0]) / self.h).astype(np.int64), 0, nx - 1)
         j = np.clip(np.floor((pts[:, 1] - self.origin[1]) / self.h).astype(np.int64), 0, ny - 1)
         cell = i * ny + j
+        # A segment's next sample in the same cell finds nothing new.
+        fresh = np.r_[True, (cell[1:] != cell[:-1]) | (rows[1:] != rows[:-1])]
+        rows, cell = rows[fresh], cell[fresh]
         lo, hi = self.start[cell], self.start[cell + 1]
         count = hi - lo
         row = np.repeat(rows, count)
@@ -291,11 +294,8 @@ class ConfigSpace:
             inside = t <= 1.0
             r = np.broadcast_to(rows[:, None], t.shape)[inside]
             pts = a[r] + t[inside][:, None] * d[r]
-            seg, o = grid.pairs(r, pts)
-            seg, o = _unskipped(seg, o, skip1, skip2)
+            seg, o = _unskipped(*grid.pairs(r, pts), skip1, skip2)
             if len(seg):
-                key = np.unique(seg * len(self.obstacles) + o)
-                seg, o = key // len(self.obstacles), key % len(self.obstacles)
                 ok[seg[self._pairs_hit(a[seg], b[seg], o)]] = False
             first += walk
             walk *= 2  # the segments still going are few: longer strides, fewer rounds

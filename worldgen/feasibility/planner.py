@@ -71,7 +71,7 @@ class Route:
 
 
 class _Node:
-    __slots__ = ("circle", "side", "normal", "point", "g", "parent", "lb", "done", "rel")
+    __slots__ = ("circle", "side", "normal", "point", "g", "parent", "lb", "done", "prev_done", "rel")
 
     def __init__(self, circle, side, normal, point, g, parent):
         self.circle = circle
@@ -82,6 +82,7 @@ class _Node:
         self.parent = parent  # (parent node index, departure normal, departure point); None at the start
         self.lb = None  # per-obstacle bounds, once expanded
         self.done = -math.inf  # bound up to which tangents were taken
+        self.prev_done = -math.inf  # ... before the last request
         self.rel = 0.0  # the arrival's angle within the circle's cone
 
 
@@ -108,9 +109,8 @@ class Planner:
     def __init__(self, cs: ConfigSpace):
         self.cs = cs
         n = len(cs.obstacles)
-        self._have: dict[int, np.ndarray] = {}
-        self._parts: dict[int, list[Tangents]] = {}
-        self._table_cache: dict[int, Tangents] = {}
+        self._have: dict[int, np.ndarray] = {}  # per obstacle: the obstacles its tangents were computed to
+        self._store = _Store()
         self._angle0 = np.arctan2(cs.cone_a[:, 1], cs.cone_a[:, 0])
         self._full = cs.full
         self._hull_max = float(cs.hull_r.max()) if n else 0.0
@@ -154,6 +154,7 @@ class Planner:
         live = []
         fresh_circles = []
         dominated = self._dominated([i for _, i in batch if nodes[i].lb is None and nodes[i].circle >= 0])
+        fresh = []
         for key, i in batch:
             node = nodes[i]
             if node.lb is None:
@@ -162,8 +163,11 @@ class Planner:
                         continue
                     self._expanded.setdefault((node.circle, node.side), []).append((node.rel, node.g))
                     fresh_circles.append(i)
-                node.lb = self._bounds(node)
+                fresh.append(node)
             live.append((key, i))
+        if fresh:
+            for node, lb in zip(fresh, self._bounds(fresh)):
+                node.lb = lb
         out = _Candidates()
         goals = _Candidates()
         # Fresh nodes on circles: straight to the goal, and along the grown edge to the next corner.
@@ -190,7 +194,7 @@ class Planner:
         for key, i in live:
             node = nodes[i]
             band, upto = self._band(node, key + BAND)
-            node.done = upto
+            node.prev_done, node.done = node.done, upto
             rest = node.lb[node.lb > upto]
             if len(rest):
                 heapq.heappush(self._heap, (float(rest.min()), self._tie, i))
@@ -199,7 +203,8 @@ class Planner:
                 requests.append((i, band, upto))
         if requests:
             self._fill_tables(requests)
-            for i, band, _ in requests:
+            picked, owners = [], []
+            for i, band, upto in requests:
                 node = nodes[i]
                 if node.circle < 0:
                     dst = _circles_of(cs, band)
@@ -207,12 +212,15 @@ class Planner:
                     tans = tangents(cs, src, dst, s1, s2, src_xy=node.point, among=self._blockers([node], None))
                     out.add(np.full(len(tans), i), tans)
                     continue
-                table = self._table_cache[int(cs.owner[node.circle])]
-                wanted = np.zeros(len(cs.obstacles), dtype=bool)
-                wanted[band] = True
-                rows = np.flatnonzero((table.src == node.circle) & (table.s1 == node.side)
-                                      & wanted[cs.owner[table.dst]])
-                out.add(np.full(len(rows), i), table.take(rows))
+                rows = self._store.rows(node.circle, node.side)
+                if len(rows):
+                    # This request's band: the obstacles whose bound it has just passed.
+                    lb = node.lb[self._store.dst_owner[rows]]
+                    rows = rows[(lb > node.prev_done) & (lb <= upto)]
+                    picked.append(rows)
+                    owners.append(np.full(len(rows), i))
+            if picked:
+                out.add(np.concatenate(owners), self._store.take(np.concatenate(picked)))
         idx, tans = goals.merged()
         if idx is not None:
             g = self._leave(idx, tans)
@@ -252,8 +260,8 @@ class Planner:
         return g
 
     # -- bounds, bands and tables --------------------------------------------
-    def _bounds(self, node: _Node) -> np.ndarray:
-        """(N,) lower bound on the length of any path through ``node`` whose next obstacle is each obstacle.
+    def _bounds(self, nodes: list[_Node]) -> np.ndarray:
+        """(k, N) per node: a lower bound on the length of any path through it whose next obstacle is each one.
 
         The path goes on through a point x of the obstacle's bounding disc (centre c,
         radius r), so it is at least g + |p - x| + |x - goal|, which is at least both
@@ -261,18 +269,22 @@ class Planner:
         line p-goal) - r from that line, 2 sqrt((|p - goal| / 2)^2 + d^2).
         """
         cs, goal = self.cs, self._goal
-        p = node.point
-        dx, dy = cs.hull_c[:, 0] - p[0], cs.hull_c[:, 1] - p[1]
-        gx, gy = cs.hull_c[:, 0] - goal[0], cs.hull_c[:, 1] - goal[1]
-        via = np.sqrt(dx * dx + dy * dy) + np.sqrt(gx * gx + gy * gy) - 2 * cs.hull_r
-        ux, uy = goal[0] - p[0], goal[1] - p[1]
-        span = math.hypot(ux, uy)
-        if span > 0:
-            off = np.maximum(np.abs(dx * uy - dy * ux) / span - cs.hull_r, 0.0)
-            via = np.maximum(via, 2 * np.sqrt(span * span / 4 + off * off))
-        lb = node.g + np.maximum(via, span)
-        if node.circle >= 0:
-            lb[cs.owner[node.circle]] = np.inf
+        p = np.array([n.point for n in nodes])[:, None, :]
+        g = np.array([n.g for n in nodes])[:, None]
+        c = cs.hull_c[None, :, :]
+        d = c - p
+        to_c = np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
+        c_goal = np.hypot(cs.hull_c[:, 0] - goal[0], cs.hull_c[:, 1] - goal[1])[None, :]
+        via = to_c + c_goal - 2 * cs.hull_r[None, :]
+        u = goal[None, None, :] - p
+        span = np.sqrt(u[..., 0] ** 2 + u[..., 1] ** 2)
+        off = np.abs(d[..., 0] * u[..., 1] - d[..., 1] * u[..., 0]) / np.maximum(span, 1e-300)
+        off = np.maximum(off - cs.hull_r[None, :], 0.0)
+        via = np.maximum(via, np.where(span > 0, 2 * np.sqrt(span * span / 4 + off * off), 0.0))
+        lb = g + np.maximum(via, span)
+        for k, node in enumerate(nodes):
+            if node.circle >= 0:
+                lb[k, cs.owner[node.circle]] = np.inf
         return lb
 
     def _band(self, node: _Node, hi: float) -> tuple[np.ndarray, float]:
@@ -309,7 +321,6 @@ class Planner:
         """Compute, in one call, every tangent the requests need that no earlier request did."""
         cs = self.cs
         src_parts, dst_parts, nodes = [], [], []
-        by_obstacle: dict[int, list[np.ndarray]] = {}
         for i, band, _ in requests:
             node = self._nodes[i]
             if node.circle < 0:
@@ -319,22 +330,14 @@ class Planner:
             todo = band[~have[band]]
             if len(todo):
                 have[todo] = True
-                by_obstacle.setdefault(a, []).append(todo)
+                src_c = np.arange(cs.first[a], cs.first[a + 1])
+                dst_c = _circles_of(cs, todo)
+                src_parts.append(np.repeat(src_c, len(dst_c)))
+                dst_parts.append(np.tile(dst_c, len(src_c)))
                 nodes.append(node)
-        if not by_obstacle:
-            return
-        for a, lists in by_obstacle.items():
-            todo = np.concatenate(lists)
-            src_c = np.arange(cs.first[a], cs.first[a + 1])
-            dst_c = _circles_of(cs, todo)
-            src_parts.append(np.repeat(src_c, len(dst_c)))
-            dst_parts.append(np.tile(dst_c, len(src_c)))
-        src, dst, s1, s2 = every_side(np.concatenate(src_parts), np.concatenate(dst_parts))
-        tans = tangents(cs, src, dst, s1, s2, among=self._blockers(nodes, None))
-        owner = cs.owner[tans.src]
-        for a in by_obstacle:
-            self._parts.setdefault(a, []).append(tans.take(np.flatnonzero(owner == a)))
-            self._table_cache[a] = Tangents.concat(self._parts[a])
+        if src_parts:
+            src, dst, s1, s2 = every_side(np.concatenate(src_parts), np.concatenate(dst_parts))
+            self._store.add(tangents(cs, src, dst, s1, s2, among=self._blockers(nodes, None)), cs)
 
     # -- arcs --------------------------------------------------------------
     def _rel(self, circle: int, normal: np.ndarray) -> float:
@@ -425,6 +428,43 @@ class Planner:
                 points.append(q)
         points.append(start)
         return Route(np.array(points[::-1], dtype=float), tuple(contacts[::-1]), float(g))
+
+
+class _Store:
+    """Every tangent computed between obstacles, with the rows leaving each (circle, side)."""
+
+    def __init__(self):
+        self.parts: list[Tangents] = []
+        self.tans: Optional[Tangents] = None
+        self.dst_owner = np.zeros(0, dtype=np.int64)
+        self.index: dict[int, list[np.ndarray]] = {}
+
+    def add(self, tans: Tangents, cs: ConfigSpace) -> None:
+        if not len(tans):
+            return
+        base = len(self.dst_owner)
+        self.parts.append(tans)
+        self.tans = None
+        self.dst_owner = np.concatenate([self.dst_owner, cs.owner[tans.dst]])
+        key = tans.src * 2 + (tans.s1 < 0)
+        order = np.argsort(key, kind="stable")
+        cut = np.flatnonzero(np.r_[True, key[order][1:] != key[order][:-1]])
+        for k, rows in zip(key[order][cut].tolist(), np.split(order + base, cut[1:])):
+            self.index.setdefault(k, []).append(rows)
+
+    def rows(self, circle: int, side: int) -> np.ndarray:
+        parts = self.index.get(circle * 2 + (side < 0))
+        if not parts:
+            return np.zeros(0, dtype=np.int64)
+        if len(parts) > 1:
+            parts[:] = [np.concatenate(parts)]
+        return parts[0]
+
+    def take(self, rows: np.ndarray) -> Tangents:
+        if self.tans is None:
+            self.tans = Tangents.concat(self.parts)
+            self.parts = [self.tans]
+        return self.tans.take(rows)
 
 
 class _Edges:
