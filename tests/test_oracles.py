@@ -212,3 +212,18 @@ def test_folder_colliders_match_the_scene_for_every_shape(tmp_path):
         # world.json keeps poses to 6 decimals: tilted shapes move by ~1e-5 m, contact depths as much.
         assert a.min_clearance == pytest.approx(b.min_clearance, abs=1e-4)
     assert {c.entity for y in (-2.0, -1.0, 1.0) for c in oracles.collisions(line((-3.5, y), (3.5, y), 0, 7), folder)} >= {"ball", "rock"}
+
+
+def test_scenario_yaml_bytes_do_not_depend_on_libyaml(monkeypatch):
+    """scenario.yaml is written by libyaml where PyYAML has it; without it the pure-Python emitter must give
+    the same bytes, or world.json's sha256 would depend on how PyYAML was built."""
+    from worldgen import scenario
+
+    world = worldgen.generate("door", seed=3, n_doors=2, state="random", n_tasks=2)
+    spec = scenario.scenario(world)
+    fast = scenario.dumps(spec)
+    assert "&id" not in fast and "*id" not in fast  # the repeated first task is written out, not aliased
+    monkeypatch.setattr(scenario, "_DUMPER", None)
+    monkeypatch.delattr(yaml, "CSafeDumper", raising=False)
+    assert scenario.dumps(spec) == fast
+    monkeypatch.setattr(scenario, "_DUMPER", None)  # the next caller gets libyaml again

@@ -80,12 +80,23 @@ def scenario(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, Any]:
 def dumps(spec: dict) -> str:
     import yaml
 
-    class _Plain(yaml.SafeDumper):
-        # The top level repeats the first task's blocks: write them out twice, not as &anchors.
-        def ignore_aliases(self, data):
-            return True
+    return yaml.dump(spec, Dumper=_plain_dumper(), sort_keys=True, default_flow_style=None, width=100,
+                     allow_unicode=False)
 
-    return yaml.dump(spec, Dumper=_Plain, sort_keys=True, default_flow_style=None, width=100, allow_unicode=False)
+
+_DUMPER = None
+
+
+def _plain_dumper():
+    """libyaml's emitter where PyYAML has it (0.2 ms a world against 1 to 3 ms for the pure-Python one;
+    the same bytes), with aliases off: the top level repeats the first task's blocks, written out twice."""
+    global _DUMPER
+    if _DUMPER is None:
+        import yaml
+
+        base = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+        _DUMPER = type("_PlainDumper", (base,), {"ignore_aliases": lambda self, data: True})
+    return _DUMPER
 
 
 def files(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, tuple[str, bytes]]:
