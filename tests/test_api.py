@@ -181,3 +181,19 @@ def test_a_map_too_fine_for_the_floor_is_refused_before_any_planning(monkeypatch
     monkeypatch.setattr(feasibility, "check", no_planning)
     with pytest.raises(worldgen.ParameterError, match=r"parameter 'map_resolution' must be at least 0\.1000 m"):
         worldgen.generate("cluttered", size=[500, 500], n_obstacles=0)
+
+
+def test_each_format_is_rendered_once_per_world(monkeypatch):
+    """to_sdf(), to_mjcf(), to_urdf(), metadata and write share one rendering per format (issue 9, item 7)."""
+    from worldgen.export import mjcf, sdf, urdf
+
+    calls = []
+    for module, name in ((sdf, "to_sdf"), (mjcf, "to_mjcf"), (urdf, "to_urdf")):
+        original = getattr(module, name)
+        monkeypatch.setattr(module, name, lambda *a, _o=original, _n=name, **k: calls.append(_n) or _o(*a, **k))
+    world = worldgen.generate("cluttered", seed=4, n_obstacles=5)
+    texts = (world.to_sdf(), world.to_mjcf(), world.to_urdf())
+    world.metadata
+    assert world.read("world.sdf").decode() == texts[0]
+    assert world.to_sdf("1.6") != texts[0]
+    assert sorted(calls) == ["to_mjcf", "to_sdf", "to_sdf", "to_urdf"]

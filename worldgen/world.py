@@ -47,6 +47,7 @@ class World:
         self.allow_infeasible = bool(allow_infeasible)
         self.path: Optional[Path] = None  # the folder once written
         self.preset: Optional[str] = None
+        self._texts: dict[tuple, str] = {}  # export()'s renderings, by (format, SDF version)
 
     def __repr__(self) -> str:
         try:
@@ -91,32 +92,42 @@ class World:
     # -- in-memory exports -------------------------------------------------
     def to_sdf(self, version: str = "1.9") -> str:
         """The world as SDFormat ``version`` (1.9 for Gazebo Fortress-Harmonic, 1.6 for classic)."""
-        if version not in SDF_VERSIONS:
-            raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
-        from worldgen.export import sdf
-        scene = self.scene
-        if scene.movers and not self.params.get("sdf_actors", True):
-            # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.
-            scene = scene.with_movers(())
-        return _text(sdf.to_sdf(scene, version=version, name=self.world_id))
+        return self.export("sdf", version)
 
     def to_mjcf(self) -> str:
         """The world as MJCF, loadable with ``mujoco.MjModel.from_xml_string``."""
-        from worldgen.export import mjcf
-        return _text(mjcf.to_mjcf(self.scene, name=self.world_id))
+        return self.export("mjcf")
 
     def to_urdf(self) -> str:
         """The world as one URDF robot: a root link with every entity a link joined to it."""
-        from worldgen.export import urdf
-        return _text(urdf.to_urdf(self.scene, name=self.world_id))
+        return self.export("urdf")
 
     def export(self, fmt: str, sdf_version: str = "1.9") -> str:
+        """The world's text in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and ``write``
+        share it (a World is a value: its scene and params do not change)."""
+        key = (fmt, sdf_version if fmt == "sdf" else None)
+        text = self._texts.get(key)
+        if text is None:
+            text = self._texts[key] = self._render(fmt, sdf_version)
+        return text
+
+    def _render(self, fmt: str, sdf_version: str) -> str:
         if fmt == "sdf":
-            return self.to_sdf(sdf_version)
+            if sdf_version not in SDF_VERSIONS:
+                raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, "
+                                     f"got {sdf_version!r}")
+            from worldgen.export import sdf
+            scene = self.scene
+            if scene.movers and not self.params.get("sdf_actors", True):
+                # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.
+                scene = scene.with_movers(())
+            return _text(sdf.to_sdf(scene, version=sdf_version, name=self.world_id))
         if fmt == "mjcf":
-            return self.to_mjcf()
+            from worldgen.export import mjcf
+            return _text(mjcf.to_mjcf(self.scene, name=self.world_id))
         if fmt == "urdf":
-            return self.to_urdf()
+            from worldgen.export import urdf
+            return _text(urdf.to_urdf(self.scene, name=self.world_id))
         raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {fmt!r}")
 
     def mesh_files(self) -> dict[str, bytes]:
