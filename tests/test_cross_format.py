@@ -36,7 +36,7 @@ def compiled(scene, fmt: str):
     if fmt == "mjcf":
         model = load(to_bytes(mjcf.to_mjcf(scene)))
     else:
-        model = load(to_bytes(urdf.to_urdf(scene)), assets=meshes.mesh_files(scene))
+        model = load(urdf.to_urdf(scene), assets=meshes.mesh_files(scene))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     return model, data

@@ -21,7 +21,7 @@ from reftools_sdf import check_sdf, dump_sdf
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.export.meshes import mesh_files
 from worldgen.export.sdf import MIN_MOMENT, to_sdf
-from worldgen.export.xml import parse_bytes, to_bytes
+from worldgen.export.xml import parse_bytes
 from worldgen.scene import (Box, Cylinder, Joint, Material, Mesh, Node, Physics, Pose, Scene, Sphere,
                             rpy_matrix)
 
@@ -78,7 +78,7 @@ def hand_scene() -> Scene:
 def write_world(scene: Scene, folder: Path, version: str) -> Path:
     """The SDF file plus the mesh files it names, as World.write lays them out."""
     path = folder / f"world-{version}.sdf"
-    path.write_bytes(to_bytes(to_sdf(scene, version, name="test_world")))
+    path.write_bytes(to_sdf(scene, version, name="test_world"))
     for rel, data in mesh_files(scene).items():
         (folder / rel).parent.mkdir(parents=True, exist_ok=True)
         (folder / rel).write_bytes(data)
@@ -182,7 +182,7 @@ def test_checker_holds_a_16_file_to_the_16_spec(tmp_path):
 
 def test_checker_rejects_a_mesh_file_that_is_not_there(tmp_path):
     path = tmp_path / "world.sdf"
-    path.write_bytes(to_bytes(to_sdf(hand_scene(), "1.9")))
+    path.write_bytes(to_sdf(hand_scene(), "1.9"))
     ok, messages = check_sdf(path)
     assert not ok
     assert any("meshes/rock.stl" in m for m in messages), messages
@@ -251,7 +251,7 @@ def test_16_and_19_describe_the_same_world(tmp_path):
 
 
 def test_markers_and_collision_free_nodes_have_only_a_visual():
-    tree = to_sdf(hand_scene())
+    tree = parse_bytes(to_sdf(hand_scene()))
     link = tree.find(".//model[@name='goal_marker']/link[@name='goal_marker']")
     assert link.find("collision") is None
     assert link.find("visual/geometry/cylinder") is not None
@@ -259,7 +259,7 @@ def test_markers_and_collision_free_nodes_have_only_a_visual():
 
 
 def test_mesh_inertial_sits_at_the_bounding_box_centre():
-    tree = to_sdf(hand_scene())
+    tree = parse_bytes(to_sdf(hand_scene()))
     pose = tree.find(".//link[@name='loose_rock']/inertial/pose")
     v = rock().scaled_vertices()
     want = (v.min(axis=0) + v.max(axis=0)) / 2
@@ -281,7 +281,7 @@ def test_physics_values_are_written(tmp_path, version, step, rtf, rate):
 
 def test_the_world_is_named_and_self_contained():
     scene, _ = draft("cluttered", seed=4)
-    text = to_bytes(to_sdf(scene, name="cluttered-s4-0123abcd")).decode()
+    text = to_sdf(scene, name="cluttered-s4-0123abcd").decode()
     root = parse_bytes(text.encode()).getroot()
     assert root.find("world").get("name") == "cluttered-s4-0123abcd"
     assert "model://" not in text and "<include" not in text
@@ -292,8 +292,8 @@ def test_the_world_is_named_and_self_contained():
 @pytest.mark.parametrize("version", VERSIONS)
 def test_output_bytes_are_deterministic(version):
     scene = hand_scene()
-    first = to_bytes(to_sdf(scene, version))
-    assert to_bytes(to_sdf(hand_scene(), version)) == first
+    first = to_sdf(scene, version)
+    assert to_sdf(hand_scene(), version) == first
     assert b"-0 " not in first and b">-0<" not in first and b"e-0" not in first
 
 
@@ -301,14 +301,14 @@ def test_output_bytes_match_in_a_fresh_process():
     code = (
         "import hashlib, sys; sys.path.insert(0, 'tests')\n"
         "from conftest import draft\n"
-        "from worldgen.export.sdf import to_sdf\nfrom worldgen.export.xml import to_bytes\n"
+        "from worldgen.export.sdf import to_sdf\n"
         "scene, _ = draft('cluttered', seed=0)\n"
-        "print(hashlib.sha256(to_bytes(to_sdf(scene, '1.9')) + to_bytes(to_sdf(scene, '1.6'))).hexdigest())\n"
+        "print(hashlib.sha256(to_sdf(scene, '1.9') + to_sdf(scene, '1.6')).hexdigest())\n"
     )
     root = Path(__file__).resolve().parent.parent
     out = subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True, check=True)
     scene, _ = draft("cluttered", seed=0)
-    here = hashlib.sha256(to_bytes(to_sdf(scene, "1.9")) + to_bytes(to_sdf(scene, "1.6"))).hexdigest()
+    here = hashlib.sha256(to_sdf(scene, "1.9") + to_sdf(scene, "1.6")).hexdigest()
     assert out.stdout.strip() == here
 
 
@@ -330,7 +330,7 @@ def test_generated_joint_names_avoid_scene_names():
         Node("arm", "door", Box((0.5, 0.1, 0.1)), Pose(0.3, 0, 0), parent="base"),
         Node("arm_fixed", "marker", Sphere(0.05), Pose(0, 0, 2)),
     )
-    names = [j.get("name") for j in to_sdf(Scene(nodes)).iter("joint")]
+    names = [j.get("name") for j in parse_bytes(to_sdf(Scene(nodes))).iter("joint")]
     assert names == ["arm_fixed_1"]
 
 

@@ -15,7 +15,7 @@ from export_scenes import rock_mesh, showcase_scene
 from reftools_mujoco import load_and_step
 from reftools_urdf import check_urdf
 from worldgen.export import meshes, urdf
-from worldgen.export.xml import parse_bytes, to_bytes
+from worldgen.export.xml import parse_bytes
 from worldgen.scene import Box, Mesh, Node, Pose, Scene
 
 CLUTTERED_CASES = [(seed, {}) for seed in range(30)] + [
@@ -27,7 +27,7 @@ CLUTTERED_CASES = [(seed, {}) for seed in range(30)] + [
 
 def write_world(folder, scene: Scene, name: str = "world"):
     """world.urdf and its mesh files in ``folder``, as World.write lays them out; returns the URDF path."""
-    data = to_bytes(urdf.to_urdf(scene, name=name))
+    data = urdf.to_urdf(scene, name=name)
     for rel, blob in meshes.mesh_files(scene).items():
         (folder / rel).parent.mkdir(parents=True, exist_ok=True)
         (folder / rel).write_bytes(blob)
@@ -74,7 +74,7 @@ def test_showcase_passes_check_urdf_and_loads_from_file_and_from_memory(tmp_path
 
 def test_revolute_joints_carry_limit_and_dynamics_and_friction_goes_to_gazebo_tags():
     scene = showcase_scene()
-    root = parse_bytes(to_bytes(urdf.to_urdf(scene))).getroot()
+    root = parse_bytes(urdf.to_urdf(scene)).getroot()
     joint = root.find("joint[@name='door_hinge']")
     assert joint.get("type") == "revolute"
     limit = joint.find("limit")
@@ -102,7 +102,7 @@ def test_materials_are_shared_by_name_and_split_when_a_name_has_two_colours():
     b = Material("paint", (0.0, 0.0, 1.0, 1.0))
     nodes = tuple(Node(f"n{i}", "obstacle", Box((1, 1, 1)), Pose(2 * i, 0, 0.5), material=m)
                   for i, m in enumerate((a, a, b)))
-    root = parse_bytes(to_bytes(urdf.to_urdf(Scene(nodes)))).getroot()
+    root = parse_bytes(urdf.to_urdf(Scene(nodes))).getroot()
     colours = {m.get("name"): m.find("color").get("rgba") for m in root.findall("material")}
     assert colours == {"paint": "1 0 0 1", "paint_1": "0 0 1 1"}
     used = [root.find(f"link[@name='n{i}']/visual/material").get("name") for i in range(3)]
@@ -110,8 +110,8 @@ def test_materials_are_shared_by_name_and_split_when_a_name_has_two_colours():
 
 
 def test_same_scene_same_bytes():
-    a = to_bytes(urdf.to_urdf(showcase_scene(), name="x"))
-    assert a == to_bytes(urdf.to_urdf(showcase_scene(), name="x"))
+    a = urdf.to_urdf(showcase_scene(), name="x")
+    assert a == urdf.to_urdf(showcase_scene(), name="x")
     assert b"-0 " not in a and b'"-0"' not in a
 
 

@@ -121,13 +121,13 @@ class World:
             if scene.movers and not self.params.get("sdf_actors", True):
                 # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.
                 scene = scene.with_movers(())
-            return _text(sdf.to_sdf(scene, version=sdf_version, name=self.world_id))
+            return sdf.to_sdf(scene, version=sdf_version, name=self.world_id).decode()
         if fmt == "mjcf":
             from worldgen.export import mjcf
             return _text(mjcf.to_mjcf(self.scene, name=self.world_id))
         if fmt == "urdf":
             from worldgen.export import urdf
-            return _text(urdf.to_urdf(self.scene, name=self.world_id))
+            return urdf.to_urdf(self.scene, name=self.world_id).decode()
         raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {fmt!r}")
 
     def mesh_files(self) -> dict[str, bytes]:

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 from lxml import etree
 
-from worldgen.export.xml import sub
+from worldgen.export.xml import XmlText, sub
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Mover, Scene
 from worldgen.scene.mover import MOVER_RGBA
@@ -48,38 +48,50 @@ __all__ = ["write_sdf_actors", "write_mjcf_mocap", "TRAJECTORY_TYPE"]
 TRAJECTORY_TYPE = "walk"
 
 
-def write_sdf_actors(world: etree._Element, scene: Scene) -> None:
-    """Append one ``<actor>`` per mover to the SDF ``<world>`` element."""
+def write_sdf_actors(out: XmlText, scene: Scene) -> None:
+    """Write one ``<actor>`` per mover at the end of the SDF ``<world>`` (``out`` is at its children's depth)."""
     for mover in scene.movers:
-        _sdf_actor(world, mover)
+        _sdf_actor(out, mover)
 
 
-def _sdf_actor(world, mover: Mover) -> None:
-    actor = sub(world, "actor", name=mover.name)
-    link = sub(actor, "link", name="body")
-    sub(link, "pose", fmt_seq((0.0, 0.0, mover.height / 2.0, 0.0, 0.0, 0.0)))
-    collision = sub(link, "collision", name="collision")
-    _cylinder(sub(collision, "geometry"), mover)
-    visual = sub(link, "visual", name="visual")
-    _cylinder(sub(visual, "geometry"), mover)
-    material = sub(visual, "material")
-    sub(material, "ambient", fmt_seq(MOVER_RGBA))
-    sub(material, "diffuse", fmt_seq(MOVER_RGBA))
-    script = sub(actor, "script")
-    sub(script, "loop", "true" if mover.loop else "false")
-    sub(script, "delay_start", "0")
-    sub(script, "auto_start", "true")
-    trajectory = sub(script, "trajectory", id="0", type=TRAJECTORY_TYPE, tension="1")
+def _sdf_actor(out: XmlText, mover: Mover) -> None:
+    out.open("actor", f' name="{mover.name}"')
+    out.open("link", ' name="body"')
+    out.leaf("pose", fmt_seq((0.0, 0.0, mover.height / 2.0, 0.0, 0.0, 0.0)))
+    out.open("collision", ' name="collision"')
+    _cylinder(out, mover)
+    out.close("collision")
+    out.open("visual", ' name="visual"')
+    _cylinder(out, mover)
+    colour = fmt_seq(MOVER_RGBA)
+    out.open("material")
+    out.leaf("ambient", colour)
+    out.leaf("diffuse", colour)
+    out.close("material")
+    out.close("visual")
+    out.close("link")
+    out.open("script")
+    out.leaf("loop", "true" if mover.loop else "false")
+    out.leaf("delay_start", "0")
+    out.leaf("auto_start", "true")
+    out.open("trajectory", f' id="0" type="{TRAJECTORY_TYPE}" tension="1"')
     for t, x, y in mover.trajectory:
-        waypoint = sub(trajectory, "waypoint")
-        sub(waypoint, "time", fmt(t))
-        sub(waypoint, "pose", fmt_seq((x, y, 0.0, 0.0, 0.0, 0.0)))
+        out.open("waypoint")
+        out.leaf("time", fmt(t))
+        out.leaf("pose", fmt_seq((x, y, 0.0, 0.0, 0.0, 0.0)))
+        out.close("waypoint")
+    out.close("trajectory")
+    out.close("script")
+    out.close("actor")
 
 
-def _cylinder(geometry, mover: Mover) -> None:
-    cylinder = sub(geometry, "cylinder")
-    sub(cylinder, "radius", fmt(mover.radius))
-    sub(cylinder, "length", fmt(mover.height))
+def _cylinder(out: XmlText, mover: Mover) -> None:
+    out.open("geometry")
+    out.open("cylinder")
+    out.leaf("radius", fmt(mover.radius))
+    out.leaf("length", fmt(mover.height))
+    out.close("cylinder")
+    out.close("geometry")
 
 
 def write_mjcf_mocap(worldbody: etree._Element, scene: Scene) -> None:

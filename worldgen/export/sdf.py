@@ -58,11 +58,10 @@ from __future__ import annotations
 from typing import Optional
 
 import numpy as np
-from lxml import etree
 
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.export.movers import write_sdf_actors
-from worldgen.export.xml import load_template
+from worldgen.export.xml import XmlText, escape_text, fill, load_template
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose
 from worldgen.scene.graph import Joint
@@ -77,11 +76,13 @@ TEMPLATE = "world.sdf"
 MIN_MOMENT = 1e-6
 
 
-def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> etree._ElementTree:
-    """The SDFormat world of ``scene`` as an lxml tree (see the module docstring).
+def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> bytes:
+    """The SDFormat world of ``scene``: UTF-8 bytes, pretty-printed (see the module docstring).
 
     ``name`` is the world's name; SDFormat 1.8+ reserves ``world`` and names
-    starting with ``__``, so the default is Gazebo's usual ``default``.
+    starting with ``__``, so the default is Gazebo's usual ``default``. The
+    skeleton is filled with lxml; the models and actors are written as text
+    (:class:`~worldgen.export.xml.XmlText`).
     """
     if version not in SDF_VERSIONS:
         raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
@@ -96,12 +97,13 @@ def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> etree._
     world = root.find("world")
     world.set("name", name)
     _fill_physics(world, scene)
+    out = XmlText(depth=2)
     writer = _ModelWriter(scene, version)
     for node in scene.nodes:
         if node.parent is None:
-            writer.write(world, node)
-    write_sdf_actors(world, scene)
-    return tree
+            writer.write(out, node)
+    write_sdf_actors(out, scene)
+    return fill(tree, world, out)
 
 
 def _fill_physics(world, scene: Scene) -> None:
@@ -130,8 +132,6 @@ class _ModelWriter:
             self.joint_of[joint.child] = joint
         # Every name a generated joint must avoid: links and joints share a model's name scope.
         self.taken = {n.name for n in scene.nodes} | {j.name for j in scene.joints}
-        self.surfaces: dict[float, etree._Element] = {}
-        self.materials: dict[tuple, etree._Element] = {}
 
     def subtree(self, root: Node) -> list[Node]:
         """``root`` and its descendants, depth first, children in scene order."""
@@ -142,31 +142,32 @@ class _ModelWriter:
             stack.extend(reversed(self.children.get(node.name, ())))
         return out
 
-    def write(self, world, root: Node) -> None:
+    def write(self, out: XmlText, root: Node) -> None:
         nodes = self.subtree(root)
         static = all(n.static for n in nodes)
-        model = _el(world, "model", name=root.name)
-        _el(model, "static", "true" if static else "false")
-        _pose(model, root.pose)
+        out.open("model", f' name="{root.name}"')
+        out.leaf("static", "true" if static else "false")
+        _pose(out, root.pose)
         names = {n.name for n in nodes}
         for node in nodes:
-            self._link(model, node, root, with_inertial=not static)
+            self._link(out, node, root, with_inertial=not static)
         for node in nodes:
             joint = self.joint_of.get(node.name)
             if node is root:
                 if joint is not None:
-                    self._joint(model, joint, names)
+                    self._joint(out, joint, names)
                 elif not static and root.static:
                     # The root stays put while its descendants move: weld it to the world.
-                    self._fixed(model, self._fresh(f"{root.name}_world"), "world", root.name)
+                    self._fixed(out, self._fresh(f"{root.name}_world"), "world", root.name)
             elif joint is not None:
                 if joint.parent != node.parent:
                     raise WorldgenError(
                         f"joint {joint.name!r} joins {joint.child!r} to {joint.parent!r}, "
                         f"but that node's parent is {node.parent!r}")
-                self._joint(model, joint, names)
+                self._joint(out, joint, names)
             else:
-                self._fixed(model, self._fresh(f"{node.name}_fixed"), node.parent, node.name)
+                self._fixed(out, self._fresh(f"{node.name}_fixed"), node.parent, node.name)
+        out.close("model")
 
     def _fresh(self, base: str) -> str:
         name, k = base, 1
@@ -175,140 +176,126 @@ class _ModelWriter:
         self.taken.add(name)
         return name
 
-    def _link(self, model, node: Node, root: Node, with_inertial: bool) -> None:
-        link = _el(model, "link", name=node.name)
+    def _link(self, out: XmlText, node: Node, root: Node, with_inertial: bool) -> None:
+        out.open("link", f' name="{node.name}"')
         if node is not root:
             if self.frames:
-                _pose(link, node.pose, relative_to=node.parent)
+                _pose(out, node.pose, relative_to=node.parent)
             else:
                 in_model = np.linalg.inv(self.scene.world_matrix(root.name)) @ self.scene.world_matrix(node.name)
-                _pose(link, matrix_to_pose(in_model))
+                _pose(out, matrix_to_pose(in_model))
         if with_inertial:
-            _inertial(link, node)
-        if node.shape is None:
-            return
-        geometry = _geometry(node.shape)
-        if node.collision:
-            collision = _el(link, "collision", name="collision")
-            collision.append(_clone(geometry))
-            collision.append(_clone(self._surface(node.material.friction)))
-        visual = _el(link, "visual", name="visual")
-        visual.append(geometry)
-        visual.append(_clone(self._material(node.material.rgba)))
-        if node.material.rgba[3] < 1.0:
-            _el(visual, "transparency", fmt(1.0 - node.material.rgba[3]))
+            _inertial(out, node)
+        if node.shape is not None:
+            geometry = _geometry(node.shape)
+            rgba = node.material.rgba
+            if node.collision:
+                mu = fmt(node.material.friction)
+                out.open("collision", ' name="collision"')
+                _write_geometry(out, geometry)
+                out.open("surface")
+                out.open("friction")
+                out.open("ode")
+                out.leaf("mu", mu)
+                out.leaf("mu2", mu)
+                out.close("ode")
+                out.close("friction")
+                out.close("surface")
+                out.close("collision")
+            out.open("visual", ' name="visual"')
+            _write_geometry(out, geometry)
+            colour = fmt_seq(rgba)
+            out.open("material")
+            out.leaf("ambient", colour)
+            out.leaf("diffuse", colour)
+            out.close("material")
+            if rgba[3] < 1.0:
+                out.leaf("transparency", fmt(1.0 - rgba[3]))
+            out.close("visual")
+        out.close("link")
 
-    # Surfaces and colours repeat across many nodes: build each once, copy it after.
-    def _surface(self, friction: float):
-        if friction not in self.surfaces:
-            surface = etree.Element("surface")
-            ode = _el(_el(surface, "friction"), "ode")
-            _el(ode, "mu", fmt(friction))
-            _el(ode, "mu2", fmt(friction))
-            self.surfaces[friction] = surface
-        return self.surfaces[friction]
-
-    def _material(self, rgba: tuple):
-        if rgba not in self.materials:
-            material = etree.Element("material")
-            text = fmt_seq(rgba)
-            _el(material, "ambient", text)
-            _el(material, "diffuse", text)
-            self.materials[rgba] = material
-        return self.materials[rgba]
-
-    def _joint(self, model, joint: Joint, names: set[str]) -> None:
+    def _joint(self, out: XmlText, joint: Joint, names: set[str]) -> None:
         if joint.parent != "world" and joint.parent not in names:
             raise WorldgenError(
                 f"joint {joint.name!r}: parent {joint.parent!r} is not in the model of {joint.child!r}; "
                 "SDF joints stay inside one model")
         if joint.kind == "fixed":
-            element = self._fixed(model, joint.name, joint.parent, joint.child)
-            if not _is_identity(joint.pose):
-                element.insert(0, _pose_element(joint.pose))
+            self._fixed(out, joint.name, joint.parent, joint.child,
+                        pose=None if _is_identity(joint.pose) else joint.pose)
             return
-        element = _el(model, "joint", name=joint.name, type="revolute")
+        out.open("joint", f' name="{joint.name}" type="revolute"')
         if not _is_identity(joint.pose):
-            _pose(element, joint.pose)
-        _el(element, "parent", joint.parent)
-        _el(element, "child", joint.child)
-        axis = _el(element, "axis")
-        _el(axis, "xyz", fmt_seq(joint.axis))
-        _el(_el(axis, "dynamics"), "damping", fmt(joint.damping))
-        limit = _el(axis, "limit")
+            _pose(out, joint.pose)
+        out.leaf("parent", joint.parent)
+        out.leaf("child", joint.child)
+        out.open("axis")
+        out.leaf("xyz", fmt_seq(joint.axis))
+        out.open("dynamics")
+        out.leaf("damping", fmt(joint.damping))
+        out.close("dynamics")
+        out.open("limit")
         # The written poses are the joint's zero: measure the limits from the initial angle.
-        _el(limit, "lower", fmt(joint.limits[0] - joint.initial))
-        _el(limit, "upper", fmt(joint.limits[1] - joint.initial))
-        _el(limit, "effort", fmt(joint.effort))
-        _el(limit, "velocity", fmt(joint.velocity))
+        out.leaf("lower", fmt(joint.limits[0] - joint.initial))
+        out.leaf("upper", fmt(joint.limits[1] - joint.initial))
+        out.leaf("effort", fmt(joint.effort))
+        out.leaf("velocity", fmt(joint.velocity))
+        out.close("limit")
+        out.close("axis")
+        out.close("joint")
 
     @staticmethod
-    def _fixed(model, name: str, parent: str, child: str):
-        element = _el(model, "joint", name=name, type="fixed")
-        _el(element, "parent", parent)
-        _el(element, "child", child)
-        return element
+    def _fixed(out: XmlText, name: str, parent: str, child: str, pose: Optional[Pose] = None) -> None:
+        out.open("joint", f' name="{name}" type="fixed"')
+        if pose is not None:
+            _pose(out, pose)
+        out.leaf("parent", parent)
+        out.leaf("child", child)
+        out.close("joint")
 
 
 def _is_identity(pose: Pose) -> bool:
     return all(fmt(v) == "0" for v in pose.as_list())
 
 
-def _pose_element(pose: Pose, relative_to: Optional[str] = None):
-    element = etree.Element("pose")
-    if relative_to is not None:
-        element.set("relative_to", relative_to)
-    element.text = fmt_seq(pose.as_list())
-    return element
+def _pose(out: XmlText, pose: Pose, relative_to: Optional[str] = None) -> None:
+    out.leaf("pose", fmt_seq(pose.as_list()), "" if relative_to is None else f' relative_to="{relative_to}"')
 
 
-def _pose(parent, pose: Pose, relative_to: Optional[str] = None) -> None:
-    parent.append(_pose_element(pose, relative_to))
-
-
-def _inertial(link, node: Node) -> None:
-    inertial = _el(link, "inertial")
+def _inertial(out: XmlText, node: Node) -> None:
+    out.open("inertial")
     if isinstance(node.shape, Mesh):
         # The moments are those of the mesh's bounding box, about the box's centre.
         v = node.shape.scaled_vertices()
         centre = (v.min(axis=0) + v.max(axis=0)) / 2.0
         if any(fmt(c) != "0" for c in centre):
-            _pose(inertial, Pose(*centre))
-    _el(inertial, "mass", fmt(node.mass))
+            _pose(out, Pose(*centre))
+    out.leaf("mass", fmt(node.mass))
     ixx, iyy, izz = (max(i, MIN_MOMENT) for i in node.inertia)
-    inertia = _el(inertial, "inertia")
+    out.open("inertia")
     for tag, value in (("ixx", ixx), ("ixy", 0.0), ("ixz", 0.0), ("iyy", iyy), ("iyz", 0.0), ("izz", izz)):
-        _el(inertia, tag, fmt(value))
+        out.leaf(tag, fmt(value))
+    out.close("inertia")
+    out.close("inertial")
 
 
-def _clone(element: etree._Element) -> etree._Element:
-    """A deep copy of a small cached subtree (lxml's own copy, without the copy module's dispatch)."""
-    return element.__deepcopy__(None)
-
-
-def _el(parent, tag: str, text: Optional[str] = None, **attrs) -> etree._Element:
-    """``sub`` without its per-attribute loop: this exporter's hot path."""
-    element = etree.SubElement(parent, tag, attrs) if attrs else etree.SubElement(parent, tag)
-    if text is not None:
-        element.text = text
-    return element
-
-
-def _geometry(shape) -> etree._Element:
-    """A detached ``<geometry>`` element for ``shape`` (SDF sizes: full extents, radius, length)."""
-    geometry = etree.Element("geometry")
+def _geometry(shape) -> tuple[str, tuple[tuple[str, str], ...]]:
+    """``(shape element, ((child, text), ...))`` inside ``<geometry>`` (SDF sizes: full extents, radius, length)."""
     if isinstance(shape, Box):
-        _el(_el(geometry, "box"), "size", fmt_seq(shape.size))
-    elif isinstance(shape, Cylinder):
-        cylinder = _el(geometry, "cylinder")
-        _el(cylinder, "radius", fmt(shape.radius))
-        _el(cylinder, "length", fmt(shape.length))
-    elif isinstance(shape, Sphere):
-        _el(_el(geometry, "sphere"), "radius", fmt(shape.radius))
-    elif isinstance(shape, Mesh):
-        mesh = _el(geometry, "mesh")
-        _el(mesh, "uri", shape.uri)
-        _el(mesh, "scale", fmt_seq(shape.scale))
-    else:
-        raise WorldgenError(f"the SDF exporter has no geometry for shape {shape!r}")
-    return geometry
+        return "box", (("size", fmt_seq(shape.size)),)
+    if isinstance(shape, Cylinder):
+        return "cylinder", (("radius", fmt(shape.radius)), ("length", fmt(shape.length)))
+    if isinstance(shape, Sphere):
+        return "sphere", (("radius", fmt(shape.radius)),)
+    if isinstance(shape, Mesh):
+        return "mesh", (("uri", escape_text(shape.uri)), ("scale", fmt_seq(shape.scale)))
+    raise WorldgenError(f"the SDF exporter has no geometry for shape {shape!r}")
+
+
+def _write_geometry(out: XmlText, geometry) -> None:
+    kind, fields = geometry
+    out.open("geometry")
+    out.open(kind)
+    for tag, content in fields:
+        out.leaf(tag, content)
+    out.close(kind)
+    out.close("geometry")

@@ -1,4 +1,4 @@
-"""URDF exporter: Scene -> lxml tree, filled into ``templates/world.urdf``.
+"""URDF exporter: Scene -> URDF bytes, filled into ``templates/world.urdf``.
 
 URDF describes one kinematic tree, so a world becomes one "robot":
 
@@ -45,11 +45,10 @@ URDF describes one kinematic tree, so a world becomes one "robot":
 from __future__ import annotations
 
 import numpy as np
-from lxml import etree
 
 from worldgen.errors import SceneError
 from worldgen.export.mjcf import RESERVED_NAME, joints_by_child, mass_properties
-from worldgen.export.xml import load_template, sub
+from worldgen.export.xml import XmlText, escape_attr, fill, load_template, sub
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose
 
@@ -74,8 +73,12 @@ def joint_origin(node: Node, joint: Joint | None, parent_joint: Joint | None) ->
     return np.linalg.inv(link_offset(parent_joint)) @ node.pose.matrix() @ link_offset(joint)
 
 
-def to_urdf(scene: Scene, name: str = "world"):
-    """The scene as a URDF document (an lxml ElementTree)."""
+def to_urdf(scene: Scene, name: str = "world") -> bytes:
+    """The scene as a URDF document: UTF-8 bytes, pretty-printed (see the module docstring).
+
+    The skeleton is filled with lxml; the materials, links, joints and
+    ``<gazebo>`` blocks are written as text (:class:`~worldgen.export.xml.XmlText`).
+    """
     joints = joints_by_child(scene)
     _check_joint_names(scene, joints)
     tree = load_template(TEMPLATE)
@@ -83,17 +86,20 @@ def to_urdf(scene: Scene, name: str = "world"):
     robot.set("name", name)
     # Only MuJoCo's importer reads physics from a URDF: step and gravity go in its extension.
     sub(robot.find("mujoco"), "option", timestep=fmt(scene.physics.step_size), gravity=fmt_seq(scene.physics.gravity))
-    materials = _write_materials(robot, scene)
+    out = XmlText(depth=1)
+    materials = _write_materials(out, scene)
     for node in scene.nodes:
         joint = joints.get(node.name)
         parent_joint = joints.get(node.parent) if node.parent is not None else None
-        _write_link(robot, node, joint, materials)
-        _write_joint(robot, node, joint, parent_joint)
+        _write_link(out, node, joint, materials)
+        _write_joint(out, node, joint, parent_joint)
         if node.shape is not None and node.collision:
-            gz = sub(robot, "gazebo", reference=node.name)
-            sub(gz, "mu1", fmt(node.material.friction))
-            sub(gz, "mu2", fmt(node.material.friction))
-    return tree
+            mu = fmt(node.material.friction)
+            out.open("gazebo", f' reference="{node.name}"')
+            out.leaf("mu1", mu)
+            out.leaf("mu2", mu)
+            out.close("gazebo")
+    return fill(tree, robot, out)
 
 
 def _joint_name(node: Node, joint: Joint | None) -> str:
@@ -110,8 +116,8 @@ def _check_joint_names(scene: Scene, joints: dict[str, Joint]) -> None:
         seen[jname] = node.name
 
 
-def _write_materials(robot, scene: Scene) -> dict[str, str]:
-    """Top-level ``<material>`` elements; returns {node name: material name}.
+def _write_materials(out: XmlText, scene: Scene) -> dict[str, str]:
+    """Top-level ``<material>`` elements, before any link that uses them; returns {node name: material name}.
 
     Materials are shared by name; a name reused with another colour gets a suffix,
     because URDF keeps one colour per material name.
@@ -119,7 +125,6 @@ def _write_materials(robot, scene: Scene) -> dict[str, str]:
     by_key: dict[tuple, str] = {}
     used: set[str] = set()
     result: dict[str, str] = {}
-    at = _first_link_index(robot) + 1  # after the root link, before any link that uses them
     for node in scene.nodes:
         if node.shape is None:
             continue
@@ -130,88 +135,88 @@ def _write_materials(robot, scene: Scene) -> dict[str, str]:
                 mname, k = f"{node.material.name}_{k}", k + 1
             used.add(mname)
             by_key[key] = mname
-            mat = etree.Element("material", name=mname)
-            sub(mat, "color", rgba=fmt_seq(node.material.rgba))
-            robot.insert(at, mat)
-            at += 1
+            out.open("material", f' name="{escape_attr(mname)}"')
+            out.empty("color", f' rgba="{fmt_seq(node.material.rgba)}"')
+            out.close("material")
         result[node.name] = by_key[key]
     return result
 
 
-def _first_link_index(robot) -> int:
-    for i, child in enumerate(robot):
-        if child.tag == "link":
-            return i
-    return len(robot)
-
-
 #: The identity origin, by far the most common one: written without any matrix work.
-_IDENTITY = {"xyz": "0 0 0", "rpy": "0 0 0"}
+_IDENTITY = ' xyz="0 0 0" rpy="0 0 0"'
 
 
-def _pose_attrs(pose) -> dict[str, str]:
-    return {"xyz": fmt_seq((pose.x, pose.y, pose.z)), "rpy": fmt_seq((pose.roll, pose.pitch, pose.yaw))}
+def _pose_attrs(pose) -> str:
+    return f' xyz="{fmt_seq((pose.x, pose.y, pose.z))}" rpy="{fmt_seq((pose.roll, pose.pitch, pose.yaw))}"'
 
 
-def _matrix_attrs(m: np.ndarray) -> dict[str, str]:
+def _matrix_attrs(m: np.ndarray) -> str:
     return _pose_attrs(matrix_to_pose(m))
 
 
-def _write_link(robot, node: Node, joint: Joint | None, materials) -> None:
-    link = sub(robot, "link", name=node.name)
+def _write_link(out: XmlText, node: Node, joint: Joint | None, materials) -> None:
+    out.open("link", f' name="{node.name}"')
     offset = link_offset(joint) if joint is not None and joint.kind == "revolute" else None
     back = _IDENTITY if offset is None else _matrix_attrs(np.linalg.inv(offset))  # node frame in link frame
-    inertial = sub(link, "inertial")
-    sub(inertial, "origin", **back)
     mass, (ixx, iyy, izz) = mass_properties(node)
-    sub(inertial, "mass", value=mass)
-    sub(inertial, "inertia", ixx=ixx, ixy="0", ixz="0", iyy=iyy, iyz="0", izz=izz)
-    if node.shape is None:
-        return
-    kind, attrs = _geometry_attrs(node)
-    visual = sub(link, "visual", name=node.name)
-    sub(visual, "origin", **back)
-    sub(sub(visual, "geometry"), kind, **attrs)
-    sub(visual, "material", name=materials[node.name])
-    if node.collision:
-        collision = sub(link, "collision", name=node.name)
-        sub(collision, "origin", **back)
-        sub(sub(collision, "geometry"), kind, **attrs)
+    out.open("inertial")
+    out.empty("origin", back)
+    out.empty("mass", f' value="{mass}"')
+    out.empty("inertia", f' ixx="{ixx}" ixy="0" ixz="0" iyy="{iyy}" iyz="0" izz="{izz}"')
+    out.close("inertial")
+    if node.shape is not None:
+        geometry = _geometry(node)
+        out.open("visual", f' name="{node.name}"')
+        out.empty("origin", back)
+        out.open("geometry")
+        out.empty(*geometry)
+        out.close("geometry")
+        out.empty("material", f' name="{escape_attr(materials[node.name])}"')
+        out.close("visual")
+        if node.collision:
+            out.open("collision", f' name="{node.name}"')
+            out.empty("origin", back)
+            out.open("geometry")
+            out.empty(*geometry)
+            out.close("geometry")
+            out.close("collision")
+    out.close("link")
 
 
-def _geometry_attrs(node: Node) -> tuple[str, dict[str, str]]:
+def _geometry(node: Node) -> tuple[str, str]:
     """(element name, attributes) of the node's shape inside ``<geometry>``."""
     shape = node.shape
     if isinstance(shape, Box):
-        return "box", {"size": fmt_seq(shape.size)}
+        return "box", f' size="{fmt_seq(shape.size)}"'
     if isinstance(shape, Cylinder):
-        return "cylinder", {"radius": fmt(shape.radius), "length": fmt(shape.length)}
+        return "cylinder", f' radius="{fmt(shape.radius)}" length="{fmt(shape.length)}"'
     if isinstance(shape, Sphere):
-        return "sphere", {"radius": fmt(shape.radius)}
+        return "sphere", f' radius="{fmt(shape.radius)}"'
     if isinstance(shape, Mesh):
-        return "mesh", {"filename": shape.uri, "scale": fmt_seq(shape.scale)}
+        return "mesh", f' filename="{escape_attr(shape.uri)}" scale="{fmt_seq(shape.scale)}"'
     raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
 
 
-def _write_joint(robot, node: Node, joint: Joint | None, parent_joint: Joint | None) -> None:
+def _write_joint(out: XmlText, node: Node, joint: Joint | None, parent_joint: Joint | None) -> None:
     if joint is not None and joint.kind == "revolute":
         kind = "revolute"
     elif node.parent is None and not node.static and joint is None:
         kind = "floating"
     else:
         kind = "fixed"
-    el = sub(robot, "joint", name=_joint_name(node, joint), type=kind)
-    sub(el, "parent", link=node.parent or RESERVED_NAME)
-    sub(el, "child", link=node.name)
+    out.open("joint", f' name="{_joint_name(node, joint)}" type="{kind}"')
+    out.empty("parent", f' link="{node.parent or RESERVED_NAME}"')
+    out.empty("child", f' link="{node.name}"')
     if kind != "revolute" and (parent_joint is None or parent_joint.kind != "revolute"):
         origin = _pose_attrs(node.pose)  # link frames are node frames here: the pose as the scene has it
     else:
         origin = _matrix_attrs(joint_origin(node, joint, parent_joint))
-    sub(el, "origin", **origin)
+    out.empty("origin", origin)
     if kind == "revolute":
-        sub(el, "axis", xyz=fmt_seq(joint.axis))
+        out.empty("axis", f' xyz="{fmt_seq(joint.axis)}"')
         lo, hi = joint.limits
         # The written pose is the joint's zero: measure the limits from the initial angle.
-        sub(el, "limit", lower=fmt(lo - joint.initial), upper=fmt(hi - joint.initial),
-            effort=fmt(joint.effort), velocity=fmt(joint.velocity))
-        sub(el, "dynamics", damping=fmt(joint.damping))
+        out.empty("limit", f' lower="{fmt(lo - joint.initial)}" upper="{fmt(hi - joint.initial)}" '
+                           f'effort="{fmt(joint.effort)}" velocity="{fmt(joint.velocity)}"')
+        out.empty("dynamics", f' damping="{fmt(joint.damping)}"')
+    out.close("joint")
