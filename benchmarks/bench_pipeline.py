@@ -10,6 +10,9 @@ times across runs). Stages:
   sdf/mjcf/urdf each exporter, Scene -> text
   metadata     world.json from the rendered files
   pipeline     generate() + all three formats + metadata, in memory (what an RL loop pays)
+  floor        the serialisation floor for the same world, no planning: its three XML documents
+               rebuilt element by element as lxml trees and serialised, plus json.dumps of world.json
+               (the cost of merely writing what the pipeline writes); "ratio" = pipeline / floor
   write        World.write to a temporary folder (files + fsync + rename)
   lidar/occupancy/metrics  the ground truth parts (360 rays; the map as PGM + YAML; BARN metrics),
                groundtruth their sum (all are also inside pipeline and metadata)
@@ -46,8 +49,13 @@ SERIES = {
         (10, 50, 200, 1000),
     ),
 }
-STAGES = ("build", "feasibility", "sdf", "mjcf", "urdf", "metadata", "pipeline", "write",
+STAGES = ("build", "feasibility", "sdf", "mjcf", "urdf", "metadata", "pipeline", "floor", "write",
           "lidar", "occupancy", "metrics", "groundtruth")
+#: Issue 9's targets: (series, obstacles) -> largest median pipeline ms, and pipeline / floor ratio.
+PIPELINE_TARGETS = {("default", 50): 12.0, ("default", 200): 40.0, ("scaling", 1000): 250.0}
+RATIO_TARGETS = {("default", 50): 7.0, ("default", 200): 6.0}
+FEASIBILITY_TARGET = ("default", 50, 4.0)
+SLOPE_TARGET = 1.2
 
 
 def _ms(seconds: float) -> float:
@@ -73,8 +81,9 @@ def time_world(params: dict, seed: int, out_dir: Path) -> dict[str, float]:
     t["feasibility"] = time.perf_counter() - t0
     for fmt in ("sdf", "mjcf", "urdf"):
         t0 = time.perf_counter()
-        world.export(fmt)
+        world._render(fmt, "1.9")  # export() would return the text the pipeline already rendered
         t[fmt] = time.perf_counter() - t0
+    t["floor"] = serialisation_floor(world, files)
     t0 = time.perf_counter()
     world.metadata_for(files)
     t["metadata"] = time.perf_counter() - t0
@@ -99,6 +108,65 @@ def time_world(params: dict, seed: int, out_dir: Path) -> dict[str, float]:
     return t
 
 
+def _rebuild(source, parent=None):
+    """An lxml tree built element by element with the same tags, attributes and text as ``source``."""
+    from lxml import etree
+
+    element = etree.Element(source.tag, source.attrib) if parent is None else \
+        etree.SubElement(parent, source.tag, source.attrib)
+    element.text = source.text
+    for child in source:
+        if isinstance(child.tag, str):  # elements only: the skeletons' comments are not the scene
+            _rebuild(child, element)
+    return element
+
+
+def serialisation_floor(world, files) -> float:
+    """Seconds to build and serialise the world's three XML trees with lxml and its world.json, no planning."""
+    from worldgen.export.metadata import dumps
+    from worldgen.export.xml import parse_bytes, to_bytes
+
+    sources = [parse_bytes(files[fmt][1]).getroot() for fmt in ("sdf", "mjcf", "urdf")]
+    meta = world.metadata_for(files)
+    t0 = time.perf_counter()
+    for source in sources:
+        to_bytes(_rebuild(source))
+    dumps(meta)
+    return time.perf_counter() - t0
+
+
+def loglog_slope(rows: dict) -> float:
+    """Least-squares slope of log(pipeline ms) against log(obstacles)."""
+    import math
+
+    xs = [math.log(int(n)) for n in rows]
+    ys = [math.log(row["pipeline"]) for row in rows.values()]
+    mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+    return sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+
+
+def targets(results: dict) -> list[dict]:
+    """Each of issue 9's targets with its measured figure and whether it is met."""
+    series = results["series"]
+    out = []
+    for (name, n), limit in PIPELINE_TARGETS.items():
+        got = series[name][str(n)]["pipeline"]
+        out.append({"target": f"pipeline, {n} obstacles ({name})", "limit": limit, "measured": got,
+                    "unit": "ms", "met": got <= limit})
+    for (name, n), limit in RATIO_TARGETS.items():
+        got = series[name][str(n)]["ratio"]
+        out.append({"target": f"pipeline / floor, {n} obstacles ({name})", "limit": limit, "measured": got,
+                    "unit": "x", "met": got <= limit})
+    name, n, limit = FEASIBILITY_TARGET
+    got = series[name][str(n)]["feasibility"]
+    out.append({"target": f"feasibility alone, {n} obstacles ({name})", "limit": limit, "measured": got,
+                "unit": "ms", "met": got <= limit})
+    got = results["slope"]
+    out.append({"target": "log-log slope of pipeline cost vs obstacles (scaling, 10-1000)", "limit": SLOPE_TARGET,
+                "measured": got, "unit": "", "met": got <= SLOPE_TARGET})
+    return out
+
+
 def run(runs: int) -> dict:
     results = {"worldgen_version": worldgen.__version__, "python": platform.python_version(),
                "machine": platform.machine(), "cpus": os.cpu_count(), "runs": runs, "series": {}}
@@ -114,25 +182,33 @@ def run(runs: int) -> dict:
                     samples.append(time_world(params, seed, Path(tmp)))
             rows[str(n)] = {
                 **{stage: _ms(statistics.median(s[stage] for s in samples)) for stage in STAGES},
+                "ratio": round(statistics.median(s["pipeline"] / s["floor"] for s in samples), 2),
                 "attempts_mean": round(statistics.mean(s["attempts"] for s in samples), 2),
                 "worlds": len(samples),
             }
         results["series"][series] = rows
+    results["slope"] = round(loglog_slope(results["series"]["scaling"]), 3)
+    results["targets"] = targets(results)
     return results
 
 
 def print_table(results: dict) -> None:
     for series, rows in results["series"].items():
         print(f"\nseries '{series}' (median ms over {results['runs']} seeds; 1000 obstacles: fewer)")
-        print(f"{'obstacles':>9} " + " ".join(f"{s:>11}" for s in STAGES) + f" {'attempts':>8} {'x per obst.':>11}")
+        print(f"{'obstacles':>9} " + " ".join(f"{s:>11}" for s in STAGES) + f" {'ratio':>6} {'attempts':>8} {'x per obst.':>11}")
         first = None
         for n, row in rows.items():
             first = first or (row["pipeline"], int(n))
             growth = (row["pipeline"] / first[0]) / (int(n) / first[1])
             print(f"{n:>9} " + " ".join(f"{row[s]:>11.2f}" for s in STAGES)
-                  + f" {row['attempts_mean']:>8.2f} {growth:>11.2f}")
+                  + f" {row['ratio']:>6.2f} {row['attempts_mean']:>8.2f} {growth:>11.2f}")
         print("  'x per obst.': pipeline time ratio to the first row divided by the obstacle-count ratio"
-              " (1.0 = linear, below 1 = sub-linear)")
+              " (1.0 = linear, below 1 = sub-linear); 'ratio': pipeline / floor, median of per-world ratios")
+    print(f"\nlog-log slope of pipeline cost against obstacle count (scaling series): {results['slope']:.3f}")
+    print("\ntargets (issue 9):")
+    for t in results["targets"]:
+        print(f"  {'met   ' if t['met'] else 'MISSED'} {t['target']:<66} {t['measured']:>8.2f} {t['unit']:<2}"
+              f" (limit {t['limit']:g} {t['unit']})")
 
 
 def main(argv=None) -> int:

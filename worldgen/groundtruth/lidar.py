@@ -149,7 +149,13 @@ def _local_rays(items, origin, dirs):
 def _first(candidates: np.ndarray, start: float) -> np.ndarray:
     """(n,) smallest candidate >= start over objects and candidates; inf where none."""
     c = np.where(candidates >= start, candidates, np.inf)  # nan compares False: dropped
-    return c.reshape(c.shape[0], c.shape[1], -1).min(axis=(0, 2))
+    c = c.reshape(c.shape[0], c.shape[1], -1)
+    # Elementwise over the few candidates, then down the objects: numpy's reductions over a short
+    # last axis cost far more than these (1.3 of 2.3 ms a scan at 50 obstacles).
+    best = c[:, :, 0]
+    for k in range(1, c.shape[2]):
+        best = np.minimum(best, c[:, :, k])
+    return best.min(axis=0)
 
 
 def _box_hits(o, d, half):
@@ -158,8 +164,9 @@ def _box_hits(o, d, half):
     with np.errstate(over="ignore"):
         t1 = (-half[:, None, :] - o) / safe
         t2 = (half[:, None, :] - o) / safe
-    near = np.minimum(t1, t2).max(axis=2)
-    far = np.maximum(t1, t2).min(axis=2)
+    lo, hi = np.minimum(t1, t2), np.maximum(t1, t2)
+    near = np.maximum(np.maximum(lo[..., 0], lo[..., 1]), lo[..., 2])
+    far = np.minimum(np.minimum(hi[..., 0], hi[..., 1]), hi[..., 2])
     ok = near <= far
     return np.stack([np.where(ok, near, np.nan), np.where(ok, far, np.nan)], axis=2)
 
