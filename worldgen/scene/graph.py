@@ -277,8 +277,9 @@ class Scene:
             corners = _tight_round_corners(node.shape, m)
         elif node.shape.kind == "mesh":  # tight: the turned vertices, not a turned box
             corners = node.shape.scaled_vertices() @ m[:3, :3].T + m[:3, 3]
-        else:
-            corners = node.shape.local_corners() @ m[:3, :3].T + m[:3, 3]
+        else:  # a box: its half extents through the rotation's absolute values, no corners
+            reach = np.abs(m[:3, :3]) @ (np.asarray(node.shape.size, dtype=float) / 2.0)
+            return np.array([m[:3, 3] - reach, m[:3, 3] + reach])
         return np.array([corners.min(axis=0), corners.max(axis=0)])
 
     def colliders(self) -> list[Node]:
