@@ -35,6 +35,10 @@ worlds:
 """
 
 
+#: Issue 9's target: this pack (1,000 worlds, no preview) with --jobs 2 in at most 20 s on a 2-core machine.
+TARGET_WORLDS, TARGET_JOBS, TARGET_SECONDS = 1000, 2, 20.0
+
+
 def one(worlds: int, jobs: int, out: Path, preview: bool) -> dict:
     from worldgen.pack import build_pack, parse_recipe
 
@@ -77,8 +81,16 @@ def main() -> None:
         r["speedup"] = round(base / r["seconds"], 2)
     print(f"speed-up vs --jobs {runs[0]['jobs']}: " + ", ".join(f"jobs {r['jobs']} {r['speedup']}x" for r in runs))
     print(f"manifests identical across --jobs: {same}")
+    targets = []
+    for r in runs:
+        if r["jobs"] == TARGET_JOBS and args.worlds == TARGET_WORLDS and not args.preview:
+            met = r["seconds"] <= TARGET_SECONDS
+            targets.append({"target": f"{TARGET_WORLDS} worlds with --jobs {TARGET_JOBS}", "limit": TARGET_SECONDS,
+                            "measured": r["seconds"], "unit": "s", "met": met})
+            print(f"target (issue 9): {'met' if met else 'MISSED'}: {TARGET_WORLDS} worlds with --jobs {TARGET_JOBS} "
+                  f"in {r['seconds']:.1f} s (limit {TARGET_SECONDS:g} s)")
     result = {"worlds": args.worlds, "preview": args.preview, "cpus": os.cpu_count(), "python": platform.python_version(),
-              "runs": runs, "manifests_identical": same}
+              "runs": runs, "manifests_identical": same, "targets": targets}
     target = Path(__file__).parent / "results" / "pack.json"
     target.parent.mkdir(exist_ok=True)
     target.write_text(json.dumps(result, indent=2, sort_keys=True) + "\n")
