@@ -27,8 +27,11 @@ demo: $(STAMP)
 	$(VENV)/bin/worldgen generate cluttered --seed 0 --count 3 --out $(DEMO_OUT)
 	@echo "worlds written under $(abspath $(DEMO_OUT))/: each folder holds world.sdf, world.mjcf.xml, world.urdf, world.json, map.pgm + map.yaml and preview.png"
 
-## test: install with the test extras and run the whole suite
+## test: install with the test extras, lint (ruff: pyflakes, pycodestyle, import order), check the
+## public API's types (mypy), then run the whole suite
 test: $(TEST_STAMP)
+	$(VENV)/bin/ruff check worldgen tests benchmarks examples
+	$(VENV)/bin/mypy
 	$(PY) -m pytest -q
 
 ## bench: per-stage medians for cluttered worlds against the serialisation floor, a 1,000-world pack

@@ -1,4 +1,4 @@
-"""A differential-drive robot follows the reference path in 20 cluttered worlds, judged by worldgen.oracles.
+"""A differential-drive robot follows the reference path in 20 cluttered worlds, judged by worldgen.testing.oracles.
 
     .venv/bin/python examples/diffdrive_mujoco.py [OUT_DIR]
 
@@ -31,7 +31,7 @@ from lxml import etree
 
 import worldgen
 from worldgen.export.xml import safe_parser
-from worldgen.oracles import evaluate
+from worldgen.testing.oracles import evaluate
 
 CRITERIA = """
 navigation:

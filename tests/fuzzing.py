@@ -32,8 +32,7 @@ import sys
 import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
-from pathlib import Path
+from dataclasses import dataclass
 from typing import Any, Optional
 
 import numpy as np
@@ -141,7 +140,7 @@ def draw_request(rng: np.random.Generator, generator: str, caps: dict = CI_CAPS,
 
 def _recheck(world) -> Optional[str]:
     """None when the world passes the independent re-check, else what failed."""
-    from worldgen import oracles
+    from worldgen.testing import oracles
     from worldgen.verify import check_folder
 
     with tempfile.TemporaryDirectory() as tmp:

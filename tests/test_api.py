@@ -7,12 +7,12 @@ import re
 
 import mujoco
 import pytest
+from lxml import etree
 
 import worldgen
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, UnknownGeneratorError, WorldgenError
 from worldgen.export import metadata
 from worldgen.export.xml import safe_parser
-from lxml import etree
 
 
 @pytest.fixture(scope="module")

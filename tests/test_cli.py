@@ -253,6 +253,6 @@ def test_failure_on_world_3_of_5_leaves_worlds_1_2_complete(tmp_path):
     assert sorted(json.loads((f / "world.json").read_text())["seed"] for f in folders) == [start, start + 1]
     for folder in folders:
         meta = json.loads((folder / "world.json").read_text())
-        # preview.png is a picture of world.json, deliberately not listed in its files (worldgen.preview).
+        # preview.png is a picture of world.json, deliberately not listed in its files (worldgen.export.preview).
         listed = {e["path"] for e in meta["files"].values()}
         assert {p.name for p in folder.iterdir()} == listed | {"world.json", "preview.png"}

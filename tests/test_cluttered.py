@@ -7,9 +7,10 @@ import textwrap
 
 import numpy as np
 import shapely
-from hypothesis import HealthCheck, given, settings, strategies as st
-
 from conftest import draft
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
 from worldgen.generators import get
 
 

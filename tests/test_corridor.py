@@ -9,14 +9,15 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
-
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from reftools_mujoco import load_and_step
 from reftools_sdf import check_sdf
 from reftools_urdf import check_urdf
+
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
-from worldgen.generators.corridor import proven_width, layout
+from worldgen.generators.corridor import layout, proven_width
 
 #: The passage figure is the checker's: connectivity between cell centres puts the radius within
 #: half a cell diagonal, so the width within sqrt(2) cells, plus the bisection's 1/8 cell

@@ -12,10 +12,10 @@ import json
 import mujoco
 import numpy as np
 import pytest
-
 from conftest import draft
 from export_scenes import showcase_scene
 from reftools_mujoco import load
+
 from worldgen.export import meshes, metadata, mjcf, urdf
 from worldgen.export.xml import to_bytes
 from worldgen.feasibility import FeasibilityReport

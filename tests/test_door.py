@@ -2,7 +2,7 @@
 
 Every figure here is re-derived from world.json alone with plain geometry
 (axis-aligned boxes and the leaf as a rectangle turned about its hinge), not
-through worldgen.doors or the feasibility code; simulators are the real ones.
+through worldgen.scene.doors or the feasibility code; simulators are the real ones.
 """
 
 from __future__ import annotations
@@ -15,14 +15,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lxml import etree
+from reftools_mujoco import load, load_and_step
+from reftools_sdf import check_sdf, dump_sdf
+from reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.export.metadata import validate
 from worldgen.export.xml import safe_parser
-from reftools_mujoco import load, load_and_step
-from reftools_sdf import check_sdf, dump_sdf
-from reftools_urdf import check_urdf
 
 SPACING_FRACTION = 0.25  # path samples every robot radius / 4, as METADATA.md asks
 

@@ -13,7 +13,6 @@ import textwrap
 
 import numpy as np
 import pytest
-
 from conftest import missing_tool
 
 try:
@@ -117,7 +116,7 @@ def test_gymnasium_envs_entry_point_registers_the_id():
 def test_worldgen_and_its_pytest_plugin_do_not_import_gymnasium():
     run = run_python("""
         import sys
-        import worldgen, worldgen.pytest_plugin
+        import worldgen, worldgen.testing.plugin
         worldgen.generate("cluttered", 0, size=[6, 6], n_obstacles=2)
         print("gymnasium" in sys.modules, "worldgen.envs" in sys.modules)
     """)
@@ -279,7 +278,7 @@ def test_a_custom_reward_function_replaces_the_default():
 
 
 def test_movers_are_driven_along_their_scripts_every_physics_step():
-    from worldgen.movers import mover_positions
+    from worldgen.scene.motion import mover_positions
 
     env = make(generator="cluttered", params={"size": [8, 8], "n_obstacles": 3, "n_movers": 2})
     env.reset(seed=0)

@@ -7,10 +7,10 @@ import math
 import mujoco
 import numpy as np
 import pytest
-
 from conftest import draft
 from export_scenes import DOOR_INITIAL, showcase_scene
 from reftools_mujoco import load_and_step
+
 from worldgen.export import mjcf
 from worldgen.export.xml import parse_bytes, to_bytes
 from worldgen.scene import Box, Joint, Node, Physics, Pose, Scene

@@ -15,15 +15,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from conftest import draft
 from reftools_sdf import check_sdf, dump_sdf
+
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.export.meshes import mesh_files
 from worldgen.export.sdf import MIN_MOMENT, to_sdf
 from worldgen.export.xml import parse_bytes
-from worldgen.scene import (Box, Cylinder, Joint, Material, Mesh, Node, Physics, Pose, Scene, Sphere,
-                            rpy_matrix)
+from worldgen.scene import Box, Cylinder, Joint, Material, Mesh, Node, Physics, Pose, Scene, Sphere, rpy_matrix
 
 VERSIONS = ("1.9", "1.6")
 TOL = 2e-6  # floats are written with 6 decimals

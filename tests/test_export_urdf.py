@@ -9,11 +9,11 @@ import mujoco
 import numpy as np
 import pytest
 import trimesh
-
 from conftest import draft
 from export_scenes import rock_mesh, showcase_scene
 from reftools_mujoco import load_and_step
 from reftools_urdf import check_urdf
+
 from worldgen.export import meshes, urdf
 from worldgen.export.xml import parse_bytes
 from worldgen.scene import Box, Mesh, Node, Pose, Scene

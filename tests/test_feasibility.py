@@ -7,10 +7,10 @@ import math
 
 import numpy as np
 import pytest
+from conftest import draft
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import draft
 from worldgen import feasibility
 from worldgen.feasibility import REQUIRED_CHECKS
 from worldgen.scene import Box, Cylinder, Node, Pose, Robot, Scene, Task
@@ -102,9 +102,9 @@ def reference_length(discs, start, goal, inflation):
             tb = math.atan2(nodes[b][1] - c[1], nodes[b][0] - c[0])
             edges.append((a, b, r * ((tb - ta) % (2 * math.pi))))
     adj = [[] for _ in nodes]
-    for a, b, l in edges:
-        adj[a].append((b, l))
-        adj[b].append((a, l))
+    for a, b, length in edges:
+        adj[a].append((b, length))
+        adj[b].append((a, length))
     # A plain Dijkstra, so the reference shares nothing with the planner's graph code.
     best = [math.inf] * len(nodes)
     best[0] = 0.0
@@ -113,10 +113,10 @@ def reference_length(discs, start, goal, inflation):
         d, a = heapq.heappop(heap)
         if d > best[a]:
             continue
-        for b, l in adj[a]:
-            if d + l < best[b]:
-                best[b] = d + l
-                heapq.heappush(heap, (d + l, b))
+        for b, length in adj[a]:
+            if d + length < best[b]:
+                best[b] = d + length
+                heapq.heappush(heap, (d + length, b))
     return best[1]
 
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-
 from fuzzing import draw_request, run_requests
 
 REQUESTS_PER_GENERATOR = 80

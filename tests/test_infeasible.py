@@ -15,12 +15,11 @@ from pathlib import Path
 
 import pytest
 import shapely
+from reftools_sdf import check_sdf
+from reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.export import metadata
-
-from reftools_sdf import check_sdf
-from reftools_urdf import check_urdf
 
 _SCRIPT = Path(sys.executable).with_name("worldgen")
 WORLDGEN = [str(_SCRIPT)] if _SCRIPT.exists() else [sys.executable, "-m", "worldgen"]

@@ -7,10 +7,10 @@ import math
 import mujoco
 import numpy as np
 import pytest
-
-import worldgen
 from conftest import draft
 from export_scenes import showcase_scene
+
+import worldgen
 from worldgen.errors import ParameterError
 from worldgen.export import mjcf
 from worldgen.export.xml import to_bytes

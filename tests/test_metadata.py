@@ -17,16 +17,15 @@ import jsonschema
 import numpy as np
 import pytest
 import shapely
+from conftest import draft
 
 import worldgen
 from worldgen.export import metadata
 from worldgen.feasibility.report import REQUIRED_CHECKS, Check, FeasibilityReport, TaskPath
-from worldgen.footprint import scene_footprints
 from worldgen.generators import get, robot_from_params
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Pose, Scene, Sphere, Task
+from worldgen.scene.footprint import scene_footprints
 from worldgen.world import World
-
-from conftest import draft
 
 VALIDATOR = jsonschema.Draft202012Validator(metadata.schema())
 
@@ -358,7 +357,7 @@ def test_written_world_json_is_valid_canonical_and_true(written):
             data = (folder / entry["path"]).read_bytes()
             assert hashlib.sha256(data).hexdigest() == entry["sha256"], (folder, key)
         # Every file in the folder is listed (nothing stray, nothing unhashed), but for
-        # preview.png: a picture of world.json, deliberately unlisted (worldgen.preview).
+        # preview.png: a picture of world.json, deliberately unlisted (worldgen.export.preview).
         listed = {e["path"] for e in meta["files"].values()} | {"world.json", "preview.png"}
         on_disk = {str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file()}
         assert on_disk == listed

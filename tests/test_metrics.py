@@ -10,9 +10,9 @@ import shapely
 
 import worldgen
 from worldgen.feasibility.report import TaskPath
-from worldgen.footprint import robot_footprints
 from worldgen.groundtruth import metrics
 from worldgen.scene import Box, Node, Pose, Robot, Scene, Task
+from worldgen.scene.footprint import robot_footprints
 
 ROBOT = Robot(0.2, 0.4, 0.05)  # inflation 0.25: dispersion reaches 1.0 m
 

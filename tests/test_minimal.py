@@ -7,9 +7,10 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings, strategies as st
-
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from test_corridor import recheck, reference_tools
+
 import worldgen
 from worldgen.errors import ParameterError
 

@@ -15,16 +15,15 @@ import sys
 import mujoco
 import numpy as np
 import pytest
+from reftools_mujoco import assert_no_warnings, load_and_step
+from reftools_sdf import check_sdf
+from reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.export import metadata
 from worldgen.export.xml import parse_bytes
-from worldgen.movers import drive_mocap, mover_names, mover_positions
-
-from reftools_mujoco import assert_no_warnings, load_and_step
-from reftools_sdf import check_sdf
-from reftools_urdf import check_urdf
+from worldgen.scene.motion import drive_mocap, mover_names, mover_positions
 
 MOVERS = {"n_movers": 3, "size": [10, 10], "n_obstacles": 12}
 
@@ -205,7 +204,7 @@ def test_urdf_leaves_movers_out(written):
     folder = written[0]
     check_urdf(folder / "world.urdf")
     root = parse_bytes((folder / "world.urdf").read_bytes()).getroot()
-    links = {l.get("name") for l in root.findall("link")}
+    links = {link.get("name") for link in root.findall("link")}
     assert not links & set(mover_names(json.loads((folder / "world.json").read_text())))
 
 

@@ -13,22 +13,22 @@ from __future__ import annotations
 
 import math
 
+import exact_reference
 import mujoco
 import numpy as np
 import pytest
 import shapely
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-
-import exact_reference
-import worldgen
 from reftools_mujoco import load
 from test_requires_door_open import _with_probe
+
+import worldgen
 from worldgen import feasibility
-from worldgen.doors import open_scene
 from worldgen.feasibility.check import SAFETY
-from worldgen.footprint import robot_footprints
 from worldgen.scene import Box, Node, Pose, Robot, Scene, Task
+from worldgen.scene.doors import open_scene
+from worldgen.scene.footprint import robot_footprints
 from worldgen.world import World
 
 #: Probe samples along the path (m), as the issue asks.

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import shapely
 import yaml
+from export_scenes import showcase_scene
 
 import worldgen
-from export_scenes import showcase_scene
 from worldgen.errors import ParameterError
 from worldgen.groundtruth import occupancy
 from worldgen.scene import Box, Node, Pose, Scene

@@ -16,8 +16,8 @@ import yaml
 import worldgen
 from worldgen import oracles
 from worldgen.errors import ParameterError
-from worldgen.oracles_eval import evaluate, load_criteria
 from worldgen.presets import generate_preset
+from worldgen.testing.evaluate import evaluate, load_criteria
 
 GOAL = (2.0, 2.5)
 REF_LENGTH = math.hypot(*GOAL)
@@ -194,6 +194,7 @@ def test_scenario_yaml_is_listed_and_matches_the_task(wall, wall_folder):
 def test_folder_colliders_match_the_scene_for_every_shape(tmp_path):
     """world.json entities (tilted boxes and cylinders, spheres, STL meshes, a hinged leaf) rebuild the same FCL world."""
     from export_scenes import showcase_scene
+
     from worldgen import feasibility
     from worldgen.generators import get, robot_from_params
     from worldgen.scene import Pose, Task
@@ -217,7 +218,7 @@ def test_folder_colliders_match_the_scene_for_every_shape(tmp_path):
 def test_scenario_yaml_bytes_do_not_depend_on_libyaml(monkeypatch):
     """scenario.yaml is written by libyaml where PyYAML has it; without it the pure-Python emitter must give
     the same bytes, or world.json's sha256 would depend on how PyYAML was built."""
-    from worldgen import scenario
+    from worldgen.export import scenario
 
     world = worldgen.generate("door", seed=3, n_doors=2, state="random", n_tasks=2)
     spec = scenario.scenario(world)

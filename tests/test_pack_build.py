@@ -18,8 +18,8 @@ import pytest
 
 import worldgen
 from worldgen.cli import main
-from worldgen.pack.manifest import world_folder
 from worldgen.pack import Pack, build_pack, parse_recipe, verify_pack, write_archive
+from worldgen.pack.manifest import world_folder
 
 RECIPE = """\
 name: tiny
@@ -281,7 +281,7 @@ def test_progress_line_has_count_rate_and_eta_and_is_quiet_off_a_terminal(tmp_pa
 
 @pytest.mark.parametrize("kind", ["folder", "archive"])
 def test_oracles_take_pack_worlds_in_a_folder_and_in_an_archive(built, tmp_path, kind):
-    from worldgen import oracles
+    from worldgen.testing import oracles
 
     _, _, pack = built
     source = pack if kind == "folder" else write_archive(pack, tmp_path / "one.tar.gz")

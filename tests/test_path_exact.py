@@ -14,18 +14,18 @@ from __future__ import annotations
 import math
 import os
 
+import exact_reference
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-import exact_reference
 import worldgen
 from worldgen import feasibility
-from worldgen.doors import open_scene
 from worldgen.feasibility.check import SAFETY
-from worldgen.footprint import robot_footprints
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Robot, Scene, Task
+from worldgen.scene.doors import open_scene
+from worldgen.scene.footprint import robot_footprints
 
 ROBOT = Robot(radius=0.2, height=0.4, clearance=0.05)
 R = ROBOT.inflation

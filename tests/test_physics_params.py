@@ -13,13 +13,12 @@ import json
 import mujoco
 import numpy as np
 import pytest
+from reftools_sdf import dump_sdf
+from reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.errors import ParameterError
 from worldgen.export.xml import parse_bytes
-
-from reftools_sdf import dump_sdf
-from reftools_urdf import check_urdf
 
 SWEEP = (0.6, 0.8, 1.0, 1.2)
 SMALL = {"size": [6, 6], "n_obstacles": 6, "n_movers": 1}

@@ -3,8 +3,6 @@
 import subprocess
 import sys
 
-import pytest
-
 # In a subprocess each: in-process runs restore sys.modules afterwards, and numpy cannot be imported twice.
 pytest_plugins = ["pytester"]
 
@@ -14,8 +12,8 @@ QUICK = "size=[6, 6], n_obstacles=3"
 def test_registered_through_the_entry_point_and_light():
     from importlib.metadata import entry_points
 
-    assert [e.value for e in entry_points(group="pytest11") if e.name == "worldgen"] == ["worldgen.pytest_plugin"]
-    code = ("import sys, worldgen.pytest_plugin; "
+    assert [e.value for e in entry_points(group="pytest11") if e.name == "worldgen"] == ["worldgen.testing.plugin"]
+    code = ("import sys, worldgen.testing.plugin; "
             "print(sorted(m for m in ('numpy', 'fcl', 'mujoco', 'scipy', 'shapely', 'trimesh', 'lxml') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.strip() == "[]"

@@ -9,10 +9,10 @@ from importlib import resources
 
 import numpy as np
 import pytest
-
 from test_cli import run, world_dirs
 from test_corridor import recheck
 from test_minimal import ray
+
 import worldgen
 from worldgen import presets
 from worldgen.errors import InfeasibleError, ParameterError

@@ -16,7 +16,7 @@ from PIL import Image
 import worldgen
 from worldgen.cli import main
 from worldgen.errors import ParameterError
-from worldgen.preview import COLOURS, NOGO_ALPHA, PREVIEW_NAME, draw, layout, render
+from worldgen.export.preview import COLOURS, NOGO_ALPHA, PREVIEW_NAME, draw, layout, render
 
 
 @pytest.fixture(scope="module")
@@ -66,7 +66,7 @@ def test_png_is_valid_with_the_expected_size_and_no_varying_chunks(folder, meta)
 
 
 def test_render_is_deterministic_across_processes(folder):
-    code = ("import hashlib, json, sys; from worldgen.preview import render; "
+    code = ("import hashlib, json, sys; from worldgen.export.preview import render; "
             "print(hashlib.sha256(render(json.load(open(sys.argv[1])))).hexdigest())")
     digests = {subprocess.run([sys.executable, "-c", code, str(folder / "world.json")], check=True,
                               capture_output=True, text=True).stdout.strip() for _ in range(2)}

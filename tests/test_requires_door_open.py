@@ -17,12 +17,12 @@ import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from lxml import etree
+from reftools_mujoco import load
 
 import worldgen
 from worldgen.export.metadata import DOOR_TIME, TIME_FACTOR, TIME_MARGIN
+from worldgen.export.scenario import scenario
 from worldgen.export.xml import safe_parser
-from worldgen.scenario import scenario
-from reftools_mujoco import load
 
 #: Probe positions along the path (m). The union of discs this far apart falls short of the exact
 #: swept disc by at most STEP^2 / (8 r) = 2e-5 m for r = 0.15 m, far inside BAND.

@@ -4,7 +4,8 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from worldgen.scene import Box, Cylinder, Joint, Material, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose, rpy_matrix
 

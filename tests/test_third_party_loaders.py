@@ -13,11 +13,11 @@ import os
 
 import pytest
 from lxml import etree
+from reftools_sdf import check_sdf
 
 import worldgen
 from worldgen.export.xml import safe_parser
 from worldgen.generators import names
-from reftools_sdf import check_sdf
 
 
 def need(module: str):

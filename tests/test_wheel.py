@@ -81,6 +81,7 @@ def test_every_module_ships_and_imports(wheel_venv, tmp_path):
     first, *names = out.stdout.split()
     assert first.startswith(str(wheel_venv)), f"imported worldgen from {first}, not the wheel"
     assert set(names) == source_modules()
+    assert (Path(first).parent / "py.typed").is_file(), "the wheel must carry py.typed (PEP 561)"
 
 
 @pytest.mark.parametrize("args", [

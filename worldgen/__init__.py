@@ -6,7 +6,8 @@
     >>> folder = world.write("worlds")                      # worlds/<world_id>/world.sdf, ...
 """
 
-from importlib.metadata import PackageNotFoundError, version as _version
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as _version
 
 try:
     __version__ = _version("worldgen")
@@ -14,18 +15,18 @@ except PackageNotFoundError:  # running from a source tree that is not installed
     __version__ = "0.0.0+unknown"
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, UnknownGeneratorError, WorldgenError
-# Imported now (it is light): bound after the submodule, the name stays the function even
-# once ``import worldgen.shrink`` has run elsewhere.
-from worldgen.shrink import shrink
 
-# The rest is imported on first use (PEP 562): the pytest plugin (worldgen.pytest_plugin) is
+# The rest is imported on first use (PEP 562): the pytest plugin (worldgen.testing.plugin) is
 # loaded by every pytest run in an environment with worldgen installed, and importing the
-# package must not drag numpy, FCL and scipy into runs that never ask for a world.
+# package must not drag numpy, FCL and scipy into runs that never ask for a world. Nothing
+# but the errors is imported here, so any module may import this package without a cycle.
 _LAZY = {
     "generate": "worldgen.api", "generate_preset": "worldgen.presets", "GeneratorSpec": "worldgen.generators",
     "register": "worldgen.generators", "FORMATS": "worldgen.world", "World": "worldgen.world",
-    "Pack": "worldgen.pack",
+    "Pack": "worldgen.pack", "shrink": "worldgen.testing.shrink",
 }
+#: Public modules that live deeper in the package: ``from worldgen import oracles``.
+_MODULES = {"oracles": "worldgen.testing.oracles"}
 
 
 def __getattr__(name):
@@ -33,6 +34,10 @@ def __getattr__(name):
         import importlib
         value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value
+        return value
+    if name in _MODULES:
+        import importlib
+        value = globals()[name] = importlib.import_module(_MODULES[name])
         return value
     if not name.startswith("_"):  # ``worldgen.generators.get(...)`` after a bare ``import worldgen``
         import importlib
@@ -46,5 +51,5 @@ def __getattr__(name):
 __all__ = [
     "__version__", "generate", "generate_preset", "World", "FORMATS", "GeneratorSpec", "register",
     "WorldgenError", "ParameterError", "UnknownGeneratorError", "InfeasibleError", "OutputError",
-    "Pack", "shrink",
+    "Pack", "shrink", "oracles",
 ]

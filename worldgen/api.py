@@ -17,9 +17,9 @@ import numpy as np
 from worldgen import feasibility
 from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.generators import Draft, get, robot_from_params
+from worldgen.generators.infeasible import wall_in_goals
+from worldgen.generators.movers import mover_rng, place_movers
 from worldgen.groundtruth import occupancy
-from worldgen.infeasible import wall_in_goals
-from worldgen.movers import mover_rng, place_movers
 from worldgen.params import validate_params
 from worldgen.world import World
 
@@ -68,9 +68,10 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
         draft = spec.build(resolved, attempt_rng(seed, attempt))
         if not draft.rejected:
             draft = _with_common_extras(spec, resolved, draft, robot, seed, attempt)
-        if draft.rejected:
-            failures[draft.rejected] += 1
-            details.setdefault(draft.rejected, draft.detail)
+        if draft.rejected or draft.scene is None:
+            reason = draft.rejected or "no_scene"
+            failures[reason] += 1
+            details.setdefault(reason, draft.detail)
             continue
         if map_extent is None:  # the map's size follows from the floor: refuse before planning on it
             map_extent = occupancy.extent(draft.scene, resolved["map_resolution"])
@@ -96,11 +97,13 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
 def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt: int) -> Draft:
     """The draft with what every generator offers through common parameters (see the modules).
 
-    ``infeasible``: every goal walled in (worldgen.infeasible), unless the generator
+    ``infeasible``: every goal walled in (worldgen.generators.infeasible), unless the generator
     declares its own ``infeasible`` parameter; ``n_movers``: movers on their own
-    RNG stream (worldgen.movers), laid out after any goal walls so they avoid them.
+    RNG stream (worldgen.generators.movers), laid out after any goal walls so they avoid them.
     """
     scene = draft.scene
+    if scene is None:  # a draw without a scene is a rejected one: nothing to add to
+        return draft
     if resolved.get("infeasible") and "infeasible" not in {p.name for p in spec.params}:
         scene, reason = wall_in_goals(scene, draft.tasks, robot, resolved["friction"])
         if reason:

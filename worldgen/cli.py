@@ -21,9 +21,9 @@ import click
 import worldgen
 from worldgen.api import MAX_SEED
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError
+from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
-from worldgen.world import FORMATS, SDF_VERSIONS, normalise_formats
 
 __all__ = ["main", "cli", "parse_settings", "describe_param"]
 
@@ -151,7 +151,7 @@ def preview_command(world_dirs: Sequence[Path], width: int) -> None:
 
     The picture is not listed in world.json's files, so world.json is left as it is.
     """
-    from worldgen.preview import write_preview
+    from worldgen.export.preview import write_preview
 
     for folder in world_dirs:
         click.echo(str(write_preview(folder, width)))
@@ -286,7 +286,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         click.echo(exc.ctx.get_help() if exc.ctx else str(exc))
         return 0
     except click.ClickException as exc:
-        hint = f" (see '{exc.ctx.command_path} --help')" if getattr(exc, "ctx", None) is not None else ""
+        ctx = getattr(exc, "ctx", None)  # usage errors carry the command they are about; other errors do not
+        hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
         click.echo(f"error: {_one_line(exc.format_message())}{hint}", err=True)
         return USAGE_STATUS
     except WorldgenError as exc:

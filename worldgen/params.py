@@ -89,6 +89,7 @@ class Param:
         whole = self.kind == "int" if whole is None else whole
         if isinstance(value, bool):
             raise self._error(f"must be {'an integer' if whole else 'a number'} {describe_range(self)}", value)
+        number: float
         try:
             if whole:
                 if isinstance(value, float) and not value.is_integer():
@@ -212,7 +213,8 @@ COMMON_PARAMS: tuple[Param, ...] = (
           "(for SDF readers that reject actors, e.g. Drake): they stay in the MJCF and world.json"),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
     # Ground truth written with every world (worldgen.groundtruth).
-    Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn", 0.001, 50.0, unit="m"),
+    Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn",
+          0.001, 50.0, unit="m"),
     Param("lidar_fov", "float", 6.283185, "field of view of the ground-truth lidar, centred ahead (6.283185 = full circle)",
           1e-3, 6.283185307179586, unit="rad"),
     Param("lidar_angle_min", "float", None, "angle of the first ray (ranges[0]) from the robot's heading, as ROS "
@@ -220,7 +222,9 @@ COMMON_PARAMS: tuple[Param, ...] = (
           optional=True, unit="rad"),
     Param("lidar_samples", "int", 360, "rays of the ground-truth lidar", 1, 100000),
     Param("lidar_range_min", "float", 0.05, "shortest range of the ground-truth lidar (rays start there)", 0.0, 100.0, unit="m"),
-    Param("lidar_range_max", "float", 30.0, "longest range of the ground-truth lidar, written where nothing is hit", 0.01, 10000.0, unit="m"),
-    Param("map_height", "float", 0.1, "height of the horizontal slice the occupancy map is made from (above the floor slab)", 0.001, 50.0, unit="m"),
+    Param("lidar_range_max", "float", 30.0, "longest range of the ground-truth lidar, written where nothing is hit",
+          0.01, 10000.0, unit="m"),
+    Param("map_height", "float", 0.1,
+          "height of the horizontal slice the occupancy map is made from (above the floor slab)", 0.001, 50.0, unit="m"),
     Param("map_resolution", "float", 0.05, "edge of one occupancy map cell", 0.005, 10.0, unit="m"),
 )

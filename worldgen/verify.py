@@ -20,7 +20,7 @@ ones would only repeat it in other words):
                  the OK line says so).
 
 preview.png is not checked: it is a picture, not listed in ``files`` (see
-:mod:`worldgen.preview`).
+:mod:`worldgen.export.preview`).
 """
 
 from __future__ import annotations
@@ -157,10 +157,10 @@ def _regenerate(meta: dict):
 
 
 def _feasibility(meta: dict, world) -> None:
-    from worldgen.doors import open_scene
     from worldgen.feasibility.collision import Colliders
     from worldgen.feasibility.verify import verify_path
     from worldgen.floats import round_float
+    from worldgen.scene.doors import open_scene
 
     report, robot = world.feasibility, world.robot
     if bool(meta["feasibility"]["feasible"]) != report.feasible:
@@ -199,7 +199,7 @@ def _feasibility(meta: dict, world) -> None:
 
 def _reproduce(folder: Path, meta: dict, world, entries) -> str:
     import worldgen
-    from worldgen.world import FILE_NAMES, FORMATS
+    from worldgen.export.formats import FILE_NAMES, FORMATS
 
     if meta.get("worldgen_version") != worldgen.__version__:
         return f"written by worldgen {meta.get('worldgen_version')}, not compared byte for byte"

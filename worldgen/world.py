@@ -12,15 +12,10 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional, Sequence
 
 from worldgen.errors import OutputError, ParameterError
+from worldgen.export.formats import FILE_NAMES, FORMATS, METADATA_NAME, SDF_VERSIONS, normalise_formats
 from worldgen.scene import Robot, Scene, Task
 
-__all__ = ["World", "FORMATS", "FILE_NAMES", "SDF_VERSIONS"]
-
-#: Every format a world can be written in, in the order they are written.
-FORMATS = ("sdf", "mjcf", "urdf")
-FILE_NAMES = {"sdf": "world.sdf", "mjcf": "world.mjcf.xml", "urdf": "world.urdf"}
-METADATA_NAME = "world.json"
-SDF_VERSIONS = ("1.9", "1.6")
+__all__ = ["World", "FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats"]
 
 
 class World:
@@ -149,8 +144,8 @@ class World:
                 files[f"mesh:{rel}"] = (rel, data)
         from worldgen.groundtruth import truth
         files.update(truth.map_files(self))  # the occupancy map goes with every world
-        from worldgen import scenario
-        files.update(scenario.files(self, formats))  # scenario.yaml: the tasks as a scenario spec (worldgen.scenario)
+        from worldgen.export import scenario
+        files.update(scenario.files(self, formats))  # scenario.yaml: the tasks as a scenario spec (worldgen.export.scenario)
         return files
 
     @cached_property
@@ -188,7 +183,7 @@ class World:
 
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
-        ``preview`` adds preview.png, a top-down picture (worldgen.preview).
+        ``preview`` adds preview.png, a top-down picture (worldgen.export.preview).
         A folder of the same name that holds another world (another
         ``content_hash``, or no readable world.json) is an :class:`OutputError`
         unless ``overwrite``; the same world is simply written again.
@@ -210,8 +205,8 @@ class World:
         files = self._default_files if default else self.rendered_files(formats, sdf_version)
         meta = self.metadata_for(files)  # afresh: a caller may have edited .metadata's dict
         blobs = {path: data for path, data in files.values()}
-        if preview:  # a picture of world.json, not listed in its `files` (see worldgen.preview)
-            from worldgen.preview import PREVIEW_NAME, render
+        if preview:  # a picture of world.json, not listed in its `files` (see worldgen.export.preview)
+            from worldgen.export.preview import PREVIEW_NAME, render
             blobs[PREVIEW_NAME] = render(meta)
         blobs[METADATA_NAME] = metadata.dumps(meta).encode()
         return blobs
@@ -221,18 +216,6 @@ class World:
         if self.path is None:
             raise OutputError("this world has not been written yet; call World.write(folder) first")
         return self.path / (METADATA_NAME if fmt == "json" else FILE_NAMES[fmt])
-
-
-def normalise_formats(formats: Iterable[str]) -> tuple[str, ...]:
-    if isinstance(formats, str):
-        formats = [f for f in formats.split(",") if f.strip()]
-    chosen = [f.strip().lower() for f in formats]
-    for f in chosen:
-        if f not in FORMATS:
-            raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {f!r}")
-    if not chosen:
-        raise ParameterError(f"parameter 'formats' must name at least one of {', '.join(FORMATS)}, got nothing")
-    return tuple(f for f in FORMATS if f in chosen)
 
 
 def _text(tree) -> str:

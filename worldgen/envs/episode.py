@@ -1,11 +1,11 @@
 """One episode's record, and its figures under the oracles' names once it ends.
 
-The record is the run as :mod:`worldgen.oracles` takes it: ``t, x, y, yaw``
+The record is the run as :mod:`worldgen.testing.oracles` takes it: ``t, x, y, yaw``
 rows, one at the reset and one after every env step, plus every MuJoCo contact
-of the robot (one :class:`~worldgen.oracles.Contact` per contact that begins,
-naming the entity touched, as :func:`worldgen.oracles.collisions` reports them).
+of the robot (one :class:`~worldgen.testing.oracles.Contact` per contact that begins,
+naming the entity touched, as :func:`worldgen.testing.oracles.collisions` reports them).
 
-:meth:`Episode.figures` gives the keys of :class:`worldgen.oracles.Run`
+:meth:`Episode.figures` gives the keys of :class:`worldgen.testing.oracles.Run`
 (``world_id``, ``task``, ``reached_goal``, ``time_to_goal``, ``duration``,
 ``path_length``, ``path_efficiency``, ``min_clearance``, ``collisions``,
 ``min_separation``, ``max_velocity``; ``collisions`` as ``Run.as_dict`` writes
@@ -25,7 +25,7 @@ from typing import Optional
 
 import numpy as np
 
-from worldgen.oracles import Contact
+from worldgen.testing.figures import Contact
 
 __all__ = ["Episode", "spl"]
 
@@ -66,7 +66,7 @@ class Episode:
 
     def figures(self) -> dict:
         """The figures of the run so far, under the oracles' names (see the module's docstring)."""
-        from worldgen import oracles
+        from worldgen.testing import figures as oracles
 
         ground = self.world.ground()
         traj = self.trajectory
@@ -85,7 +85,7 @@ class Episode:
             min_separation=oracles.min_separation(traj, ground),
             max_velocity=float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0)
         limit: Optional[float] = task.get("time_limit")
-        # evaluate's rule (worldgen.oracles_eval): the goal, within the scenario's max_time, and no collision.
+        # evaluate's rule (worldgen.testing.evaluate): the goal, within the scenario's max_time, and no collision.
         ok = bool(run.reached_goal and not run.collisions and (limit is None or run.time_to_goal <= limit))
         out = run.as_dict()
         out.update(success=ok, spl=spl(ok, ref, length), reference_path_length=ref)

@@ -2,7 +2,7 @@
 
 The scripts are world.json's ``dynamic_obstacles[].trajectory`` (``t, x, y``
 rows, straight legs at constant speed, looping or waiting at the end), read
-exactly as :func:`worldgen.movers.mover_positions` reads them, but for all the
+exactly as :func:`worldgen.scene.motion.mover_positions` reads them, but for all the
 physics steps of one control period at once.
 """
 

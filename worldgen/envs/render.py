@@ -1,6 +1,6 @@
 """``render_mode="rgb_array"``: a top-down picture of the episode, drawn with Pillow (no OpenGL).
 
-The world is drawn once per episode by :func:`worldgen.preview.draw` (the same
+The world is drawn once per episode by :func:`worldgen.export.preview.draw` (the same
 picture as preview.png: walls, obstacles, no-go zone, reference path, spawn and
 goal, title, scale bar); each frame copies it and adds, in the preview's own
 world-to-pixel layout: the lidar beams as thin lines to where they read, the
@@ -16,7 +16,7 @@ from typing import Optional, Sequence
 import numpy as np
 from PIL import Image, ImageDraw
 
-from worldgen.preview import COLOURS, draw, layout
+from worldgen.export.preview import COLOURS, draw, layout
 
 __all__ = ["FRAME_WIDTH", "MAX_BEAMS_DRAWN", "TopDown", "mover_discs", "ROBOT_COLOUR", "BEAM_COLOUR", "TRACK_COLOUR"]
 

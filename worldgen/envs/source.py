@@ -3,7 +3,7 @@
 A source hands the environment one :class:`EpisodeWorld` per episode: the
 world's MJCF as an lxml element (the env adds its robot to it), the footprint,
 the task as world.json describes it, the movers, and lazy access to the
-oracles' :class:`~worldgen.oracles.Ground` and to world.json (for drawing).
+oracles' :class:`~worldgen.testing.oracles.Ground` and to world.json (for drawing).
 
 - :class:`GeneratorSource`: ``worldgen.generate(generator, seed, **params)`` in
   memory, a new seed per episode; nothing touches the disk. A preset is a
@@ -76,9 +76,9 @@ def _checked_task(world_id: str, task: dict) -> dict:
 
 def _task_of_world(world) -> dict:
     """world.json's ``tasks[0]`` of an in-memory World, without rendering any file."""
-    from worldgen.doors import door_joints, leaves_in_the_way
     from worldgen.export.metadata import time_limit
     from worldgen.params import COMMON_PARAMS
+    from worldgen.scene.doors import door_joints, leaves_in_the_way
 
     task = world.tasks[0]
     path = world.feasibility.paths[0] if world.feasibility.paths else None
@@ -99,11 +99,11 @@ def _task_of_world(world) -> dict:
 def episode_world(world) -> EpisodeWorld:
     """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
     from worldgen.export import mjcf
-    from worldgen.movers import metadata_entry
-    from worldgen.oracles import Ground
+    from worldgen.export.metadata import mover_entry
+    from worldgen.testing.figures import Ground
 
     task = _task_of_world(world)
-    movers = [metadata_entry(m) for m in world.scene.movers]
+    movers = [mover_entry(m) for m in world.scene.movers]
     robot = world.robot
     light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": movers,
              "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance}}
@@ -167,10 +167,11 @@ class PackSource:
         return len(self.pack)
 
     def world(self, index: int) -> EpisodeWorld:
-        from worldgen.export.xml import safe_parser
-        from worldgen.oracles import load as ground_of
-        from worldgen.scene import Robot as _Robot
         from lxml import etree
+
+        from worldgen.export.xml import safe_parser
+        from worldgen.scene import Robot as _Robot
+        from worldgen.testing.figures import load as ground_of
 
         pw = self.pack[index]
         meta = pw.metadata

@@ -19,14 +19,14 @@ from typing import Any, Mapping
 import numpy as np
 import shapely
 
-from worldgen.doors import door_records, leaves_in_the_way
 from worldgen.floats import round_float
 from worldgen.groundtruth import truth
-from worldgen.footprint import scene_footprints
-from worldgen.movers import metadata_entry as mover_entry
 from worldgen.params import COMMON_PARAMS
+from worldgen.scene.doors import door_records, leaves_in_the_way
+from worldgen.scene.footprint import scene_footprints
 
-__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "time_limit", "free_area_ratio"]
+__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "time_limit", "free_area_ratio", "mover_entry",
+           "FORMATS_NOTE"]
 
 #: The value of world.json's ``schema`` field; a breaking change bumps the number.
 SCHEMA_ID = "worldgen.world/1"
@@ -107,6 +107,22 @@ def dumps(meta: Mapping[str, Any]) -> str:
     readable. ``dumps(json.loads(dumps(m))) == dumps(m)``.
     """
     return _emit(meta, "") + "\n"
+
+
+#: How each exported format carries a mover; URDF cannot express a scripted motion.
+FORMATS_NOTE = {"sdf": "actor", "mjcf": "mocap_body", "urdf": None}
+
+
+def mover_entry(mover) -> dict:
+    """The mover's ``dynamic_obstacles[]`` entry of world.json."""
+    return {
+        "name": mover.name,
+        "radius": mover.radius,
+        "height": mover.height,
+        "trajectory": [list(row) for row in mover.trajectory],
+        "loop": mover.loop,
+        "formats": dict(FORMATS_NOTE),
+    }
 
 
 def time_limit(length: float, robot_speed: float, doors: int = 0) -> float:

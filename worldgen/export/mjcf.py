@@ -23,8 +23,11 @@ How the scene maps onto MJCF:
 - Friction: "slide torsional rolling" = node.material.friction and MuJoCo's own
   defaults for the two others. Colour: ``rgba``.
 - Nodes without collision (role ``marker``): ``contype="0" conaffinity="0"``.
-- Movers: mocap bodies named after the mover (:mod:`worldgen.export.movers`),
-  driven through ``data.mocap_pos`` (:func:`worldgen.movers.drive_mocap`).
+- Movers: ``<body mocap="true">`` in the worldbody, named after the mover, at
+  its first waypoint, with a cylinder geom of the same name; driven through
+  ``data.mocap_pos`` (:func:`worldgen.scene.motion.drive_mocap`). Mocap bodies
+  push dynamic bodies (a robot) but never collide with static geometry. URDF
+  has no element for a scripted motion, so movers are left out of it.
 - Physics: ``<option timestep gravity>``; the real-time factor, which MuJoCo
   does not know, as ``<custom><numeric name="real_time_factor">``.
 """
@@ -34,10 +37,10 @@ from __future__ import annotations
 from typing import Optional
 
 from worldgen.errors import SceneError
-from worldgen.export.movers import write_mjcf_mocap
 from worldgen.export.xml import load_template, sub
 from worldgen.floats import fmt, fmt_seq, round_float
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere
+from worldgen.scene.mover import MOVER_RGBA
 
 __all__ = ["to_mjcf", "TEMPLATE", "joints_by_child", "mass_properties", "RESERVED_NAME"]
 
@@ -106,7 +109,7 @@ def to_mjcf(scene: Scene, name: str = "world"):
         children.setdefault(node.parent, []).append(node)
     for node in children.get(None, ()):
         _write_node(worldbody, node, joints, children, mesh_assets)
-    write_mjcf_mocap(worldbody, scene)
+    _write_mocap(worldbody, scene)
     # MuJoCo has no pacing of its own: the real-time factor travels as a custom
     # number (model.numeric("real_time_factor")) for a runner that wants it.
     sub(sub(root, "custom"), "numeric", name="real_time_factor", data=fmt(scene.physics.real_time_factor))
@@ -192,3 +195,12 @@ def _write_geom(parent_el, node: Node, mesh_assets, pose_attrs: dict[str, str]) 
         # Visual only: no contact with anything, drawn in group 2 with the other visuals.
         attrs.update(contype="0", conaffinity="0", group="2")
     sub(parent_el, "geom", **attrs)
+
+
+def _write_mocap(worldbody, scene: Scene) -> None:
+    """Append one mocap body (with a cylinder geom of the same name) per mover to ``<worldbody>``."""
+    for mover in scene.movers:
+        _, x, y = mover.trajectory[0]
+        body = sub(worldbody, "body", name=mover.name, mocap="true", pos=fmt_seq((x, y, mover.height / 2.0)))
+        sub(body, "geom", name=mover.name, type="cylinder", size=fmt_seq((mover.radius, mover.height / 2.0)),
+            rgba=fmt_seq(MOVER_RGBA), friction=fmt_seq((mover.friction, TORSIONAL_FRICTION, ROLLING_FRICTION)))

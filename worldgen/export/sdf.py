@@ -41,12 +41,19 @@ simulators' sources):
   up on its resource path, so add the world folder to ``GAZEBO_RESOURCE_PATH``.
 * No ``<plugin>``: Gazebo Sim loads its default systems (physics, scene
   broadcaster, user commands) when a world names none.
-* Movers (``scene.movers``) are ``<actor>``s with a looping scripted
-  trajectory and a link carrying their cylinder, the same element in 1.6 and
-  1.9 (:mod:`worldgen.export.movers`). Gazebo classic moves any actor link
-  along the script; Gazebo Sim accepts skin-less, trajectory-only actors only
-  since gz-sim pull request 1947 (2023) and may not draw their links (gz-sim
-  issue 418). Neither gives actors contacts: a mover is seen, not felt.
+* Movers (``scene.movers``) are ``<actor>``s, the same element in 1.6 and
+  1.9: a link ``body`` carrying the mover's cylinder (visual and collision, its
+  base on the floor) and a ``<script>`` looping one ``<trajectory>`` of timed
+  ``<waypoint>``s, one per trajectory row. Gazebo classic carries every actor
+  link along the script; ``tension="1"`` makes it pass through the waypoints
+  instead of overshooting them on its Catmull-Rom spline. Gazebo Sim accepts
+  skin-less, trajectory-only actors only since gz-sim pull request 1947 (2023),
+  may not draw their links (gz-sim issue 418) and ignores ``tension`` (gz-sim
+  issue 243). Neither gives actors physics: the collision element is there for
+  plugins that enable it, a stock actor is seen, not felt, and separation from
+  movers is judged from world.json's trajectories. worldgen ships no skin (the
+  worlds must load without a network); add a ``<skin>``/``<animation>`` to see
+  a person.
 
 A model is ``<static>`` only when all its nodes are static. A static root with a
 dynamic descendant (a door frame with its leaf) gives a dynamic model whose root
@@ -60,20 +67,21 @@ from typing import Optional
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError
-from worldgen.export.movers import write_sdf_actors
+from worldgen.export.formats import SDF_VERSIONS
 from worldgen.export.xml import XmlText, escape_text, fill, load_template
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose
 from worldgen.scene.graph import Joint
+from worldgen.scene.mover import MOVER_RGBA, Mover
 
-__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "to_sdf"]
+__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "to_sdf"]
 
-#: Versions this exporter writes: 1.9 for Gazebo Fortress-Harmonic, 1.6 for Gazebo classic.
-SDF_VERSIONS = ("1.9", "1.6")
 TEMPLATE = "world.sdf"
 #: Smallest principal moment written (kg m^2): floats keep 6 decimals, and a
 #: moment rounded to 0 would make the inertia invalid for every physics engine.
 MIN_MOMENT = 1e-6
+#: A mover's trajectory ``type``: it would name a skin animation played along it, if there were one.
+TRAJECTORY_TYPE = "walk"
 
 
 def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> bytes:
@@ -102,7 +110,7 @@ def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> bytes:
     for node in scene.nodes:
         if node.parent is None:
             writer.write(out, node)
-    write_sdf_actors(out, scene)
+    _write_actors(out, scene)
     return fill(tree, world, out)
 
 
@@ -298,4 +306,52 @@ def _write_geometry(out: XmlText, geometry) -> None:
     for tag, content in fields:
         out.leaf(tag, content)
     out.close(kind)
+    out.close("geometry")
+
+
+# -- movers: one <actor> each ------------------------------------------------
+
+def _write_actors(out: XmlText, scene: Scene) -> None:
+    """Write one ``<actor>`` per mover at the end of the SDF ``<world>`` (``out`` is at its children's depth)."""
+    for mover in scene.movers:
+        _sdf_actor(out, mover)
+
+
+def _sdf_actor(out: XmlText, mover: Mover) -> None:
+    out.open("actor", f' name="{mover.name}"')
+    out.open("link", ' name="body"')
+    out.leaf("pose", fmt_seq((0.0, 0.0, mover.height / 2.0, 0.0, 0.0, 0.0)))
+    out.open("collision", ' name="collision"')
+    _cylinder(out, mover)
+    out.close("collision")
+    out.open("visual", ' name="visual"')
+    _cylinder(out, mover)
+    colour = fmt_seq(MOVER_RGBA)
+    out.open("material")
+    out.leaf("ambient", colour)
+    out.leaf("diffuse", colour)
+    out.close("material")
+    out.close("visual")
+    out.close("link")
+    out.open("script")
+    out.leaf("loop", "true" if mover.loop else "false")
+    out.leaf("delay_start", "0")
+    out.leaf("auto_start", "true")
+    out.open("trajectory", f' id="0" type="{TRAJECTORY_TYPE}" tension="1"')
+    for t, x, y in mover.trajectory:
+        out.open("waypoint")
+        out.leaf("time", fmt(t))
+        out.leaf("pose", fmt_seq((x, y, 0.0, 0.0, 0.0, 0.0)))
+        out.close("waypoint")
+    out.close("trajectory")
+    out.close("script")
+    out.close("actor")
+
+
+def _cylinder(out: XmlText, mover: Mover) -> None:
+    out.open("geometry")
+    out.open("cylinder")
+    out.leaf("radius", fmt(mover.radius))
+    out.leaf("length", fmt(mover.height))
+    out.close("cylinder")
     out.close("geometry")

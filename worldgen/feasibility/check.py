@@ -21,17 +21,18 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from worldgen.doors import door_joints, fixed_scene, open_scene
 from worldgen.feasibility.collision import Colliders
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.passage import narrowest_passage
-from worldgen.feasibility.planner import Planner, waypoints
+from worldgen.feasibility.planner import Planner
 from worldgen.feasibility.report import Check, FeasibilityReport, TaskPath
+from worldgen.feasibility.route import waypoints
 from worldgen.feasibility.verify import verify_path
 from worldgen.floats import DECIMALS
-from worldgen.footprint import robot_footprints
 from worldgen.scene import Robot, Scene, Task
+from worldgen.scene.doors import door_joints, fixed_scene, open_scene
+from worldgen.scene.footprint import robot_footprints
 
 __all__ = ["check", "SAFETY"]
 
@@ -55,7 +56,7 @@ def _p(xy) -> str:
 def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityReport:
     """Check every task of ``scene`` for ``robot``; never raises for an infeasible world.
 
-    Doors (see :mod:`worldgen.doors`) are planned through at their open limit;
+    Doors (see :mod:`worldgen.scene.doors`) are planned through at their open limit;
     spawn and goal must be free both so and as the doors start, and the
     informational ``reachable_initial_state`` is this same check run with every
     leaf held where it starts: ok when every task can be driven without opening

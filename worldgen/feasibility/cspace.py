@@ -19,7 +19,6 @@ Indices: obstacle ids are those of :class:`~worldgen.feasibility.geometry.Obstac
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Optional
@@ -28,6 +27,7 @@ import numpy as np
 import shapely
 
 from worldgen.feasibility.geometry import Obstacles2D, point_segment_distance, segment_segment_distance
+from worldgen.feasibility.grid import SegmentGrid
 
 __all__ = ["ConfigSpace", "TOUCH", "CONE_SLACK", "NEAR_MARGIN"]
 
@@ -74,57 +74,6 @@ def _unskipped(seg: np.ndarray, o: np.ndarray, skip1, skip2) -> tuple[np.ndarray
     if skip2 is not None:
         keep &= o != skip2[seg]
     return seg[keep], o[keep]
-
-
-@dataclass(frozen=True, eq=False)
-class _Grid:
-    """Obstacles by square cell of side ``h``: each listed in every cell within h / 4 of its grown box,
-    so a point sampled every h / 2 along a segment finds, in its own cell, every obstacle the
-    segment comes within the radius of near that point."""
-
-    origin: tuple[float, float]
-    h: float
-    shape: tuple[int, int]
-    start: np.ndarray
-    ids: np.ndarray
-
-    @classmethod
-    def build(cls, cs: "ConfigSpace") -> "_Grid":
-        boxes = cs.obstacles.boxes
-        x0, y0, x1, y1 = cs.box
-        spread = float(np.median(cs.hull_r))
-        h = max(2 * spread, math.sqrt(max((x1 - x0) * (y1 - y0), 1e-9) / len(boxes)), 1e-3)
-        grow = cs.radius + h / 4
-        origin = (min(x0, boxes[:, 0].min()) - grow, min(y0, boxes[:, 1].min()) - grow)
-        nx = int(math.ceil((max(x1, boxes[:, 2].max()) + grow - origin[0]) / h)) + 1
-        ny = int(math.ceil((max(y1, boxes[:, 3].max()) + grow - origin[1]) / h)) + 1
-        i0 = np.floor((boxes[:, 0] - grow - origin[0]) / h).astype(np.int64)
-        i1 = np.floor((boxes[:, 2] + grow - origin[0]) / h).astype(np.int64)
-        j0 = np.floor((boxes[:, 1] - grow - origin[1]) / h).astype(np.int64)
-        j1 = np.floor((boxes[:, 3] + grow - origin[1]) / h).astype(np.int64)
-        wi, wj = i1 - i0 + 1, j1 - j0 + 1
-        count = wi * wj
-        owner = np.repeat(np.arange(len(boxes)), count)
-        local = np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
-        cell = (i0[owner] + local // wj[owner]) * ny + (j0[owner] + local % wj[owner])
-        order = np.argsort(cell, kind="stable")
-        start = np.searchsorted(cell[order], np.arange(nx * ny + 1))
-        return cls(origin, h, (nx, ny), start.astype(np.int64), owner[order].astype(np.int64))
-
-    def pairs(self, rows: np.ndarray, pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(row, obstacle) for every obstacle listed in the cell of each point (rows[k] owns pts[k])."""
-        nx, ny = self.shape
-        i = np.clip(np.floor((pts[:, 0] - self.origin[0]) / self.h).astype(np.int64), 0, nx - 1)
-        j = np.clip(np.floor((pts[:, 1] - self.origin[1]) / self.h).astype(np.int64), 0, ny - 1)
-        cell = i * ny + j
-        # A segment's next sample in the same cell finds nothing new.
-        fresh = np.r_[True, (cell[1:] != cell[:-1]) | (rows[1:] != rows[:-1])]
-        rows, cell = rows[fresh], cell[fresh]
-        lo, hi = self.start[cell], self.start[cell + 1]
-        count = hi - lo
-        row = np.repeat(rows, count)
-        k = np.repeat(lo, count) + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
-        return row, self.ids[k]
 
 
 def _near(lo: np.ndarray, hi: np.ndarray, boxes: np.ndarray, reach: float) -> np.ndarray:
@@ -224,6 +173,12 @@ class ConfigSpace:
         return len(self.rho)
 
     # -- cones and angles --------------------------------------------------
+    def circles_of(self, obstacles: np.ndarray) -> np.ndarray:
+        """Every circle id of the given obstacle ids, in order."""
+        lo, hi = self.first[obstacles], self.first[obstacles + 1]
+        counts = hi - lo
+        return np.repeat(lo, counts) + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
+
     def in_cone(self, circle: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """(m,) bool: the outward ``normal`` (m, 2) lies in the cone of ``circle`` (m,)."""
         a, b = self.cone_a[circle], self.cone_b[circle]
@@ -278,8 +233,8 @@ class ConfigSpace:
         return ok
 
     @cached_property
-    def _grid(self) -> Optional["_Grid"]:
-        return _Grid.build(self) if len(self.obstacles) > GRID_FROM else None
+    def _grid(self) -> Optional[SegmentGrid]:
+        return SegmentGrid.build(self) if len(self.obstacles) > GRID_FROM else None
 
     def _grid_clear(self, a, b, ok, skip1, skip2) -> np.ndarray:
         grid = self._grid

@@ -1,7 +1,7 @@
 """Obstacle footprints as flat arrays, and exact 2-D point and segment distances, vectorised.
 
 Footprints are
-discs or convex polygons (see :mod:`worldgen.footprint`); here they are kept as
+discs or convex polygons (see :mod:`worldgen.scene.footprint`); here they are kept as
 flat numpy arrays (disc centres and radii; every polygon edge with its owner)
 so one call answers for many points or segments without a Python loop per
 obstacle. A bounding-box broad phase keeps the work near the query.
@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 import shapely
 
-from worldgen.footprint import Footprint
+from worldgen.scene.footprint import Footprint
 
 __all__ = ["Obstacles2D", "point_segment_distance", "segment_segment_distance"]
 

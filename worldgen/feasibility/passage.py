@@ -85,7 +85,7 @@ def _joins(obstacles: Obstacles2D, bounds, reach: float):
     than ``reach``, sorted by gap. Pieces: the obstacles, then the outside of the bounds beyond each edge
     (left, bottom, right, top), each a half-plane."""
     (x0, y0), (x1, y1) = bounds
-    n, nd = len(obstacles), obstacles.n_discs
+    n = len(obstacles)
     far = (x1 - x0) + (y1 - y0) + 1.0
     xc, yc = (x0 + x1) / 2, (y0 + y1) / 2
     starts = obstacles.edge_start[:-1]

@@ -27,15 +27,15 @@ from __future__ import annotations
 
 import heapq
 import math
-from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
-from worldgen.feasibility.tangents import Tangents, every_side, tangents
+from worldgen.feasibility.route import Contact, Route
+from worldgen.feasibility.tangents import EdgeIndex, TangentBatch, Tangents, TangentStore, every_side, tangents
 
-__all__ = ["Contact", "Route", "Planner", "waypoints", "MAX_ARC_STEP"]
+__all__ = ["Planner"]
 
 #: Slack (m) added to a node's bound when it asks for tangents, so that one
 #: request covers the obstacles just beyond it.
@@ -44,30 +44,6 @@ BAND = 0.25
 MIN_BATCH = 16
 #: Nodes whose keys lie within this (m) of the smallest are expanded together.
 BATCH = 0.5
-#: Largest angle (rad) one straight piece of a written arc may turn: the polygon round an arc
-#: is then at most 0.33 % longer than the arc.
-MAX_ARC_STEP = math.pi / 16
-
-
-@dataclass(frozen=True)
-class Contact:
-    """The path winding round ``circle`` on ``side`` (+1 counter-clockwise) from outward normal angle
-    ``start`` (rad) over ``sweep`` (rad, >= 0), in the direction of travel."""
-
-    circle: int
-    side: int
-    start: float
-    sweep: float
-
-
-@dataclass(frozen=True)
-class Route:
-    """A taut path: the straight legs' ends ``points`` (k, 2) (spawn, then for each contact its
-    arrival and departure point, then goal), ``contacts`` between them, and the exact ``length``."""
-
-    points: np.ndarray
-    contacts: tuple[Contact, ...]
-    length: float
 
 
 class _Node:
@@ -86,23 +62,6 @@ class _Node:
         self.rel = 0.0  # the arrival's angle within the circle's cone
 
 
-class _Candidates:
-    """Ways out of expanded nodes, gathered for one vectorised pass: parallel lists of arrays."""
-
-    def __init__(self):
-        self.parts: list[tuple] = []
-
-    def add(self, node_index: np.ndarray, tans: Tangents) -> None:
-        if len(tans):
-            self.parts.append((node_index, tans))
-
-    def merged(self):
-        if not self.parts:
-            return None, None
-        idx = np.concatenate([p[0] for p in self.parts])
-        return idx, Tangents.concat([p[1] for p in self.parts])
-
-
 class Planner:
     """Shortest paths in one configuration space; tangents between obstacles are shared by every query."""
 
@@ -110,7 +69,7 @@ class Planner:
         self.cs = cs
         n = len(cs.obstacles)
         self._have: dict[int, np.ndarray] = {}  # per obstacle: the obstacles its tangents were computed to
-        self._store = _Store()
+        self._store = TangentStore()
         self._angle0 = np.arctan2(cs.cone_a[:, 1], cs.cone_a[:, 0])
         self._full = cs.full
         self._hull_max = float(cs.hull_r.max()) if n else 0.0
@@ -168,8 +127,8 @@ class Planner:
         if fresh:
             for node, lb in zip(fresh, self._bounds(fresh)):
                 node.lb = lb
-        out = _Candidates()
-        goals = _Candidates()
+        out = TangentBatch()
+        goals = TangentBatch()
         # Fresh nodes on circles: straight to the goal, and along the grown edge to the next corner.
         if fresh_circles:
             idx = np.array(fresh_circles)
@@ -207,7 +166,7 @@ class Planner:
             for i, band, upto in requests:
                 node = nodes[i]
                 if node.circle < 0:
-                    dst = _circles_of(cs, band)
+                    dst = cs.circles_of(band)
                     src, dst, s1, s2 = every_side(np.full(len(dst), -1), dst, (1,), (1, -1))
                     tans = tangents(cs, src, dst, s1, s2, src_xy=node.point, among=self._blockers([node], None))
                     out.add(np.full(len(tans), i), tans)
@@ -331,7 +290,7 @@ class Planner:
             if len(todo):
                 have[todo] = True
                 src_c = np.arange(cs.first[a], cs.first[a + 1])
-                dst_c = _circles_of(cs, todo)
+                dst_c = cs.circles_of(todo)
                 src_parts.append(np.repeat(src_c, len(dst_c)))
                 dst_parts.append(np.tile(dst_c, len(src_c)))
                 nodes.append(node)
@@ -386,7 +345,7 @@ class Planner:
         inside = (lo[:, 0] >= x0) & (lo[:, 1] >= y0) & (hi[:, 0] <= x1) & (hi[:, 1] <= y1)
         return inside & (cs.nb_start[1:] == cs.nb_start[:-1])[cs.owner]
 
-    def _grown_edges(self) -> "_Edges":
+    def _grown_edges(self) -> EdgeIndex:
         """The grown edges between neighbouring corners, as tangents each way, where clear."""
         cs = self.cs
         corner = np.flatnonzero(cs.nxt >= 0)
@@ -403,7 +362,7 @@ class Planner:
         # Winding counter-clockwise (side +1) the path goes from a corner to the next; clockwise, back.
         tans = Tangents.concat([Tangents(corner, nxt, one, one, a, b, n, n, length),
                                 Tangents(nxt, corner, -one, -one, b, a, n, n, length)])
-        return _Edges(tans, cs.n_circles)
+        return EdgeIndex(tans, cs.n_circles)
 
     # -- the answer --------------------------------------------------------
     def _route(self, start, goal) -> Route:
@@ -428,96 +387,3 @@ class Planner:
                 points.append(q)
         points.append(start)
         return Route(np.array(points[::-1], dtype=float), tuple(contacts[::-1]), float(g))
-
-
-class _Store:
-    """Every tangent computed between obstacles, with the rows leaving each (circle, side)."""
-
-    def __init__(self):
-        self.parts: list[Tangents] = []
-        self.tans: Optional[Tangents] = None
-        self.dst_owner = np.zeros(0, dtype=np.int64)
-        self.index: dict[int, list[np.ndarray]] = {}
-
-    def add(self, tans: Tangents, cs: ConfigSpace) -> None:
-        if not len(tans):
-            return
-        base = len(self.dst_owner)
-        self.parts.append(tans)
-        self.tans = None
-        self.dst_owner = np.concatenate([self.dst_owner, cs.owner[tans.dst]])
-        key = tans.src * 2 + (tans.s1 < 0)
-        order = np.argsort(key, kind="stable")
-        cut = np.flatnonzero(np.r_[True, key[order][1:] != key[order][:-1]])
-        for k, rows in zip(key[order][cut].tolist(), np.split(order + base, cut[1:])):
-            self.index.setdefault(k, []).append(rows)
-
-    def rows(self, circle: int, side: int) -> np.ndarray:
-        parts = self.index.get(circle * 2 + (side < 0))
-        if not parts:
-            return np.zeros(0, dtype=np.int64)
-        if len(parts) > 1:
-            parts[:] = [np.concatenate(parts)]
-        return parts[0]
-
-    def take(self, rows: np.ndarray) -> Tangents:
-        if self.tans is None:
-            self.tans = Tangents.concat(self.parts)
-            self.parts = [self.tans]
-        return self.tans.take(rows)
-
-
-class _Edges:
-    """Grown polygon edges as tangents, looked up by (circle, side)."""
-
-    def __init__(self, tans: Tangents, n_circles: int):
-        self.tans = tans
-        self.index = np.full((n_circles, 2), -1, dtype=np.int64)
-        self.index[tans.src, (tans.s1 < 0).astype(np.int64)] = np.arange(len(tans))
-
-    def pick(self, circles: np.ndarray, sides: np.ndarray) -> np.ndarray:
-        return self.index[circles, (sides < 0).astype(np.int64)]
-
-
-def _circles_of(cs: ConfigSpace, obstacles: np.ndarray) -> np.ndarray:
-    """Every circle id of the given obstacle ids, in order."""
-    lo, hi = cs.first[obstacles], cs.first[obstacles + 1]
-    counts = hi - lo
-    return np.repeat(lo, counts) + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
-
-
-def waypoints(cs: ConfigSpace, route: Route, spare: float) -> np.ndarray:
-    """(k, 2) a polyline along ``route`` that keeps the clearance: straight legs as they are, each arc
-    replaced by a polygon circumscribed about it (so no chord cuts into the obstacle it wraps).
-
-    Such a polygon bulges out of the arc by rho (1 / cos(step / 2) - 1); the step is
-    chosen so that the bulge stays within the arc's own slack to other obstacles
-    (measured exactly, up to a tenth of the radius) plus ``spare`` (m), a part of the
-    planner's safety margin.
-    """
-    arcs = [k for k, c in enumerate(route.contacts) if c.sweep > 1e-9]
-    slack = {}
-    if arcs:
-        contacts = [route.contacts[k] for k in arcs]
-        circle = np.array([c.circle for c in contacts], dtype=np.int64)
-        ccw_start = np.array([c.start if c.side > 0 else c.start - c.sweep for c in contacts])
-        measured = cs.arc_clearance(circle, ccw_start, np.array([c.sweep for c in contacts]))
-        slack = dict(zip(arcs, measured.tolist()))
-    pts = [route.points[0]]
-    for k, contact in enumerate(route.contacts):
-        arrive, depart = route.points[1 + 2 * k], route.points[2 + 2 * k]
-        pts.append(arrive)
-        if k in slack:
-            c, rho = cs.centre[contact.circle], float(cs.rho[contact.circle])
-            bulge = max(slack[k], 0.0) + spare
-            step = min(MAX_ARC_STEP, 2 * math.acos(1 / (1 + bulge / rho)))
-            n = max(1, math.ceil(contact.sweep / step - 1e-9))
-            piece = contact.sweep / n
-            out = rho / math.cos(piece / 2)
-            ang = contact.start + contact.side * (np.arange(n) + 0.5) * piece
-            pts.extend(c + out * np.stack([np.cos(ang), np.sin(ang)], axis=1))
-        pts.append(depart)
-    pts.append(route.points[-1])
-    pts = np.array(pts, dtype=float)
-    keep = np.r_[True, np.any(np.abs(np.diff(pts, axis=0)) > 1e-12, axis=1)]
-    return pts[keep]

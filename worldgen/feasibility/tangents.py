@@ -4,12 +4,12 @@ A shortest path for a disc among grown convex obstacles is taut: straight
 segments, each tangent to the circles at its two ends, joined by arcs of those
 circles. A segment leaves circle 1 with the circle on its left (side ``s1 = +1``,
 the path then winds counter-clockwise round it) or on its right (``s1 = -1``),
-and meets circle 2 on side ``s2``. With ``l`` the unit normal to the left of the
-direction of travel, the touching points are ``q = c1 - s1 r1 l`` and
-``t = c2 - s2 r2 l``, and the line is tangent to both exactly when
-``l . (c2 - c1) = s2 r2 - s1 r1``; of the two solutions, the one with the
+and meets circle 2 on side ``s2``. With ``unit`` the unit normal to the left of the
+direction of travel, the touching points are ``q = c1 - s1 r1 unit`` and
+``t = c2 - s2 r2 unit``, and the line is tangent to both exactly when
+``unit . (c2 - c1) = s2 r2 - s1 r1``; of the two solutions, the one with the
 direction of travel pointing from circle 1 to circle 2 is
-``angle(l) = angle(c2 - c1) + acos(k / |c2 - c1|)``.
+``angle(unit) = angle(c2 - c1) + acos(k / |c2 - c1|)``.
 
 A point (the spawn, the goal) is a circle of radius 0 with a full cone.
 """
@@ -17,12 +17,13 @@ A point (the spawn, the goal) is a circle of radius 0 with a full cone.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Optional
 
 import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
 
-__all__ = ["Tangents", "tangents", "every_side", "SIDES"]
+__all__ = ["Tangents", "tangents", "every_side", "SIDES", "TangentStore", "EdgeIndex", "TangentBatch"]
 
 #: The four kinds of common tangent (s1, s2): both circles on the left, left-right, ...
 SIDES = ((1, 1), (1, -1), (-1, -1), (-1, 1))
@@ -102,9 +103,9 @@ def tangents(cs: ConfigSpace, src: np.ndarray, dst: np.ndarray, s1: np.ndarray, 
     cos = np.where(ok, k / safe, 0.0)
     sin = np.sqrt(1.0 - cos * cos)
     ux, uy = delta[:, 0] / safe, delta[:, 1] / safe
-    l = np.stack([cos * ux - sin * uy, sin * ux + cos * uy], axis=1)
-    nq = -sf1[:, None] * l
-    nt = -sf2[:, None] * l
+    unit = np.stack([cos * ux - sin * uy, sin * ux + cos * uy], axis=1)
+    nq = -sf1[:, None] * unit
+    nt = -sf2[:, None] * unit
     if src_xy is None:
         ok &= cs.in_cone(src, nq)
     if dst_xy is None:
@@ -121,3 +122,69 @@ def tangents(cs: ConfigSpace, src: np.ndarray, dst: np.ndarray, s1: np.ndarray, 
     return Tangents(src[keep], dst[keep], np.asarray(s1)[keep], np.asarray(s2)[keep], q, t,
                     np.where(src_xy is None, 1.0, 0.0) * nq[keep], np.where(dst_xy is None, 1.0, 0.0) * nt[keep],
                     np.sqrt(seg[:, 0] * seg[:, 0] + seg[:, 1] * seg[:, 1]))
+
+
+class TangentStore:
+    """Every tangent computed between obstacles, with the rows leaving each (circle, side)."""
+
+    def __init__(self):
+        self.parts: list[Tangents] = []
+        self.tans: Optional[Tangents] = None
+        self.dst_owner = np.zeros(0, dtype=np.int64)
+        self.index: dict[int, list[np.ndarray]] = {}
+
+    def add(self, tans: Tangents, cs) -> None:
+        if not len(tans):
+            return
+        base = len(self.dst_owner)
+        self.parts.append(tans)
+        self.tans = None
+        self.dst_owner = np.concatenate([self.dst_owner, cs.owner[tans.dst]])
+        key = tans.src * 2 + (tans.s1 < 0)
+        order = np.argsort(key, kind="stable")
+        cut = np.flatnonzero(np.r_[True, key[order][1:] != key[order][:-1]])
+        for k, rows in zip(key[order][cut].tolist(), np.split(order + base, cut[1:])):
+            self.index.setdefault(k, []).append(rows)
+
+    def rows(self, circle: int, side: int) -> np.ndarray:
+        parts = self.index.get(circle * 2 + (side < 0))
+        if not parts:
+            return np.zeros(0, dtype=np.int64)
+        if len(parts) > 1:
+            parts[:] = [np.concatenate(parts)]
+        return parts[0]
+
+    def take(self, rows: np.ndarray) -> Tangents:
+        if self.tans is None:
+            self.tans = Tangents.concat(self.parts)
+            self.parts = [self.tans]
+        return self.tans.take(rows)
+
+
+class EdgeIndex:
+    """Grown polygon edges as tangents, looked up by (circle, side)."""
+
+    def __init__(self, tans: Tangents, n_circles: int):
+        self.tans = tans
+        self.index = np.full((n_circles, 2), -1, dtype=np.int64)
+        self.index[tans.src, (tans.s1 < 0).astype(np.int64)] = np.arange(len(tans))
+
+    def pick(self, circles: np.ndarray, sides: np.ndarray) -> np.ndarray:
+        return self.index[circles, (sides < 0).astype(np.int64)]
+
+
+class TangentBatch:
+    """Ways out of expanded nodes, gathered for one vectorised pass: parallel lists of arrays."""
+
+    def __init__(self):
+        self.parts: list[tuple] = []
+
+    def add(self, node_index: np.ndarray, tans: Tangents) -> None:
+        if len(tans):
+            self.parts.append((node_index, tans))
+
+    def merged(self):
+        if not self.parts:
+            return None, None
+        idx = np.concatenate([p[0] for p in self.parts])
+        return idx, Tangents.concat([p[1] for p in self.parts])

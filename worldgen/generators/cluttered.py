@@ -17,13 +17,12 @@ import shapely
 
 from worldgen.errors import ParameterError
 from worldgen.floats import round_float
-from worldgen.footprint import FootprintIndex, robot_footprints
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
-from worldgen.generators.registry import register
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
 from worldgen.generators.tasks import TASK_PARAMS, check_task_params, sample_tasks
 from worldgen.params import Param
 from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene
+from worldgen.scene.footprint import FootprintIndex, robot_footprints
 
 __all__ = ["SPEC", "build"]
 
@@ -60,7 +59,8 @@ def check(params: Mapping[str, Any]) -> None:
     inflation = params["robot_radius"] + params["clearance"]
     if min(sx, sy) <= 2 * inflation:
         raise ParameterError(
-            f"parameter 'size' must exceed 2 x (robot_radius + clearance) = {2 * inflation:g} m on both axes, got {params['size']!r}"
+            f"parameter 'size' must exceed 2 x (robot_radius + clearance) = {2 * inflation:g} m on both axes, "
+            f"got {params['size']!r}"
         )
     reach = math.hypot(sx - 2 * inflation, sy - 2 * inflation)
     if params["min_spawn_goal_distance"] > reach:
@@ -215,16 +215,14 @@ def _clear_of_neighbours(candidate: _Footprint, gap: float, placed, grid, cell) 
     return True
 
 
-SPEC = register(
-    GeneratorSpec(
-        name="cluttered",
-        summary="a walled room with randomly placed static boxes and cylinders",
-        params=PARAMS,
-        build=build,
-        check=check,
-        examples=(
-            "worldgen generate cluttered --seed 7 --set size=20,20 --set n_obstacles=50 --out worlds",
-            "worldgen generate cluttered --set density=0.2 --set obstacle_shapes=box --count 10 --out worlds",
-        ),
-    )
+SPEC = GeneratorSpec(
+    name="cluttered",
+    summary="a walled room with randomly placed static boxes and cylinders",
+    params=PARAMS,
+    build=build,
+    check=check,
+    examples=(
+        "worldgen generate cluttered --seed 7 --set size=20,20 --set n_obstacles=50 --out worlds",
+        "worldgen generate cluttered --set density=0.2 --set obstacle_shapes=box --count 10 --out worlds",
+    ),
 )

@@ -35,7 +35,6 @@ from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.feasibility.check import SAFETY
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
-from worldgen.generators.registry import register
 from worldgen.generators.room import FLOOR_RGBA, FLOOR_THICKNESS, WALL_RGBA
 from worldgen.params import Param
 from worldgen.scene import Box, Material, Node, Physics, Pose, Scene, Task
@@ -375,19 +374,17 @@ def _cut(a: float, b: float, gaps) -> list[tuple[float, float]]:
     return out
 
 
-SPEC = register(
-    GeneratorSpec(
-        name="corridor",
-        summary="a walled corridor (straight, L, U or zigzag) with optional obstacles and side openings",
-        params=PARAMS,
-        build=build,
-        check=check,
-        examples=(
-            "worldgen generate corridor --set width=0.8 --out worlds",
-            "worldgen generate corridor --set shape=zigzag --set segments=4,3,4 --set turns=left,right --out worlds",
-            "worldgen generate corridor --set shape=L --set n_obstacles=4 --set side_openings=2 --out worlds",
-        ),
-    )
+SPEC = GeneratorSpec(
+    name="corridor",
+    summary="a walled corridor (straight, L, U or zigzag) with optional obstacles and side openings",
+    params=PARAMS,
+    build=build,
+    check=check,
+    examples=(
+        "worldgen generate corridor --set width=0.8 --out worlds",
+        "worldgen generate corridor --set shape=zigzag --set segments=4,3,4 --set turns=left,right --out worlds",
+        "worldgen generate corridor --set shape=L --set n_obstacles=4 --set side_openings=2 --out worlds",
+    ),
 )
 
 

@@ -14,7 +14,7 @@ push opens the leaf towards +x. The hinge line sits on the wall face of the
 side the leaf opens into, so the leaf, closed, fills the doorway inside the wall
 thickness and, opening, sweeps only that side's room (up to ``limits`` hi <= 3
 rad, short of lying flat against the wall). Positive angles open the door in
-every format; world.json's ``doors[]`` says where (see :mod:`worldgen.doors`).
+every format; world.json's ``doors[]`` says where (see :mod:`worldgen.scene.doors`).
 
 A leaf opens only as far as its room lets it: past pi/2 its free edge comes
 back towards the outer wall on the hinge side, and a thick leaf's corner
@@ -32,16 +32,15 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from worldgen.doors import open_scene
 from worldgen.errors import ParameterError
 from worldgen.floats import round_float
-from worldgen.footprint import FootprintIndex, robot_footprints
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
-from worldgen.generators.registry import register
-from worldgen.generators.room import floor_node, wall_nodes, WALL_RGBA
+from worldgen.generators.room import WALL_RGBA, floor_node, wall_nodes
 from worldgen.generators.tasks import free_points
 from worldgen.params import Param
 from worldgen.scene import Box, Joint, Material, Node, Physics, Pose, Scene, Task, matrix_to_pose
+from worldgen.scene.doors import open_scene
+from worldgen.scene.footprint import FootprintIndex, robot_footprints
 
 __all__ = ["SPEC", "build", "check", "wall_positions", "LEAF_GAP", "JAMB_WIDTH", "MAX_OPENING"]
 
@@ -114,7 +113,8 @@ def check(params: Mapping[str, Any]) -> None:
     inflation = params["robot_radius"] + params["clearance"]
     lo, hi = params["limits"]
     if hi - lo <= 0:
-        raise ParameterError(f"parameter 'limits' must be [lo, hi] with lo < hi in [0, {MAX_OPENING:g}] rad, got {params['limits']!r}")
+        raise ParameterError(f"parameter 'limits' must be [lo, hi] with lo < hi in [0, {MAX_OPENING:g}] rad, "
+                             f"got {params['limits']!r}")
     if params["state"] in ("closed", "random") and lo != 0:
         raise ParameterError(f"parameter 'limits' must start at 0 (closed) for state {params['state']}, got {params['limits']!r}")
     if params["state"] in ("ajar", "random") and not lo < params["angle"] < hi:
@@ -138,7 +138,8 @@ def check(params: Mapping[str, Any]) -> None:
         raise ParameterError(f"parameter 'door_y' must be in [{-(room - w) / 2:g}, {(room - w) / 2:g}] m for this "
                              f"size and door_width, got {params['door_y']!r}")
     if params["door_x"] is not None and not -sx / 2 < params["door_x"] < sx / 2:
-        raise ParameterError(f"parameter 'door_x' must be in ({-sx / 2:g}, {sx / 2:g}) m (inside size x), got {params['door_x']!r}")
+        raise ParameterError(f"parameter 'door_x' must be in ({-sx / 2:g}, {sx / 2:g}) m (inside size x), "
+                             f"got {params['door_x']!r}")
     need = max(2 * inflation, w) + 2 * LEAF_GAP  # the robot, and a leaf opening into the room
     for k, (a, b) in enumerate(_room_spans(params)):
         if b - a < need:
@@ -244,7 +245,8 @@ def _door(params, k: int, x: float, u_side, u_swing, u_state, u_y, rooms):
     north = (c + w / 2 + JAMB_WIDTH, sy / 2)
     for label, (a, b) in (("s", south), ("n", north)):
         if b - a > 1e-6:
-            nodes.append(Node(f"wall_{k}_{label}", "wall", Box((t, b - a, h_w)), Pose(x, (a + b) / 2, h_w / 2), material=wall_mat))
+            nodes.append(Node(f"wall_{k}_{label}", "wall", Box((t, b - a, h_w)), Pose(x, (a + b) / 2, h_w / 2),
+                              material=wall_mat))
     for label, y in (("s", c - w / 2 - JAMB_WIDTH / 2), ("n", c + w / 2 + JAMB_WIDTH / 2)):
         nodes.append(Node(f"door_{k}_jamb_{label}", "door_frame", Box((t, JAMB_WIDTH, h_w)), Pose(x, y, h_w / 2),
                           material=frame_mat))
@@ -288,7 +290,8 @@ def _tasks(params, rng, index, first, last, robot):
                 if len(out) < n and all(math.hypot(p[0] - q[0], p[1] - q[1]) >= separation for q in out):
                     out.append((float(p[0]), float(p[1])))
         if len(out) < n:
-            return [], f"found {len(out)} of {n} free {'spawns' if out is spawns else 'goals'} in the {'first' if out is spawns else 'last'} room"
+            which, room = ("spawns", "first") if out is spawns else ("goals", "last")
+            return [], f"found {len(out)} of {n} free {which} in the {room} room"
     yaws = rng.uniform(-math.pi, math.pi, 2 * n)
     tasks = []
     for i in range(n):
@@ -298,16 +301,14 @@ def _tasks(params, rng, index, first, last, robot):
     return tasks, None
 
 
-SPEC = register(
-    GeneratorSpec(
-        name="door",
-        summary="rooms in a row, divided by walls with hinged door leaves (closed, open or ajar)",
-        params=PARAMS,
-        build=build,
-        check=check,
-        examples=(
-            "worldgen generate door --seed 1 --set n_doors=2 --set state=closed --out worlds",
-            "worldgen generate door --set size=14,4 --set door_x=3 --set door_y=0 --set spawn=0,0,0 --set goal=6,0 --out worlds",
-        ),
-    )
+SPEC = GeneratorSpec(
+    name="door",
+    summary="rooms in a row, divided by walls with hinged door leaves (closed, open or ajar)",
+    params=PARAMS,
+    build=build,
+    check=check,
+    examples=(
+        "worldgen generate door --seed 1 --set n_doors=2 --set state=closed --out worlds",
+        "worldgen generate door --set size=14,4 --set door_x=3 --set door_y=0 --set spawn=0,0,0 --set goal=6,0 --out worlds",
+    ),
 )

@@ -33,8 +33,7 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 from worldgen.floats import round_float
-from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
-from worldgen.generators.registry import register
+from worldgen.generators.base import Draft, GeneratorSpec
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
 from worldgen.params import Param
 from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene, Task
@@ -219,16 +218,14 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     return Draft(scene, (task,))
 
 
-SPEC = register(
-    GeneratorSpec(
-        name="minimal",
-        summary="a floor and one target (wall, box or cylinder) at an exact distance and bearing from the spawn",
-        params=PARAMS,
-        build=build,
-        check=check,
-        examples=(
-            "worldgen generate minimal --set target_distance=2.0 --out worlds",
-            "worldgen generate minimal --set target=cylinder --set target_bearing=0.5 --set walls=true --out worlds",
-        ),
-    )
+SPEC = GeneratorSpec(
+    name="minimal",
+    summary="a floor and one target (wall, box or cylinder) at an exact distance and bearing from the spawn",
+    params=PARAMS,
+    build=build,
+    check=check,
+    examples=(
+        "worldgen generate minimal --set target_distance=2.0 --out worlds",
+        "worldgen generate minimal --set target=cylinder --set target_bearing=0.5 --set walls=true --out worlds",
+    ),
 )

@@ -29,10 +29,15 @@ def register(spec: GeneratorSpec) -> GeneratorSpec:
 
 
 def _load_builtins() -> None:
-    from worldgen.generators import cluttered  # noqa: F401  (registers itself)
-    from worldgen.generators import door  # noqa: F401
-    from worldgen.generators import minimal  # noqa: F401
-    from worldgen.generators import corridor  # noqa: F401
+    # Imported on first lookup, not with the package: each generator pulls in shapely and its
+    # geometry. The modules only define their SPEC; registering them is this module's job.
+    from worldgen.generators.cluttered import SPEC as CLUTTERED
+    from worldgen.generators.corridor import SPEC as CORRIDOR
+    from worldgen.generators.door import SPEC as DOOR
+    from worldgen.generators.minimal import SPEC as MINIMAL
+
+    for spec in (CLUTTERED, DOOR, MINIMAL, CORRIDOR):
+        register(spec)
 
 
 def _load_plugins() -> None:

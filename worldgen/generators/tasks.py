@@ -14,9 +14,9 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 from worldgen.floats import round_float
-from worldgen.footprint import FootprintIndex
 from worldgen.params import Param
 from worldgen.scene import Pose, Robot, Task
+from worldgen.scene.footprint import FootprintIndex
 
 __all__ = ["free_points", "sample_tasks", "region_bounds", "check_task_params", "TASK_PARAMS"]
 

@@ -2,7 +2,7 @@
 
 Definitions (docs/metrics.md gives them with formulas and says where they
 differ from BARN, Perille et al. 2020): the obstacles are the floor shadows of
-everything a robot can hit (:func:`worldgen.footprint.robot_footprints`, walls
+everything a robot can hit (:func:`worldgen.scene.footprint.robot_footprints`, walls
 included) and the edge of the floor area (``scene.bounds``) counts as a wall.
 Each task's path is sampled at :data:`SAMPLES` points evenly spaced by arc
 length, ends included; from each sample :data:`DIRECTIONS` rays are cast in
@@ -17,7 +17,7 @@ from typing import Optional, Sequence
 import numpy as np
 import shapely
 
-from worldgen.footprint import Footprint, robot_footprints
+from worldgen.scene.footprint import Footprint, robot_footprints
 
 __all__ = ["difficulty", "path_samples", "ray_lengths", "SAMPLES", "DIRECTIONS", "DISPERSION_REACH", "NAMES"]
 

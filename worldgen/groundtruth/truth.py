@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import weakref
 
-from worldgen.doors import open_scene
 from worldgen.groundtruth import lidar, metrics, occupancy
 from worldgen.params import COMMON_PARAMS
 from worldgen.scene import Pose
+from worldgen.scene.doors import open_scene
 
 __all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "MAP_KEYS"]
 

@@ -10,8 +10,8 @@ whose name is absolute, has ``..`` or leaves that folder is refused.
 from __future__ import annotations
 
 import gzip
-import json
 import io
+import json
 import tarfile
 from pathlib import Path, PurePosixPath
 from typing import Optional

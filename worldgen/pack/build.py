@@ -24,14 +24,23 @@ from collections import Counter
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional, TextIO
+from typing import Optional, TextIO
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError
-from worldgen.pack.manifest import (INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, build_manifest, index_bytes,
-                                    key_metrics, manifest_bytes, world_folder, write_atomically)
-from worldgen.pack.recipe import Job, Recipe
+from worldgen.pack.manifest import (
+    INDEX_NAME,
+    MANIFEST_NAME,
+    WORLDS_DIR,
+    build_manifest,
+    index_bytes,
+    manifest_bytes,
+    world_folder,
+    write_atomically,
+)
+from worldgen.pack.recipe import Recipe
+from worldgen.pack.render import build_job
 
-__all__ = ["build_pack", "BuildSummary", "STATE_DIR", "build_job", "render_job"]
+__all__ = ["build_pack", "BuildSummary", "STATE_DIR"]
 
 STATE_DIR = ".build"
 MAX_JOBS = 256
@@ -60,42 +69,6 @@ class BuildSummary:
             f"extra draws before a feasible one (max_attempts retries): {self.extra_draws}",
             f"time: {self.seconds:.2f} s, {self.rate:.1f} worlds/s",
         ] + ([f"removed {self.stale} world folder(s) an earlier recipe left in the pack"] if self.stale else [])
-
-
-def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict, dict[str, bytes]]:
-    """Generate one world: its record and its folder's files (no disk; runs in any worker)."""
-    import hashlib
-
-    import worldgen
-
-    params = {k: _thaw(v) for k, v in job.params}
-    rec: dict[str, Any] = {"job": job.index, "key": job.key, "generator": job.generator, "seed": job.seed,
-                           "worldgen_version": worldgen.__version__}
-    try:
-        world = worldgen.generate(job.generator, seed=job.seed, **params)
-    except InfeasibleError as exc:
-        rec.update(params=params, reason=str(exc), failures=dict(sorted(exc.failures.items())))
-        return rec, {}
-    world.preset = job.preset
-    if job.preset:
-        rec["preset"] = job.preset
-    blobs = world.folder_blobs(formats, sdf_version, preview)
-    meta = json.loads(blobs["world.json"])
-    folder = f"{WORLDS_DIR}/{world.folder_name}"
-    rec.update(world_id=world.world_id, folder=world.folder_name, params=meta["params"], metrics=key_metrics(meta),
-               attempts=world.attempts,
-               files={f"{folder}/{rel}": hashlib.sha256(data).hexdigest() for rel, data in sorted(blobs.items())})
-    return rec, blobs
-
-
-def build_job(job: Job, worlds_dir: str, formats, sdf_version: str, preview: bool) -> dict:
-    """Build and write one world; return its record (runs in a local worker process)."""
-    from worldgen.world import write_folder_atomically
-
-    rec, blobs = render_job(job, formats, sdf_version, preview)
-    if blobs:
-        write_folder_atomically(Path(worlds_dir), rec["folder"], blobs)
-    return rec
 
 
 def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = None,
@@ -223,10 +196,6 @@ def _check_unique(manifest: dict) -> None:
                 f"recipe jobs {seen[w['world_id']]} and {w['job']} make the same world {w['world_id']}: "
                 "their parameters differ only where the scene does not; drop one of them")
         seen[w["world_id"]] = w["job"]
-
-
-def _thaw(value):
-    return [_thaw(v) for v in value] if isinstance(value, tuple) else value
 
 
 class _Progress:

@@ -26,7 +26,7 @@ def run_on_dask(jobs: Sequence, scheduler: Optional[str], render_args: tuple, ve
         from distributed import Client, as_completed
     except ImportError:
         raise ParameterError("--executor dask needs dask.distributed: pip install 'worldgen[dask]'") from None
-    from worldgen.pack.build import render_job
+    from worldgen.pack.render import render_job
 
     try:
         client = Client(scheduler, timeout="10s")

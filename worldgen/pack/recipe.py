@@ -38,8 +38,8 @@ import numpy as np
 import yaml
 
 from worldgen.errors import InfeasibleError, ParameterError, WorldgenError, quoted, read_user_text
+from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.floats import round_float
-from worldgen.world import FORMATS, SDF_VERSIONS, normalise_formats
 
 __all__ = ["Job", "Recipe", "load_recipe", "parse_recipe", "TOP_KEYS", "ENTRY_KEYS", "PHYSICS_PARAMS"]
 
@@ -251,7 +251,8 @@ class _Reader:
                     if p.kind == "int" and not (_is_int(lo) and _is_int(hi)):
                         self.fail(vnode, key, f"is an integer parameter; min and max must be integers, got {quoted(value)}")
                     ranges[key] = (lo, hi)
-                elif isinstance(value, list) and (p.kind not in _LIST_KINDS or (value and all(isinstance(v, list) for v in value))):
+                elif isinstance(value, list) and (
+                        p.kind not in _LIST_KINDS or (value and all(isinstance(v, list) for v in value))):
                     if not value:
                         self.fail(vnode, key, "a grid axis needs at least one value")
                     axes[key] = value

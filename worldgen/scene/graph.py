@@ -10,7 +10,6 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import re
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Iterable, Optional
@@ -19,9 +18,10 @@ import numpy as np
 
 from worldgen.errors import SceneError
 from worldgen.floats import round_float
+from worldgen.scene.mover import Mover
+from worldgen.scene.names import NAME_PATTERN
 from worldgen.scene.pose import Pose
 from worldgen.scene.shapes import Mesh, Shape, unit_inertia
-from worldgen.scene.mover import Mover
 
 __all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN", "Mover"]
 
@@ -29,7 +29,6 @@ __all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Phys
 ROLES = ("floor", "wall", "obstacle", "door", "door_frame", "marker")
 
 #: Names become element names in three formats and file names of meshes: keep them plain.
-NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 from worldgen.errors import SceneError
 from worldgen.floats import round_float
+from worldgen.scene.names import NAME_PATTERN
 
 __all__ = ["Mover", "MOVER_RGBA"]
 
@@ -37,8 +38,6 @@ class Mover:
     friction: float = 1.0
 
     def __post_init__(self):
-        from worldgen.scene.graph import NAME_PATTERN  # graph imports this module
-
         if not NAME_PATTERN.match(self.name):
             raise SceneError(f"mover name {self.name!r} must match {NAME_PATTERN.pattern}")
         for what, value in (("radius", self.radius), ("height", self.height)):

@@ -28,123 +28,33 @@ import io
 import json
 import math
 import os
-from dataclasses import dataclass
-from functools import lru_cache
 from pathlib import Path
 from typing import Any, Mapping, Optional
 
 import numpy as np
 import shapely
-from PIL import Image, ImageDraw, ImageFont
+from PIL import Image, ImageDraw
 
 from worldgen.errors import OutputError, ParameterError
+from worldgen.export.preview_frame import (
+    COLOURS,
+    DEFAULT_WIDTH,
+    HIDDEN_ROLES,
+    MAX_WIDTH,
+    MIN_WIDTH,
+    NOGO_ALPHA,
+    PREVIEW_NAME,
+    SUPERSAMPLE,
+    Layout,
+    footer,
+    layout,
+    text_font,
+    title,
+)
 from worldgen.scene.pose import rpy_matrix
 
 __all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
            "Layout", "layout", "draw", "render", "blocking"]
-
-PREVIEW_NAME = "preview.png"
-DEFAULT_WIDTH = 800
-MIN_WIDTH, MAX_WIDTH = 400, 4000
-
-#: RGB of each layer; tests sample pixels against these.
-COLOURS = {
-    "background": (255, 255, 255),
-    "slab": (214, 214, 210),        # floor slab outside the usable bounds
-    "floor": (248, 247, 242),       # the usable bounds
-    "grid": (228, 227, 220),
-    "nogo": (232, 72, 64),          # blended at NOGO_ALPHA over what lies beneath
-    "wall": (45, 45, 55),
-    "obstacle": (84, 104, 140),
-    "overhead": (150, 160, 180),    # outline of colliders the robot passes under
-    "frame": (105, 80, 60),
-    "door": (176, 112, 48),
-    "marker": (120, 170, 120),
-    "mover": (150, 70, 200),
-    "path": (250, 140, 0),
-    "spawn": (28, 150, 70),
-    "spawn_fill": (206, 238, 214),
-    "goal": (30, 90, 220),
-    "goal_fill": (210, 224, 250),
-    "text": (20, 20, 25),
-    "alert": (200, 30, 30),
-}
-#: Opacity of the no-go zone: light enough that the floor grid still shows through.
-NOGO_ALPHA = 0.3
-
-_MARGIN = 16     # px left and right of the map
-_TITLE_H = 46    # px above the map: two lines of text
-_FOOTER_H = 40   # px below the map per legend row
-_SS = 2          # the map is drawn at twice the size and averaged down: smooth edges, no blur
-_SCALE_BAR_MAX = 130  # px: the longest round length (100, 50, 10, 5, 1, 0.5 m) below it
-_HIDDEN = ("floor", "marker")  # roles that never block the robot
-
-
-@dataclass(frozen=True)
-class Layout:
-    """Where the world lands in the image.
-
-    World point (x, y) -> pixel ``(left + (x - x0) * scale, top + (y1 - y) * scale)``:
-    +x to the right, +y up (REP 103 seen from above). ``scale`` is px per metre;
-    (x0, y1) is the top-left corner of the drawn extent.
-    """
-
-    width: int
-    height: int
-    scale: float
-    x0: float
-    y1: float
-    left: float
-    top: float
-    legend_rows: int
-
-    def px(self, x: float, y: float) -> tuple[float, float]:
-        return self.left + (x - self.x0) * self.scale, self.top + (self.y1 - y) * self.scale
-
-
-def layout(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Layout:
-    """The image size and world->pixel map for ``meta`` at ``width`` px.
-
-    The drawn extent covers the bounds, every entity's box, every mover's
-    trajectory and every spawn and goal, plus a small margin. The map is at
-    most as tall as it is wide, so a long corridor along y stays on screen.
-    """
-    if isinstance(width, bool) or not isinstance(width, int) or not MIN_WIDTH <= width <= MAX_WIDTH:
-        raise ParameterError(f"parameter 'width' must be an integer in [{MIN_WIDTH}, {MAX_WIDTH}] px, got {width!r}")
-    xs, ys = _extent_points(meta)
-    lo = np.array([min(xs), min(ys)])
-    hi = np.array([max(xs), max(ys)])
-    span = hi - lo
-    pad = 0.02 * float(span.max()) + 0.1
-    lo, hi = lo - pad, hi + pad
-    span = hi - lo
-    room = width - 2 * _MARGIN
-    scale = min(room / span[0], room / span[1])
-    map_w, map_h = span[0] * scale, span[1] * scale
-    rows = 1 if _LEGEND_START + _legend_width() + _MARGIN <= width else 2
-    height = int(math.ceil(_TITLE_H + map_h + _FOOTER_H * rows - 1e-6))  # 768.0000001 px is 768
-    return Layout(width, height, float(scale), float(lo[0]), float(hi[1]),
-                  float((width - map_w) / 2), float(_TITLE_H), rows)
-
-
-def _extent_points(meta) -> tuple[list[float], list[float]]:
-    b = meta["bounds"]
-    xs, ys = [b["min"][0], b["max"][0]], [b["min"][1], b["max"][1]]
-    for e in meta.get("entities", []):
-        (x0, y0, _), (x1, y1, _) = e["aabb"]
-        xs += [x0, x1]
-        ys += [y0, y1]
-    for m in meta.get("dynamic_obstacles", []) or []:
-        for _, x, y in m["trajectory"]:
-            xs += [x - m["radius"], x + m["radius"]]
-            ys += [y - m["radius"], y + m["radius"]]
-    r = meta["robot"]["radius"]
-    for t in meta.get("tasks", []):
-        for p in (t["spawn"], t["goal"]):
-            xs += [p[0] - r, p[0] + r]
-            ys += [p[1] - r, p[1] + r]
-    return xs, ys
-
 
 # -- geometry from the metadata ------------------------------------------------
 
@@ -175,7 +85,7 @@ def blocking(entity, robot: Mapping[str, float]) -> bool:
 
     Door leaves are left out: reference paths are planned with doors open.
     """
-    if entity["role"] in _HIDDEN or entity["role"] == "door":
+    if entity["role"] in HIDDEN_ROLES or entity["role"] == "door":
         return False
     (_, _, z0), (_, _, z1) = entity["aabb"]
     return z1 > 0.0 and z0 < robot["height"] + robot["clearance"]
@@ -201,26 +111,26 @@ class _Pen:
         out = []
         for x, y in np.asarray(pts, dtype=float).reshape(-1, 2):
             u, v = self.lay.px(x, y)
-            out.append((u * _SS, v * _SS))
+            out.append((u * SUPERSAMPLE, v * SUPERSAMPLE))
         return out
 
     def m(self, metres: float) -> float:
-        return metres * self.lay.scale * _SS
+        return metres * self.lay.scale * SUPERSAMPLE
 
     def shape(self, kind, geo, fill=None, outline=None, width=1):
         if kind == "circle":
             (u, v), = self.xy([geo[:2]])
             r = self.m(geo[2])
-            self.draw.ellipse([u - r, v - r, u + r, v + r], fill=fill, outline=outline, width=width * _SS)
+            self.draw.ellipse([u - r, v - r, u + r, v + r], fill=fill, outline=outline, width=width * SUPERSAMPLE)
         else:
-            self.draw.polygon(self.xy(geo), fill=fill, outline=outline, width=width * _SS)
+            self.draw.polygon(self.xy(geo), fill=fill, outline=outline, width=width * SUPERSAMPLE)
 
     def line(self, pts, fill, width=1, dash: Optional[float] = None):
         p = self.xy(pts)
         if dash is None:
-            self.draw.line(p, fill=fill, width=width * _SS, joint="curve")
+            self.draw.line(p, fill=fill, width=width * SUPERSAMPLE, joint="curve")
             return
-        step, on = dash * _SS, True
+        step, on = dash * SUPERSAMPLE, True
         for a, b in zip(p[:-1], p[1:]):  # the dash pattern restarts at each vertex: simple, and fine here
             length = math.dist(a, b)
             n = max(1, int(length // step))
@@ -229,7 +139,7 @@ class _Pen:
                     t0, t1 = k / n, (k + 1) / n
                     self.draw.line([(a[0] + (b[0] - a[0]) * t0, a[1] + (b[1] - a[1]) * t0),
                                     (a[0] + (b[0] - a[0]) * t1, a[1] + (b[1] - a[1]) * t1)],
-                                   fill=fill, width=width * _SS)
+                                   fill=fill, width=width * SUPERSAMPLE)
                 on = not on
 
     def arrow(self, x, y, yaw, length, fill, width=2):
@@ -240,15 +150,10 @@ class _Pen:
         self.draw.polygon(self.xy([tip, wings[0], wings[1]]), fill=fill)
 
 
-@lru_cache(maxsize=None)
-def _font(size: int):
-    return ImageFont.load_default(size=size)
-
-
 def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
     """The preview of ``meta`` (a world.json dict) as an RGB image ``width`` px wide."""
     lay = layout(meta, width)
-    big = Image.new("RGB", (lay.width * _SS, lay.height * _SS), COLOURS["background"])
+    big = Image.new("RGB", (lay.width * SUPERSAMPLE, lay.height * SUPERSAMPLE), COLOURS["background"])
     pen = _Pen(big, lay)
     robot = meta["robot"]
     entities = list(meta.get("entities", []))
@@ -261,7 +166,7 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
     _grid(pen, (bx0, by0, bx1, by1), _grid_step(lay.scale))
 
     for e in entities:  # colliders the robot passes under (a door head): a thin outline, beneath the rest
-        if e["role"] not in _HIDDEN and e["role"] != "door" and not blocking(e, robot):
+        if e["role"] not in HIDDEN_ROLES and e["role"] != "door" and not blocking(e, robot):
             pen.shape(*_outline(e), outline=COLOURS["overhead"], width=1)
 
     # The no-go zone: one mask (so overlaps do not darken), blended once.
@@ -304,9 +209,9 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
         _pose_marker(pen, t["spawn"], robot["radius"], "spawn", "S" + label)
         _pose_marker(pen, t["goal"], robot["radius"], "goal", "G" + label, t.get("goal_tolerance"))
 
-    image = big.reduce(_SS)
-    _title(image, meta, lay)
-    _footer(image, lay)
+    image = big.reduce(SUPERSAMPLE)
+    title(image, meta, lay)
+    footer(image, lay)
     return image
 
 
@@ -358,99 +263,8 @@ def _pose_marker(pen: _Pen, pose, radius: float, kind: str, label: str, toleranc
     pen.shape("circle", (x, y, radius), fill=COLOURS[kind + "_fill"], outline=COLOURS[kind], width=2)
     pen.arrow(x, y, yaw, radius * 2.2, COLOURS[kind])
     (u, v), = pen.xy([(x - radius * 0.75, y + radius * 0.75)])  # to the upper left, off the arrow's usual path
-    font = _font(15 * _SS)
+    font = text_font(15 * SUPERSAMPLE)
     pen.draw.text((u, v), label, fill=COLOURS[kind], font=font, anchor="rb")
-
-
-def _fmt_m(x) -> str:
-    return "-" if x is None else f"{x:.2f} m"
-
-
-def _title(image: Image.Image, meta, lay: Layout) -> None:
-    d = ImageDraw.Draw(image)
-    room = lay.width - 2 * _MARGIN
-    big, small = _font(16), _font(13)
-    world_id = str(meta.get("world_id", "?"))
-    d.text((_MARGIN, 6), world_id, fill=COLOURS["text"], font=big)
-    feas = meta.get("feasibility", {}) or {}
-    if feas and not feas.get("feasible", True):
-        failed = ", ".join(c["name"] for c in feas.get("checks", []) if not c.get("ok"))
-        x = _MARGIN + big.getlength(world_id) + 12
-        d.text((x, 6), _fit(f"INFEASIBLE: {failed}", big, _MARGIN + room - x), fill=COLOURS["alert"], font=big)
-    metrics = meta.get("metrics", {}) or {}
-    lengths = [t["path"]["length"] for t in meta.get("tasks", []) if t.get("path")]
-    parts = [
-        f"path {', '.join(f'{x:.2f}' for x in lengths)} m" if lengths else "no path",
-        f"narrowest passage {_fmt_m(metrics.get('narrowest_passage'))}",
-        f"{metrics.get('obstacle_count', '?')} obstacles",
-        *([f"doors: {', '.join(d['state'] for d in meta['doors'])}"] if meta.get("doors") else []),
-        f"robot r {meta['robot']['radius']:.2f} + {meta['robot']['clearance']:.2f} m",
-    ]
-    while len(parts) > 1 and small.getlength("   |   ".join(parts)) > room:  # narrow image: least important last
-        parts.pop()
-    d.text((_MARGIN, 26), _fit("   |   ".join(parts), small, room), fill=COLOURS["text"], font=small)
-
-
-def _fit(text: str, font, room: float) -> str:
-    """``text`` cut (with an ellipsis) to at most ``room`` px."""
-    if font.getlength(text) <= room:
-        return text
-    while text and font.getlength(text + "...") > room:
-        text = text[:-1]
-    return text + "..."
-
-
-_LEGEND = (("obstacle", "obstacle", "box"), ("wall", "wall", "box"), ("no-go zone", "nogo", "zone"),
-           ("path", "path", "line"), ("spawn", "spawn", "disc"), ("goal", "goal", "disc"),
-           ("door", "door", "box"), ("mover", "mover", "dash"))
-_LEGEND_START = _MARGIN + _SCALE_BAR_MAX + 28 + 40  # right of the longest scale bar and the axes
-_LEGEND_GAP = 12  # px between one entry's text and the next glyph
-
-
-def _legend_width() -> float:
-    font = _font(12)
-    return sum(19 + font.getlength(text) + _LEGEND_GAP for text, _, _ in _LEGEND)
-
-
-def _footer(image: Image.Image, lay: Layout) -> None:
-    d = ImageDraw.Draw(image)
-    font = _font(12)
-    top = lay.height - _FOOTER_H * lay.legend_rows
-    y = top + 14
-    length = next((s for s in (100.0, 50.0, 10.0, 5.0, 1.0, 0.5) if s * lay.scale <= _SCALE_BAR_MAX), 0.5)
-    x0, x1 = _MARGIN, _MARGIN + length * lay.scale
-    d.line([(x0, y), (x1, y)], fill=COLOURS["text"], width=3)
-    for x in (x0, x1):
-        d.line([(x, y - 5), (x, y + 5)], fill=COLOURS["text"], width=2)
-    d.text(((x0 + x1) / 2, y + 6), f"{length:g} m", fill=COLOURS["text"], font=font, anchor="ma")
-    # Axes: +x right, +y up.
-    ax, ay = x1 + 28, y + 8
-    d.line([(ax, ay), (ax + 18, ay)], fill=COLOURS["text"], width=2)
-    d.line([(ax, ay), (ax, ay - 18)], fill=COLOURS["text"], width=2)
-    d.text((ax + 20, ay), "x", fill=COLOURS["text"], font=font, anchor="lm")
-    d.text((ax, ay - 20), "y", fill=COLOURS["text"], font=font, anchor="mb")
-    # Legend, wrapped onto the rows the layout reserved.
-    per_row = math.ceil(len(_LEGEND) / lay.legend_rows)
-    gx = start = max(ax + 40, lay.width - _MARGIN - _legend_width() / lay.legend_rows)
-    for i, (text, colour, glyph) in enumerate(_LEGEND):
-        if i and i % per_row == 0:
-            gx = start
-        gy = top + 12 + (i // per_row) * _FOOTER_H
-        c = COLOURS[colour]
-        if glyph == "box":
-            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=c)
-        elif glyph == "zone":
-            blend = tuple(round(f + (n - f) * NOGO_ALPHA) for f, n in zip(COLOURS["floor"], c))
-            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=blend, outline=c)
-        elif glyph == "line":
-            d.line([(gx, gy), (gx + 14, gy)], fill=c, width=3)
-        elif glyph == "disc":
-            d.ellipse([gx + 1, gy - 6, gx + 13, gy + 6], fill=COLOURS[colour + "_fill"], outline=c, width=2)
-        else:
-            d.line([(gx, gy), (gx + 5, gy)], fill=c, width=2)
-            d.line([(gx + 9, gy), (gx + 14, gy)], fill=c, width=2)
-        d.text((gx + 19, gy), text, fill=COLOURS["text"], font=font, anchor="lm")
-        gx += 19 + font.getlength(text) + _LEGEND_GAP
 
 
 def render(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> bytes:

@@ -14,9 +14,7 @@ at least ``robot.inflation + mover_radius`` from every spawn and goal, and
 ``2 x mover_radius`` from every other mover's start. The tasks' reference paths
 stay those of the static world; judging separation over time is the oracles'.
 
-For simulation, :func:`mover_positions` interpolates where every mover is at a
-time ``t`` (looping), and :func:`drive_mocap` writes that into a MuJoCo
-``data.mocap_pos``, which is how the MJCF export's mocap bodies are meant to move.
+Where a mover is at a time ``t`` is :mod:`worldgen.scene.motion`'s.
 """
 
 from __future__ import annotations
@@ -28,13 +26,10 @@ import numpy as np
 import shapely
 
 from worldgen.floats import round_float
-from worldgen.footprint import FootprintIndex, scene_footprints
 from worldgen.scene import Mover, Robot, Scene, Task
+from worldgen.scene.footprint import FootprintIndex, scene_footprints
 
-__all__ = [
-    "MOVER_STREAM", "mover_rng", "place_movers", "mover_positions", "mover_names", "drive_mocap",
-    "metadata_entry", "FORMATS_NOTE",
-]
+__all__ = ["MOVER_STREAM", "PATH_TRIES", "mover_rng", "place_movers"]
 
 #: The spawn-key element of the movers' RNG stream: far from the small integers
 #: generators use for their own ``rng.spawn()`` children.
@@ -45,8 +40,6 @@ PATH_TRIES = 40
 _BATCH = 64
 #: Extra distance (m) kept from obstacles, so 6-decimal rounding never tips a leg into contact.
 _SLACK = 1e-3
-#: How each exported format carries a mover; URDF cannot express a scripted motion.
-FORMATS_NOTE = {"sdf": "actor", "mjcf": "mocap_body", "urdf": None}
 
 
 def mover_rng(seed: int, attempt: int) -> np.random.Generator:
@@ -154,72 +147,3 @@ def _timed(path: np.ndarray, speed: float) -> tuple[tuple[float, float, float], 
             t += math.hypot(x - closed[k - 1][0], y - closed[k - 1][1]) / speed
         rows.append((round_float(t), round_float(x), round_float(y)))
     return tuple(rows)
-
-
-# -- using movers ------------------------------------------------------------
-
-def _mover_rows(source) -> list[tuple[str, float, np.ndarray, bool]]:
-    """(name, height, (k, 3) trajectory, loop) of every mover in a World, Scene, world.json dict or list."""
-    if hasattr(source, "scene"):  # a World
-        source = source.scene
-    if isinstance(source, Scene):
-        source = source.movers
-    elif isinstance(source, Mapping):
-        source = source.get("dynamic_obstacles", [])
-    out = []
-    for m in source:
-        if isinstance(m, Mover):
-            out.append((m.name, m.height, np.asarray(m.trajectory, dtype=float), m.loop))
-        else:
-            out.append((m["name"], float(m["height"]), np.asarray(m["trajectory"], dtype=float), bool(m["loop"])))
-    return out
-
-
-def mover_names(source) -> list[str]:
-    """Names of the movers of a World, Scene, world.json dict or list of movers, in order."""
-    return [name for name, *_ in _mover_rows(source)]
-
-
-def mover_positions(source, t: float) -> np.ndarray:
-    """(n, 2) float: where each mover's centre is at time ``t`` s (straight legs, constant speed).
-
-    ``source`` is a World, a Scene, a world.json dict (``dynamic_obstacles``) or a
-    list of movers. A looping mover repeats its script; one that does not loop
-    waits at its last point.
-    """
-    rows = _mover_rows(source)
-    out = np.zeros((len(rows), 2))
-    for i, (_, _, traj, loop) in enumerate(rows):
-        period = traj[-1, 0]
-        tt = math.fmod(t, period) if loop else min(t, period)
-        if tt < 0:
-            tt += period
-        out[i, 0] = np.interp(tt, traj[:, 0], traj[:, 1])
-        out[i, 1] = np.interp(tt, traj[:, 0], traj[:, 2])
-    return out
-
-
-def drive_mocap(model, data, source, t: float) -> None:
-    """Put each mover's MuJoCo mocap body where the script has it at ``t`` (call before ``mj_step``).
-
-    ``model``/``data`` are a compiled MJCF world of worldgen and its MjData; the
-    mocap body of a mover has the mover's name.
-    """
-    xy = mover_positions(source, t)
-    for (name, height, _, _), (x, y) in zip(_mover_rows(source), xy):
-        mocap = model.body(name).mocapid[0]
-        if mocap < 0:
-            raise ValueError(f"body {name!r} is not a mocap body")
-        data.mocap_pos[mocap] = (x, y, height / 2.0)
-
-
-def metadata_entry(mover: Mover) -> dict:
-    """The mover's ``dynamic_obstacles[]`` entry of world.json."""
-    return {
-        "name": mover.name,
-        "radius": mover.radius,
-        "height": mover.height,
-        "trajectory": [list(row) for row in mover.trajectory],
-        "loop": mover.loop,
-        "formats": dict(FORMATS_NOTE),
-    }

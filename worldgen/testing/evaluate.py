@@ -29,7 +29,8 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional
 
 from worldgen.errors import ParameterError
-from worldgen.oracles import Run, load, run as run_figures
+from worldgen.testing.figures import Run, load
+from worldgen.testing.figures import run as run_figures
 
 __all__ = ["CRITERIA", "Criterion", "Report", "load_criteria", "evaluate", "scenario_of"]
 
@@ -51,7 +52,8 @@ def load_criteria(criteria) -> dict[str, dict[str, float]]:
     import yaml
 
     where = "criteria"
-    if isinstance(criteria, Path) or (isinstance(criteria, str) and "\n" not in criteria and criteria.endswith((".yaml", ".yml"))):
+    is_file_name = isinstance(criteria, str) and "\n" not in criteria and criteria.endswith((".yaml", ".yml"))
+    if isinstance(criteria, Path) or is_file_name:
         where = str(criteria)
         try:
             criteria = Path(criteria).read_text()
@@ -63,7 +65,8 @@ def load_criteria(criteria) -> dict[str, dict[str, float]]:
         except yaml.YAMLError as exc:
             raise ParameterError(f"parameter 'criteria': {where} is not valid YAML ({str(exc).splitlines()[0]})") from None
     if not isinstance(criteria, Mapping):
-        raise ParameterError(f"parameter 'criteria' must be a mapping of sections {', '.join(CRITERIA)}, got {type(criteria).__name__}")
+        raise ParameterError(f"parameter 'criteria' must be a mapping of sections {', '.join(CRITERIA)}, "
+                             f"got {type(criteria).__name__}")
     out: dict[str, dict[str, float]] = {}
     for section, keys in criteria.items():
         if section not in CRITERIA:
@@ -73,7 +76,8 @@ def load_criteria(criteria) -> dict[str, dict[str, float]]:
         out[section] = {}
         for key, value in keys.items():
             if key not in CRITERIA[section]:
-                raise ParameterError(f"{where}: unknown key {section}.{key}; allowed in {section}: {', '.join(CRITERIA[section])}")
+                raise ParameterError(f"{where}: unknown key {section}.{key}; "
+                                     f"allowed in {section}: {', '.join(CRITERIA[section])}")
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
                 raise ParameterError(f"{where}: {section}.{key} must be a finite number >= 0, got {value!r}")
             if key == "success_rate" and value > 1:
@@ -84,7 +88,7 @@ def load_criteria(criteria) -> dict[str, dict[str, float]]:
 
 def scenario_of(world) -> dict:
     """The scenario spec of a world: scenario.yaml of a folder or written World, else built in memory."""
-    from worldgen import scenario
+    from worldgen.export import scenario
 
     if isinstance(world, (str, Path)):
         return scenario.read(world)
@@ -164,7 +168,10 @@ class Report:
         rows = self.rows()
         head = ["criterion", "required", "measured", "verdict", "margin"]
         widths = [max([len(h)] + [len(r[h]) for r in rows]) for h in head]
-        line = lambda cells: "  ".join(c.ljust(w) for c, w in zip(cells, widths)).rstrip()
+
+        def line(cells):
+            return "  ".join(c.ljust(w) for c, w in zip(cells, widths)).rstrip()
+
         out = [line(head), line(["-" * w for w in widths])] + [line([r[h] for h in head]) for r in rows]
         s = self.summary
         out.append(f"{s['runs']} runs, {s['successes']} succeeded: {'PASS' if self.passed else 'FAIL'}")

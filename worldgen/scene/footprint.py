@@ -16,7 +16,7 @@ from typing import Optional
 import numpy as np
 import shapely
 
-from worldgen.scene import Scene
+from worldgen.scene.graph import Scene
 
 __all__ = ["Footprint", "FootprintIndex", "scene_footprints", "robot_footprints"]
 

@@ -101,8 +101,9 @@ def _parametrize_pack(metafunc, where, replay):
 
 
 def _write(request, generator, seed, params, tmp):
-    import worldgen
     from pathlib import Path
+
+    import worldgen
 
     world = worldgen.generate(generator, seed, **params)
     out = request.config.getoption("worldgen_out")

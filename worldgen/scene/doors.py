@@ -27,8 +27,10 @@ from typing import Mapping, Optional
 import numpy as np
 import shapely
 
-from worldgen.footprint import scene_footprints
-from worldgen.scene import Box, Joint, Node, Scene, matrix_to_pose
+from worldgen.scene.footprint import scene_footprints
+from worldgen.scene.graph import Joint, Node, Scene
+from worldgen.scene.pose import matrix_to_pose
+from worldgen.scene.shapes import Box
 
 __all__ = ["door_joints", "open_angle", "state_of", "scene_at", "open_scene", "fixed_scene", "door_records",
            "leaves_in_the_way", "requires_door_open", "STATE_TOL"]

@@ -1,8 +1,4 @@
-"""Test oracles: a recorded run plus a world's ground truth in, navigation figures out.
-
-    >>> from worldgen import oracles
-    >>> oracles.path_efficiency(trajectory, world)      # recorded length / task path length
-    >>> oracles.collisions(trajectory, "worlds/cluttered-s7-1f3a9c0b")
+"""The oracles' figures of one recorded run in one world (the implementation behind :mod:`worldgen.testing.oracles`).
 
 A trajectory is an (n, 3) array-like of ``t, x, y`` rows (seconds, metres), or
 (n, 4) with a yaw column, which is accepted and ignored: every figure here is
@@ -34,7 +30,7 @@ from worldgen.errors import ParameterError
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "min_separation", "run", "evaluate",
+    "collisions", "min_separation", "run",
 ]
 
 
@@ -93,7 +89,8 @@ def load(world) -> Ground:
         try:
             meta = json.loads(path.read_text())
         except (OSError, ValueError) as exc:
-            raise ParameterError(f"parameter 'world' must be a World or a world folder with world.json, got {str(world)!r} ({exc})") from None
+            raise ParameterError(f"parameter 'world' must be a World or a world folder with world.json, "
+                                 f"got {str(world)!r} ({exc})") from None
         return Ground(meta, read=lambda rel: (path.parent / rel).read_bytes())
     raise ParameterError(f"parameter 'world' must be a World, a PackWorld or a world folder, got {type(world).__name__}")
 
@@ -105,7 +102,8 @@ def as_trajectory(trajectory) -> np.ndarray:
     except (TypeError, ValueError):
         raise ParameterError("parameter 'trajectory' must be an (n, 3) or (n, 4) array of numbers (t, x, y[, yaw])") from None
     if a.ndim != 2 or a.shape[1] not in (3, 4) or len(a) < 1:
-        raise ParameterError(f"parameter 'trajectory' must be an (n, 3) or (n, 4) array (t, x, y[, yaw]) with n >= 1, got shape {a.shape}")
+        raise ParameterError(f"parameter 'trajectory' must be an (n, 3) or (n, 4) array (t, x, y[, yaw]) with n >= 1, "
+                             f"got shape {a.shape}")
     if not np.all(np.isfinite(a)):
         raise ParameterError("parameter 'trajectory' must hold finite numbers only, got NaN or inf")
     if np.any(np.diff(a[:, 0]) < 0):
@@ -199,7 +197,7 @@ def collisions(trajectory, world) -> list[Contact]:
 
 def _mover_gaps(pts: np.ndarray, ground: Ground) -> np.ndarray:
     """(samples, movers) gap (m) between the footprint's edge and each mover's disc at each ``t, x, y`` sample."""
-    from worldgen.movers import mover_positions
+    from worldgen.scene.motion import mover_positions
 
     radii = np.array([float(m["radius"]) for m in ground.meta["dynamic_obstacles"]])
     gaps = np.empty((len(pts), len(radii)))
@@ -228,7 +226,7 @@ def min_separation(trajectory, world) -> Optional[float]:
     """Smallest gap (m) between the footprint's edge and any mover's disc over the run's times.
 
     Movers are where world.json's ``dynamic_obstacles`` scripts have them at each
-    sample time (:func:`worldgen.movers.mover_positions`); None without movers.
+    sample time (:func:`worldgen.scene.motion.mover_positions`); None without movers.
     """
     ground = load(world)
     if not ground.meta.get("dynamic_obstacles"):
@@ -239,7 +237,7 @@ def min_separation(trajectory, world) -> Optional[float]:
 
 @dataclass(frozen=True)
 class Run:
-    """Every figure of one run in one world, as :func:`worldgen.oracles_eval.evaluate` tabulates them."""
+    """Every figure of one run in one world, as :func:`worldgen.testing.evaluate.evaluate` tabulates them."""
 
     world_id: str
     task: str
@@ -308,9 +306,3 @@ def _entity_colliders(meta: dict, read: Callable[[str], bytes]):
         nodes.append(Node(e["name"], e["role"], shape, Pose(*e["pose"])))
     from worldgen.feasibility.collision import Colliders
     return Colliders(Scene(tuple(nodes)))
-
-
-def evaluate(runs, criteria):
-    """Many runs judged against acceptance criteria: see :func:`worldgen.oracles_eval.evaluate`."""
-    from worldgen.oracles_eval import evaluate as _evaluate
-    return _evaluate(runs, criteria)

@@ -40,9 +40,9 @@ SCENARIO_NAME = "scenario.yaml"
 
 def scenario(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, Any]:
     """The scenario spec of ``world`` as a plain dict; ``world`` names the first written of SDF, MJCF, URDF."""
+    from worldgen.export.formats import FILE_NAMES, FORMATS
     from worldgen.export.metadata import _default, _in_the_way, time_limit
     from worldgen.floats import round_float
-    from worldgen.world import FILE_NAMES, FORMATS
 
     speed = world.params.get("robot_speed", _default("robot_speed"))
     paths = list(world.feasibility.paths) + [None] * len(world.tasks)
@@ -109,6 +109,7 @@ def read(folder) -> dict:
     from pathlib import Path
 
     import yaml
+
     from worldgen.errors import ParameterError
 
     path = Path(folder)

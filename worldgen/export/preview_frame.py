@@ -1,0 +1,215 @@
+"""The frame of preview.png: its size and the world-to-pixel layout, the title above the map,
+and the scale bar, axes and legend below it (:mod:`worldgen.export.preview` draws the map)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Any, Mapping
+
+import numpy as np
+from PIL import Image, ImageDraw, ImageFont
+
+from worldgen.errors import ParameterError
+
+__all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA", "SUPERSAMPLE",
+           "HIDDEN_ROLES", "Layout", "layout", "text_font", "title", "footer"]
+
+PREVIEW_NAME = "preview.png"
+DEFAULT_WIDTH = 800
+MIN_WIDTH, MAX_WIDTH = 400, 4000
+
+#: RGB of each layer; tests sample pixels against these.
+COLOURS = {
+    "background": (255, 255, 255),
+    "slab": (214, 214, 210),        # floor slab outside the usable bounds
+    "floor": (248, 247, 242),       # the usable bounds
+    "grid": (228, 227, 220),
+    "nogo": (232, 72, 64),          # blended at NOGO_ALPHA over what lies beneath
+    "wall": (45, 45, 55),
+    "obstacle": (84, 104, 140),
+    "overhead": (150, 160, 180),    # outline of colliders the robot passes under
+    "frame": (105, 80, 60),
+    "door": (176, 112, 48),
+    "marker": (120, 170, 120),
+    "mover": (150, 70, 200),
+    "path": (250, 140, 0),
+    "spawn": (28, 150, 70),
+    "spawn_fill": (206, 238, 214),
+    "goal": (30, 90, 220),
+    "goal_fill": (210, 224, 250),
+    "text": (20, 20, 25),
+    "alert": (200, 30, 30),
+}
+#: Opacity of the no-go zone: light enough that the floor grid still shows through.
+NOGO_ALPHA = 0.3
+
+_MARGIN = 16     # px left and right of the map
+_TITLE_H = 46    # px above the map: two lines of text
+_FOOTER_H = 40   # px below the map per legend row
+SUPERSAMPLE = 2          # the map is drawn at twice the size and averaged down: smooth edges, no blur
+_SCALE_BAR_MAX = 130  # px: the longest round length (100, 50, 10, 5, 1, 0.5 m) below it
+HIDDEN_ROLES = ("floor", "marker")  # roles that never block the robot
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where the world lands in the image.
+
+    World point (x, y) -> pixel ``(left + (x - x0) * scale, top + (y1 - y) * scale)``:
+    +x to the right, +y up (REP 103 seen from above). ``scale`` is px per metre;
+    (x0, y1) is the top-left corner of the drawn extent.
+    """
+
+    width: int
+    height: int
+    scale: float
+    x0: float
+    y1: float
+    left: float
+    top: float
+    legend_rows: int
+
+    def px(self, x: float, y: float) -> tuple[float, float]:
+        return self.left + (x - self.x0) * self.scale, self.top + (self.y1 - y) * self.scale
+
+
+def layout(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Layout:
+    """The image size and world->pixel map for ``meta`` at ``width`` px.
+
+    The drawn extent covers the bounds, every entity's box, every mover's
+    trajectory and every spawn and goal, plus a small margin. The map is at
+    most as tall as it is wide, so a long corridor along y stays on screen.
+    """
+    if isinstance(width, bool) or not isinstance(width, int) or not MIN_WIDTH <= width <= MAX_WIDTH:
+        raise ParameterError(f"parameter 'width' must be an integer in [{MIN_WIDTH}, {MAX_WIDTH}] px, got {width!r}")
+    xs, ys = _extent_points(meta)
+    lo = np.array([min(xs), min(ys)])
+    hi = np.array([max(xs), max(ys)])
+    span = hi - lo
+    pad = 0.02 * float(span.max()) + 0.1
+    lo, hi = lo - pad, hi + pad
+    span = hi - lo
+    room = width - 2 * _MARGIN
+    scale = min(room / span[0], room / span[1])
+    map_w, map_h = span[0] * scale, span[1] * scale
+    rows = 1 if _LEGEND_START + _legend_width() + _MARGIN <= width else 2
+    height = int(math.ceil(_TITLE_H + map_h + _FOOTER_H * rows - 1e-6))  # 768.0000001 px is 768
+    return Layout(width, height, float(scale), float(lo[0]), float(hi[1]),
+                  float((width - map_w) / 2), float(_TITLE_H), rows)
+
+
+def _extent_points(meta) -> tuple[list[float], list[float]]:
+    b = meta["bounds"]
+    xs, ys = [b["min"][0], b["max"][0]], [b["min"][1], b["max"][1]]
+    for e in meta.get("entities", []):
+        (x0, y0, _), (x1, y1, _) = e["aabb"]
+        xs += [x0, x1]
+        ys += [y0, y1]
+    for m in meta.get("dynamic_obstacles", []) or []:
+        for _, x, y in m["trajectory"]:
+            xs += [x - m["radius"], x + m["radius"]]
+            ys += [y - m["radius"], y + m["radius"]]
+    r = meta["robot"]["radius"]
+    for t in meta.get("tasks", []):
+        for p in (t["spawn"], t["goal"]):
+            xs += [p[0] - r, p[0] + r]
+            ys += [p[1] - r, p[1] + r]
+    return xs, ys
+
+
+@lru_cache(maxsize=None)
+def text_font(size: int):
+    return ImageFont.load_default(size=size)
+
+
+def _fmt_m(x) -> str:
+    return "-" if x is None else f"{x:.2f} m"
+
+
+def title(image: Image.Image, meta, lay: Layout) -> None:
+    d = ImageDraw.Draw(image)
+    room = lay.width - 2 * _MARGIN
+    big, small = text_font(16), text_font(13)
+    world_id = str(meta.get("world_id", "?"))
+    d.text((_MARGIN, 6), world_id, fill=COLOURS["text"], font=big)
+    feas = meta.get("feasibility", {}) or {}
+    if feas and not feas.get("feasible", True):
+        failed = ", ".join(c["name"] for c in feas.get("checks", []) if not c.get("ok"))
+        x = _MARGIN + big.getlength(world_id) + 12
+        d.text((x, 6), _fit(f"INFEASIBLE: {failed}", big, _MARGIN + room - x), fill=COLOURS["alert"], font=big)
+    metrics = meta.get("metrics", {}) or {}
+    lengths = [t["path"]["length"] for t in meta.get("tasks", []) if t.get("path")]
+    parts = [
+        f"path {', '.join(f'{x:.2f}' for x in lengths)} m" if lengths else "no path",
+        f"narrowest passage {_fmt_m(metrics.get('narrowest_passage'))}",
+        f"{metrics.get('obstacle_count', '?')} obstacles",
+        *([f"doors: {', '.join(d['state'] for d in meta['doors'])}"] if meta.get("doors") else []),
+        f"robot r {meta['robot']['radius']:.2f} + {meta['robot']['clearance']:.2f} m",
+    ]
+    while len(parts) > 1 and small.getlength("   |   ".join(parts)) > room:  # narrow image: least important last
+        parts.pop()
+    d.text((_MARGIN, 26), _fit("   |   ".join(parts), small, room), fill=COLOURS["text"], font=small)
+
+
+def _fit(text: str, font, room: float) -> str:
+    """``text`` cut (with an ellipsis) to at most ``room`` px."""
+    if font.getlength(text) <= room:
+        return text
+    while text and font.getlength(text + "...") > room:
+        text = text[:-1]
+    return text + "..."
+
+
+_LEGEND = (("obstacle", "obstacle", "box"), ("wall", "wall", "box"), ("no-go zone", "nogo", "zone"),
+           ("path", "path", "line"), ("spawn", "spawn", "disc"), ("goal", "goal", "disc"),
+           ("door", "door", "box"), ("mover", "mover", "dash"))
+_LEGEND_START = _MARGIN + _SCALE_BAR_MAX + 28 + 40  # right of the longest scale bar and the axes
+_LEGEND_GAP = 12  # px between one entry's text and the next glyph
+
+
+def _legend_width() -> float:
+    font = text_font(12)
+    return sum(19 + font.getlength(text) + _LEGEND_GAP for text, _, _ in _LEGEND)
+
+
+def footer(image: Image.Image, lay: Layout) -> None:
+    d = ImageDraw.Draw(image)
+    font = text_font(12)
+    top = lay.height - _FOOTER_H * lay.legend_rows
+    y = top + 14
+    length = next((s for s in (100.0, 50.0, 10.0, 5.0, 1.0, 0.5) if s * lay.scale <= _SCALE_BAR_MAX), 0.5)
+    x0, x1 = _MARGIN, _MARGIN + length * lay.scale
+    d.line([(x0, y), (x1, y)], fill=COLOURS["text"], width=3)
+    for x in (x0, x1):
+        d.line([(x, y - 5), (x, y + 5)], fill=COLOURS["text"], width=2)
+    d.text(((x0 + x1) / 2, y + 6), f"{length:g} m", fill=COLOURS["text"], font=font, anchor="ma")
+    # Axes: +x right, +y up.
+    ax, ay = x1 + 28, y + 8
+    d.line([(ax, ay), (ax + 18, ay)], fill=COLOURS["text"], width=2)
+    d.line([(ax, ay), (ax, ay - 18)], fill=COLOURS["text"], width=2)
+    d.text((ax + 20, ay), "x", fill=COLOURS["text"], font=font, anchor="lm")
+    d.text((ax, ay - 20), "y", fill=COLOURS["text"], font=font, anchor="mb")
+    # Legend, wrapped onto the rows the layout reserved.
+    per_row = math.ceil(len(_LEGEND) / lay.legend_rows)
+    gx = start = max(ax + 40, lay.width - _MARGIN - _legend_width() / lay.legend_rows)
+    for i, (text, colour, glyph) in enumerate(_LEGEND):
+        if i and i % per_row == 0:
+            gx = start
+        gy = top + 12 + (i // per_row) * _FOOTER_H
+        c = COLOURS[colour]
+        if glyph == "box":
+            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=c)
+        elif glyph == "zone":
+            blend = tuple(round(f + (n - f) * NOGO_ALPHA) for f, n in zip(COLOURS["floor"], c))
+            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=blend, outline=c)
+        elif glyph == "line":
+            d.line([(gx, gy), (gx + 14, gy)], fill=c, width=3)
+        elif glyph == "disc":
+            d.ellipse([gx + 1, gy - 6, gx + 13, gy + 6], fill=COLOURS[colour + "_fill"], outline=c, width=2)
+        else:
+            d.line([(gx, gy), (gx + 5, gy)], fill=c, width=2)
+            d.line([(gx + 9, gy), (gx + 14, gy)], fill=c, width=2)
+        d.text((gx + 19, gy), text, fill=COLOURS["text"], font=font, anchor="lm")
+        gx += 19 + font.getlength(text) + _LEGEND_GAP
