@@ -1,4 +1,4 @@
-"""A differential-drive robot follows the reference path in 20 cluttered worlds, judged by worldgen.testing.oracles.
+"""A differential-drive robot follows the reference path in 20 cluttered worlds, judged by worldgen.oracles.
 
     .venv/bin/python examples/diffdrive_mujoco.py [OUT_DIR]
 
@@ -30,8 +30,8 @@ import numpy as np
 from lxml import etree
 
 import worldgen
+from worldgen import oracles
 from worldgen.export.xml import safe_parser
-from worldgen.testing.oracles import evaluate
 
 CRITERIA = """
 navigation:
@@ -142,7 +142,7 @@ def main(out_dir: str) -> int:
     for seed in range(20):
         world = worldgen.generate("cluttered", seed=seed, size=[10, 10], n_obstacles=15)
         runs.append((drive(world), world))
-    report = evaluate(runs, CRITERIA)
+    report = oracles.evaluate(runs, CRITERIA)
     print(report)
     report.write_csv(out / "report.csv")
     report.write_json(out / "report.json")

@@ -10,7 +10,7 @@ OUT_DIR/pack, then drives every world once with each policy in
   an upper bound that reads the robot's true pose;
 - ``random``: uniform random actions (the floor).
 
-Each run's recorded trajectory is judged by ``worldgen.testing.oracles.evaluate`` against
+Each run's recorded trajectory is judged by ``worldgen.oracles.evaluate`` against
 the criteria below and each world's scenario.yaml (success rate, collisions,
 path efficiency, clearance: the same report as for a run from any simulator);
 SPL, which evaluate does not know, comes from the environment's episode info.
@@ -29,9 +29,9 @@ from pathlib import Path
 import gymnasium
 
 import worldgen.envs  # noqa: F401  (registers worldgen/Navigation-v0)
+from worldgen import oracles
 from worldgen.envs.policies import PathFollower, RandomPolicy
 from worldgen.pack import Pack, build_pack, parse_recipe
-from worldgen.testing.oracles import evaluate
 
 RECIPE = """
 name: rl_smoke
@@ -81,7 +81,7 @@ def main(out_dir: str) -> int:
             trajectory, info = episode(env, name, seed=i)
             runs.append((trajectory, pack[i]))
             infos.append(info)
-        report = evaluate(runs, CRITERIA)
+        report = oracles.evaluate(runs, CRITERIA)
         report.write_json(out / f"report-{name}.json")
         spl = statistics.mean(i["spl"] for i in infos)
         agree = sum(i["success"] == r["success"] for i, r in zip(infos, report.runs))

@@ -6,6 +6,8 @@ import json
 import re
 from pathlib import Path
 
+import pytest
+
 REPO = Path(__file__).resolve().parents[1]
 
 
@@ -46,3 +48,18 @@ def test_readme_points_at_documents_that_exist():
     assert "METADATA.md" not in readme
     for target in re.findall(r"\]\(((?:docs|examples)/[^)#]+)\)", readme):
         assert (REPO / target).exists(), target
+
+
+def test_readme_is_a_tour_and_every_reference_page_is_linked():
+    readme = (REPO / "README.md").read_text()
+    assert len(readme.splitlines()) <= 200, "the README is a tour; the reference lives in docs/"
+    assert "make demo" in readme and "make test" in readme
+    linked = set(re.findall(r"\]\(docs/([^)#]+)\)", readme))
+    assert linked == {p.name for p in (REPO / "docs").glob("*.md")}, "every docs page is linked from the README"
+
+
+@pytest.mark.parametrize("page", sorted(p.name for p in (REPO / "docs").glob("*.md")))
+def test_links_between_docs_pages_resolve(page):
+    text = (REPO / "docs" / page).read_text()
+    for target in re.findall(r"\]\(([^)#:]+)(?:#[^)]*)?\)", text):
+        assert (REPO / "docs" / target).resolve().exists(), f"{page} links to {target}"
