@@ -134,13 +134,14 @@ def bench_injection(worlds: int) -> dict:
     import worldgen
     from worldgen.envs.robot import ROBOT, add_robot, compile_world
     from worldgen.export import mjcf
+    from worldgen.export.xml import parse_bytes
     from worldgen.presets import load
 
     params = load(PRESET).params
     made = [worldgen.generate("cluttered", s, **params) for s in range(worlds)]
 
     def through_lxml(w):
-        root = mjcf.to_mjcf(w.scene, name=w.world_id).getroot()
+        root = parse_bytes(mjcf.to_mjcf(w.scene, name=w.world_id)).getroot()
         add_robot(root, w.robot.radius, w.robot.height, (0.0, 1.0), 1.0)
         compile_world(root, (0.0, 0.0, 0.0), ["floor"], [])
 

@@ -17,7 +17,6 @@ from export_scenes import showcase_scene
 from reftools_mujoco import load
 
 from worldgen.export import meshes, metadata, mjcf, urdf
-from worldgen.export.xml import to_bytes
 from worldgen.feasibility import FeasibilityReport
 from worldgen.scene import Robot, rpy_matrix
 from worldgen.world import World
@@ -34,7 +33,7 @@ def _quat_matrix(q) -> np.ndarray:
 def compiled(scene, fmt: str):
     """(model, data) after mj_forward from the model's own initial state."""
     if fmt == "mjcf":
-        model = load(to_bytes(mjcf.to_mjcf(scene)))
+        model = load(mjcf.to_mjcf(scene))
     else:
         model = load(urdf.to_urdf(scene), assets=meshes.mesh_files(scene))
     data = mujoco.MjData(model)

@@ -12,7 +12,7 @@ from export_scenes import DOOR_INITIAL, showcase_scene
 from reftools_mujoco import load_and_step
 
 from worldgen.export import mjcf
-from worldgen.export.xml import parse_bytes, to_bytes
+from worldgen.export.xml import parse_bytes
 from worldgen.scene import Box, Joint, Node, Physics, Pose, Scene
 
 #: (seed, params): the default room, a crowded big room, boxes only, no walls, tall thin cylinders.
@@ -26,7 +26,7 @@ CLUTTERED_CASES = [(seed, {}) for seed in range(50)] + [
 
 
 def mjcf_text(scene: Scene, name: str = "world") -> str:
-    return to_bytes(mjcf.to_mjcf(scene, name=name)).decode()
+    return mjcf.to_mjcf(scene, name=name).decode()
 
 
 @pytest.mark.parametrize("seed,params", CLUTTERED_CASES, ids=lambda v: str(v) if isinstance(v, int) else None)
@@ -91,7 +91,7 @@ def test_options_come_from_the_scene_physics():
 
 def test_model_name_and_same_bytes_twice():
     scene = showcase_scene()
-    a, b = to_bytes(mjcf.to_mjcf(scene, name="w1")), to_bytes(mjcf.to_mjcf(showcase_scene(), name="w1"))
+    a, b = mjcf.to_mjcf(scene, name="w1"), mjcf.to_mjcf(showcase_scene(), name="w1")
     assert a == b
     assert b'<mujoco model="w1">' in a
     assert b"-0 " not in a and b'"-0"' not in a

@@ -13,7 +13,6 @@ from export_scenes import showcase_scene
 import worldgen
 from worldgen.errors import ParameterError
 from worldgen.export import mjcf
-from worldgen.export.xml import to_bytes
 from worldgen.groundtruth import lidar
 from worldgen.scene import Box, Node, Pose, Scene
 
@@ -23,7 +22,7 @@ GROUPS = np.array([1, 1, 0, 1, 1, 1], dtype=np.uint8)
 
 def mujoco_ranges(scene: Scene, spec: lidar.LidarSpec) -> np.ndarray:
     """Ranges by mj_ray from the lidar pose, static geoms included, no body excluded; inf = no hit."""
-    model = mujoco.MjModel.from_xml_string(to_bytes(mjcf.to_mjcf(scene)).decode())
+    model = mujoco.MjModel.from_xml_string(mjcf.to_mjcf(scene).decode())
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)  # geom poses of the bodies (a door leaf, loose objects)
     origin = spec.pose.position

@@ -119,7 +119,7 @@ class World:
             return sdf.to_sdf(scene, version=sdf_version, name=self.world_id).decode()
         if fmt == "mjcf":
             from worldgen.export import mjcf
-            return _text(mjcf.to_mjcf(self.scene, name=self.world_id))
+            return mjcf.to_mjcf(self.scene, name=self.world_id).decode()
         if fmt == "urdf":
             from worldgen.export import urdf
             return urdf.to_urdf(self.scene, name=self.world_id).decode()
@@ -216,11 +216,6 @@ class World:
         if self.path is None:
             raise OutputError("this world has not been written yet; call World.write(folder) first")
         return self.path / (METADATA_NAME if fmt == "json" else FILE_NAMES[fmt])
-
-
-def _text(tree) -> str:
-    from worldgen.export.xml import to_bytes
-    return to_bytes(tree).decode()
 
 
 def _safe_relative(rel: str) -> str:

@@ -98,8 +98,8 @@ def _task_of_world(world) -> dict:
 
 def episode_world(world) -> EpisodeWorld:
     """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
-    from worldgen.export import mjcf
     from worldgen.export.metadata import mover_entry
+    from worldgen.export.xml import parse_bytes
     from worldgen.testing.figures import Ground
 
     task = _task_of_world(world)
@@ -108,7 +108,7 @@ def episode_world(world) -> EpisodeWorld:
     light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": movers,
              "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance}}
     return EpisodeWorld(
-        world_id=world.world_id, mjcf=mjcf.to_mjcf(world.scene, name=world.world_id).getroot(), robot=robot,
+        world_id=world.world_id, mjcf=parse_bytes(world.to_mjcf().encode()).getroot(), robot=robot,
         task=task, movers=movers, floor=frozenset(n.name for n in world.scene.nodes if n.role == "floor"),
         lidar_height=float(world.params.get("lidar_height", 0.3)), params=dict(world.params),
         _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}))
@@ -192,14 +192,14 @@ class PackSource:
     @staticmethod
     def _regenerated_mjcf(pw, meta):
         from worldgen.api import generate
-        from worldgen.export import mjcf
+        from worldgen.export.xml import parse_bytes
 
         world = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
                          **meta["params"])
         if world.content_hash != meta["content_hash"]:
             raise ParameterError(f"pack world {pw.world_id} has no MJCF and does not regenerate with this worldgen "
                                  f"version ({world.content_hash} != {meta['content_hash']}); build the pack with mjcf")
-        return mjcf.to_mjcf(world.scene, name=world.world_id).getroot()
+        return parse_bytes(world.to_mjcf().encode()).getroot()
 
 
 def make_source(generator=None, params=None, preset=None, pack=None):

@@ -1,4 +1,4 @@
-"""MJCF exporter: Scene -> lxml tree for MuJoCo, filled into ``templates/world.mjcf.xml``.
+"""MJCF exporter: Scene -> MJCF bytes for MuJoCo, filled into ``templates/world.mjcf.xml``.
 
 How the scene maps onto MJCF:
 
@@ -37,7 +37,7 @@ from __future__ import annotations
 from typing import Optional
 
 from worldgen.errors import SceneError
-from worldgen.export.xml import load_template, sub
+from worldgen.export.xml import XmlText, fill, load_template, sub
 from worldgen.floats import fmt, fmt_seq, round_float
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere
 from worldgen.scene.mover import MOVER_RGBA
@@ -92,8 +92,13 @@ def joints_by_child(scene: Scene) -> dict[str, Joint]:
     return found
 
 
-def to_mjcf(scene: Scene, name: str = "world"):
-    """The scene as an MJCF document (an lxml ElementTree)."""
+def to_mjcf(scene: Scene, name: str = "world") -> bytes:
+    """The scene as an MJCF document: UTF-8 bytes, pretty-printed.
+
+    The skeleton, the option and the mesh assets are filled with lxml; the bodies and geoms
+    are written as text (:class:`~worldgen.export.xml.XmlText`). Parse the bytes with
+    :func:`~worldgen.export.xml.parse_bytes` to edit the model (the RL environment adds its robot so).
+    """
     joints = joints_by_child(scene)
     tree = load_template(TEMPLATE)
     root = tree.getroot()
@@ -103,17 +108,17 @@ def to_mjcf(scene: Scene, name: str = "world"):
     option.set("gravity", fmt_seq(scene.physics.gravity))
     mesh_assets = _write_mesh_assets(root.find("asset"), scene)
     _check_joint_names(scene, joints)
-    worldbody = root.find("worldbody")
-    children: dict[Optional[str], list[Node]] = {}
-    for node in scene.nodes:  # one pass, keeping the scene's node order
-        children.setdefault(node.parent, []).append(node)
-    for node in children.get(None, ()):
-        _write_node(worldbody, node, joints, children, mesh_assets)
-    _write_mocap(worldbody, scene)
     # MuJoCo has no pacing of its own: the real-time factor travels as a custom
     # number (model.numeric("real_time_factor")) for a runner that wants it.
     sub(sub(root, "custom"), "numeric", name="real_time_factor", data=fmt(scene.physics.real_time_factor))
-    return tree
+    children: dict[Optional[str], list[Node]] = {}
+    for node in scene.nodes:  # one pass, keeping the scene's node order
+        children.setdefault(node.parent, []).append(node)
+    out = XmlText(depth=2)
+    for node in children.get(None, ()):
+        _write_node(out, node, joints, children, mesh_assets)
+    _write_mocap(out, scene)
+    return fill(tree, root.find("worldbody"), out)
 
 
 def _check_joint_names(scene: Scene, joints: dict[str, Joint]) -> None:
@@ -145,62 +150,62 @@ def _write_mesh_assets(asset, scene: Scene) -> dict[tuple, str]:
     return names
 
 
-def _pose_attrs(pose) -> dict[str, str]:
-    return {"pos": fmt_seq((pose.x, pose.y, pose.z)), "euler": fmt_seq((pose.roll, pose.pitch, pose.yaw))}
+def _pose_attrs(pose) -> str:
+    return f' pos="{fmt_seq((pose.x, pose.y, pose.z))}" euler="{fmt_seq((pose.roll, pose.pitch, pose.yaw))}"'
 
 
-def _write_node(parent_el, node: Node, joints, children, mesh_assets) -> None:
+def _write_node(out: XmlText, node: Node, joints, children, mesh_assets) -> None:
     joint = joints.get(node.name)
     kids = children.get(node.name, ())
     if node.parent is None and node.static and joint is None and not kids:
         if node.shape is not None:
-            _write_geom(parent_el, node, mesh_assets, _pose_attrs(node.pose))
+            _write_geom(out, node, mesh_assets, _pose_attrs(node.pose))
         return
-    body = sub(parent_el, "body", name=node.name, **_pose_attrs(node.pose))
+    out.open("body", f' name="{node.name}"{_pose_attrs(node.pose)}')
     mass, inertia = mass_properties(node)
-    sub(body, "inertial", pos="0 0 0", mass=mass, diaginertia=" ".join(inertia))
+    out.empty("inertial", f' pos="0 0 0" mass="{mass}" diaginertia="{" ".join(inertia)}"')
     if _is_free(node, joints):
-        sub(body, "freejoint", name=node.name)
+        out.empty("freejoint", f' name="{node.name}"')
     elif joint is not None and joint.kind == "revolute":
         rot = joint.pose.rotation
         axis = rot @ joint.axis  # MJCF wants the axis in the body (child) frame
         lo, hi = joint.limits
-        sub(body, "joint", name=joint.name, type="hinge", pos=fmt_seq((joint.pose.x, joint.pose.y, joint.pose.z)),
-            axis=fmt_seq(axis), limited="true", range=fmt_seq((lo, hi)), ref=fmt(joint.initial),
-            damping=fmt(joint.damping), actuatorfrclimited="true",
-            actuatorfrcrange=fmt_seq((-joint.effort, joint.effort)))
+        out.empty("joint", f' name="{joint.name}" type="hinge" pos="{fmt_seq((joint.pose.x, joint.pose.y, joint.pose.z))}"'
+                           f' axis="{fmt_seq(axis)}" limited="true" range="{fmt_seq((lo, hi))}" ref="{fmt(joint.initial)}"'
+                           f' damping="{fmt(joint.damping)}" actuatorfrclimited="true"'
+                           f' actuatorfrcrange="{fmt_seq((-joint.effort, joint.effort))}"')
     if node.shape is not None:
-        _write_geom(body, node, mesh_assets, {})
+        _write_geom(out, node, mesh_assets, "")
     for child in kids:
-        _write_node(body, child, joints, children, mesh_assets)
+        _write_node(out, child, joints, children, mesh_assets)
+    out.close("body")
 
 
-def _write_geom(parent_el, node: Node, mesh_assets, pose_attrs: dict[str, str]) -> None:
-    attrs = {"name": node.name}
+def _write_geom(out: XmlText, node: Node, mesh_assets, pose_attrs: str) -> None:
     shape = node.shape
     if isinstance(shape, Box):
-        attrs.update(type="box", size=fmt_seq(s / 2.0 for s in shape.size))
+        kind = f' type="box" size="{fmt_seq(s / 2.0 for s in shape.size)}"'
     elif isinstance(shape, Cylinder):
-        attrs.update(type="cylinder", size=fmt_seq((shape.radius, shape.length / 2.0)))
+        kind = f' type="cylinder" size="{fmt_seq((shape.radius, shape.length / 2.0))}"'
     elif isinstance(shape, Sphere):
-        attrs.update(type="sphere", size=fmt(shape.radius))
+        kind = f' type="sphere" size="{fmt(shape.radius)}"'
     elif isinstance(shape, Mesh):
-        attrs.update(type="mesh", mesh=mesh_assets[(shape.uri, shape.scale)])
+        kind = f' type="mesh" mesh="{mesh_assets[(shape.uri, shape.scale)]}"'
     else:
         raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
-    attrs.update(pose_attrs)
-    attrs["rgba"] = fmt_seq(node.material.rgba)
-    attrs["friction"] = fmt_seq((node.material.friction, TORSIONAL_FRICTION, ROLLING_FRICTION))
-    if not node.collision:
-        # Visual only: no contact with anything, drawn in group 2 with the other visuals.
-        attrs.update(contype="0", conaffinity="0", group="2")
-    sub(parent_el, "geom", **attrs)
+    friction = fmt_seq((node.material.friction, TORSIONAL_FRICTION, ROLLING_FRICTION))
+    # Visual only: no contact with anything, drawn in group 2 with the other visuals.
+    visual = "" if node.collision else ' contype="0" conaffinity="0" group="2"'
+    out.empty("geom", f' name="{node.name}"{kind}{pose_attrs} rgba="{fmt_seq(node.material.rgba)}"'
+                      f' friction="{friction}"{visual}')
 
 
-def _write_mocap(worldbody, scene: Scene) -> None:
-    """Append one mocap body (with a cylinder geom of the same name) per mover to ``<worldbody>``."""
+def _write_mocap(out: XmlText, scene: Scene) -> None:
+    """One mocap body (with a cylinder geom of the same name) per mover, at the end of ``<worldbody>``."""
     for mover in scene.movers:
         _, x, y = mover.trajectory[0]
-        body = sub(worldbody, "body", name=mover.name, mocap="true", pos=fmt_seq((x, y, mover.height / 2.0)))
-        sub(body, "geom", name=mover.name, type="cylinder", size=fmt_seq((mover.radius, mover.height / 2.0)),
-            rgba=fmt_seq(MOVER_RGBA), friction=fmt_seq((mover.friction, TORSIONAL_FRICTION, ROLLING_FRICTION)))
+        out.open("body", f' name="{mover.name}" mocap="true" pos="{fmt_seq((x, y, mover.height / 2.0))}"')
+        out.empty("geom", f' name="{mover.name}" type="cylinder" size="{fmt_seq((mover.radius, mover.height / 2.0))}"'
+                          f' rgba="{fmt_seq(MOVER_RGBA)}"'
+                          f' friction="{fmt_seq((mover.friction, TORSIONAL_FRICTION, ROLLING_FRICTION))}"')
+        out.close("body")
