@@ -1,4 +1,8 @@
-"""Scene graph: nodes, shapes, poses, joints. Plain data, no I/O, no file formats."""
+"""Scenes: the graph (nodes, shapes, poses, joints, movers) as plain data, no I/O, no file formats.
+
+Exported here: the data types. The facts read off a scene live beside them and are imported
+from their modules: ``footprint`` (floor shadows), ``doors`` (leaves and their states),
+``motion`` (where movers are at a time)."""
 
 from worldgen.scene.graph import NAME_PATTERN, ROLES, Joint, Material, Node, Physics, Robot, Scene, Task
 from worldgen.scene.mover import Mover
