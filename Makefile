@@ -25,7 +25,7 @@ $(RL_STAMP): $(STAMP)
 ## demo: install, then generate worlds from the cluttered generator's defaults and say where they are
 demo: $(STAMP)
 	$(VENV)/bin/worldgen generate cluttered --seed 0 --count 3 --out $(DEMO_OUT)
-	@echo "worlds written under $(abspath $(DEMO_OUT))/: each folder holds world.sdf, world.mjcf.xml, world.urdf, world.json, map.pgm + map.yaml and preview.png"
+	@echo "worlds written under $(abspath $(DEMO_OUT))/: each folder holds world.sdf, world.mjcf.xml, world.urdf, world.json, scenario.yaml, map.pgm + map.yaml and preview.png"
 
 ## test: install with the test extras, lint (ruff: pyflakes, pycodestyle, import order), check the
 ## public API's types (mypy), then run the whole suite

@@ -17,7 +17,7 @@ import pytest
 
 import worldgen
 from worldgen.errors import InfeasibleError
-from worldgen.generators import get
+from worldgen.generators import all_specs, get
 from worldgen.params import describe_range
 
 _SCRIPT = Path(sys.executable).with_name("worldgen")
@@ -73,6 +73,17 @@ def test_list_shows_every_parameter_with_default_range_and_unit():
         assert p.doc in row
     assert re.search(r"^  n_obstacles\s+int\s+20\s+integer in \[0, 5000\]\s+-\s+number of obstacles", r.stdout, re.M)
     assert re.search(r"^  size\s+pair\s+10,10\s+each in \[1, 500\]\s+m\s", r.stdout, re.M)
+
+
+def test_list_markdown_has_a_table_per_generator_and_every_parameter_once_per_generator():
+    r = run("list", "--markdown")
+    assert r.returncode == 0, r.stderr
+    sections = re.split(r"^### ", r.stdout, flags=re.M)[1:]
+    assert [s.splitlines()[0].split(":")[0].strip("`") for s in sections] == [s.name for s in all_specs()] + ["Every generator"]
+    common = set(re.findall(r"^\| `([a-z_]+)` \|", sections[-1], re.M))
+    for spec, section in zip(all_specs(), sections):
+        own = set(re.findall(r"^\| `([a-z_]+)` \|", section, re.M))
+        assert own | common == {p.name for p in spec.all_params} and not own & common, spec.name
 
 
 def test_list_json_matches_the_registry():

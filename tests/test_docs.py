@@ -63,3 +63,13 @@ def test_links_between_docs_pages_resolve(page):
     text = (REPO / "docs" / page).read_text()
     for target in re.findall(r"\]\(([^)#:]+)(?:#[^)]*)?\)", text):
         assert (REPO / "docs" / target).resolve().exists(), f"{page} links to {target}"
+
+
+def test_generators_doc_holds_every_parameter_as_worldgen_list_prints_it():
+    from worldgen.cli import parameter_tables
+    from worldgen.generators import all_specs
+
+    text = (REPO / "docs" / "generators.md").read_text()
+    block = re.search(r"<!-- begin: worldgen list --markdown -->\n(.*)<!-- end: worldgen list --markdown -->", text, re.S)
+    assert block, "docs/generators.md lost its parameter tables"
+    assert block.group(1) == parameter_tables(all_specs()), "run `worldgen list --markdown` and paste it into docs/generators.md"

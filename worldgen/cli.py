@@ -52,9 +52,15 @@ def cli() -> None:
 
 @cli.command("list", context_settings=_CONTEXT)
 @click.option("--json", "as_json", is_flag=True, help="Print the same as JSON (stable key order).")
-def list_command(as_json: bool) -> None:
+@click.option("--markdown", "as_markdown", is_flag=True,
+              help="Print Markdown tables: each generator's own parameters, then the common ones "
+                   "(the reference in docs/generators.md is this output).")
+def list_command(as_json: bool, as_markdown: bool) -> None:
     """List generators and every parameter: kind, default, allowed range, unit."""
     specs = all_specs()
+    if as_markdown:
+        click.echo(parameter_tables(specs), nl=False)
+        return
     if as_json:
         doc = {
             "worldgen_version": worldgen.__version__,
@@ -78,6 +84,26 @@ def list_command(as_json: bool) -> None:
             click.echo("  " + "  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[5])
         for ex in spec.examples:
             click.echo(f"  e.g. {ex}")
+
+
+def parameter_tables(specs) -> str:
+    """Markdown: a table of each generator's own parameters, then one of the parameters every generator takes."""
+    from worldgen.params import COMMON_PARAMS
+
+    def table(params) -> list[str]:
+        rows = ["| parameter | kind | default | allowed | unit | meaning |", "|---|---|---|---|---|---|"]
+        for d in (describe_param(p) for p in sorted(params, key=lambda p: p.name)):
+            cells = [f"`{d['name']}`", d["kind"], f"`{d['default_text']}`", d["allowed"], d["unit"] or "-", d["doc"]]
+            rows.append("| " + " | ".join(c.replace("|", "\\|") for c in cells) + " |")
+        return rows
+
+    common = {p.name for p in COMMON_PARAMS}
+    lines = []
+    for spec in specs:
+        own = [p for p in spec.params if p.name not in common]
+        lines += [f"### `{spec.name}`: {spec.summary}", ""] + table(own) + [""]
+    lines += ["### Every generator", ""] + table(COMMON_PARAMS) + [""]
+    return "\n".join(lines)
 
 
 @cli.command("generate", context_settings=_CONTEXT, epilog=_examples())
