@@ -190,14 +190,6 @@ class ConfigSpace:
         """(C,) bool: the circle is a disc obstacle's, usable at every angle."""
         return self.cone_w >= 2 * np.pi
 
-    def rel_angle(self, circle: np.ndarray, normal: np.ndarray) -> np.ndarray:
-        """(m,) angle (rad) from the cone's first normal counter-clockwise to ``normal``, in [0, 2 pi)."""
-        a = self.cone_a[circle]
-        ang = np.arctan2(_cross(a, normal), np.einsum("ij,ij->i", a, normal))
-        ang = np.where(ang < 0, ang + 2 * np.pi, ang)
-        # A normal a hair before a polygon cone's start (within CONE_SLACK) is its start.
-        return np.where(~self.full[circle] & (ang > self.cone_w[circle] + 1e-6), 0.0, ang)
-
     # -- clearance tests ---------------------------------------------------
     def inside_box(self, pts: np.ndarray) -> np.ndarray:
         """(n,) bool: the (n, 2) points lie where the robot's centre may be."""
