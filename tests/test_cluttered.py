@@ -6,6 +6,7 @@ import sys
 import textwrap
 
 import numpy as np
+import pytest
 import shapely
 from conftest import draft
 from hypothesis import HealthCheck, given, settings
@@ -112,3 +113,21 @@ def test_other_packages_register_generators_through_entry_points(tmp_path):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          env={"PYTHONPATH": str(tmp_path), "PATH": "/usr/bin:/bin"}, check=True).stdout
     assert "'extra'" in out and "a plugin generator" in out
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(st.floats(-3, 3), min_size=6, max_size=6), st.lists(st.floats(0.05, 2), min_size=4, max_size=4),
+       st.floats(0.02, 1.0))
+def test_placement_distances_equal_shapelys(xyyaw, sizes, radius):
+    """The closed-form distances the draw uses (rectangles, discs, points) against GEOS."""
+    from worldgen.generators.cluttered import _Footprint
+    from worldgen.scene import Box, Cylinder
+
+    (x1, y1, yaw1, x2, y2, yaw2), (a, b, c, d) = xyyaw, sizes
+    r1 = _Footprint("box", Box((a, b, 1.0)), x1, y1, yaw1)
+    r2 = _Footprint("box", Box((c, d, 1.0)), x2, y2, yaw2)
+    disc = _Footprint("cylinder", Cylinder(radius, 1.0), x2, y2, 0.0)
+    p1, p2 = shapely.Polygon(r1.corners), shapely.Polygon(r2.corners)
+    assert r1.distance(r2) == pytest.approx(p1.distance(p2), abs=1e-12)
+    assert r1.distance(disc) == pytest.approx(p1.distance(shapely.Point(x2, y2)) - radius, abs=1e-12)
+    assert r1.point_distance(x2, y2) == pytest.approx(p1.distance(shapely.Point(x2, y2)), abs=1e-12)
