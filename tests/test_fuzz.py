@@ -41,6 +41,10 @@ def test_a_native_crash_in_a_child_is_reported_not_fatal():
 @pytest.mark.parametrize("request_", [
     # A robot exactly as tall as the doorway under the lintel: libccd's EPA aborted the process.
     {"generator": "door", "seed": 2, "params": {"robot_height": 2.0, "clearance": 0.0}},
+    # `make fuzz`, 2026-11-25: as tall as the doorway with no clearance, the reference path touched the head.
+    {"generator": "door", "seed": 2109898065, "params": {"state": "random", "clearance": 0.0, "robot_height": 2.0}},
+    {"generator": "door", "seed": 1058751681, "params": {"swing": "pull", "state": "open", "leaf_mass": 0.1,
+                                                         "clearance": 0.0, "robot_height": 2.0}},
     # --allow-infeasible in a corridor too narrow for obstacles: a negative box size, a traceback.
     {"generator": "corridor", "seed": 0, "params": {"width": 0.6, "n_obstacles": 2}, "allow_infeasible": True},
 ])

@@ -128,6 +128,12 @@ def check(params: Mapping[str, Any]) -> None:
         raise ParameterError(
             f"parameter 'robot_height' must be at most door_height - clearance = "
             f"{params['door_height'] - params['clearance']:g} m to pass under the doorways, got {params['robot_height']!r}")
+    if params["robot_height"] >= params["door_height"]:
+        # With no clearance asked, a robot exactly as tall as the opening would touch the head: FCL, MuJoCo
+        # and the oracles all count touching as a contact, so the world would not be what it claims.
+        raise ParameterError(
+            f"parameter 'robot_height' must be below door_height = {params['door_height']:g} m (a robot as tall as "
+            f"the doorway touches its head), got {params['robot_height']!r}")
     if params["door_height"] - 2 * LEAF_GAP <= 0:
         raise ParameterError(f"parameter 'door_height' must exceed {2 * LEAF_GAP:g} m, got {params['door_height']!r}")
     room = sy - 2 * JAMB_WIDTH
