@@ -27,6 +27,8 @@ __all__ = ["SPEC", "build"]
 
 #: Tries to place one obstacle before the draw counts as overcrowded.
 PLACEMENT_TRIES = 60
+#: Most obstacles one world may ask for, by count or by density.
+MAX_OBSTACLES = 5000
 #: Density of obstacles (kg/m^3) for their nominal mass: static, but inertia must be valid.
 OBSTACLE_DENSITY = 300.0
 
@@ -35,7 +37,7 @@ CYLINDER_RGBA = (0.25, 0.50, 0.75, 1.0)
 
 PARAMS = (
     Param("size", "pair", [10.0, 10.0], "inner extents (x, y) of the room, centred on the origin", 1.0, 500.0, unit="m"),
-    Param("n_obstacles", "int", 20, "number of obstacles (ignored when density is set)", 0, 5000),
+    Param("n_obstacles", "int", 20, "number of obstacles (ignored when density is set)", 0, MAX_OBSTACLES),
     Param("density", "float", None, "obstacles per square metre of floor; replaces n_obstacles when set",
           0.0, 5.0, optional=True, unit="1/m^2"),
     Param("obstacle_shapes", "choice", "mixed", "which obstacle shapes to draw", choices=("box", "cylinder", "mixed")),
@@ -67,6 +69,13 @@ def check(params: Mapping[str, Any]) -> None:
             f"parameter 'min_spawn_goal_distance' must be in [0, {reach:.3f}] for this room and robot "
             f"(the usable diagonal), got {params['min_spawn_goal_distance']!r}"
         )
+    count = obstacle_count(params)
+    if params["density"] is not None and count > MAX_OBSTACLES:
+        # The same ceiling as n_obstacles: a density over a large floor asked for 100,000 obstacles
+        # and took a minute of failed draws to say they did not fit.
+        raise ParameterError(
+            f"parameter 'density' gives {count} obstacles on this {sx:g} x {sy:g} m floor; at most {MAX_OBSTACLES} "
+            f"(density <= {MAX_OBSTACLES / (sx * sy):.4g} here), got {params['density']!r}")
     check_task_params(params, room_bounds(params["size"]))
 
 
