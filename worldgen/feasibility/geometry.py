@@ -91,15 +91,20 @@ class Obstacles2D:
         else:
             edge_a = edge_b = np.zeros((0, 2))
         owner = np.repeat(np.arange(len(rings)), counts)
-        boxes = np.array([f.bounds() for f in discs] + [f.bounds() for f in polys], dtype=float).reshape(-1, 4)
+        disc_boxes = np.column_stack([disc_xy - disc_r[:, None], disc_xy + disc_r[:, None]])
+        poly_boxes = shapely.bounds(np.array([f.polygon for f in polys], dtype=object)).reshape(-1, 4)
+        boxes = np.concatenate([disc_boxes.reshape(-1, 4), poly_boxes]).astype(float)
         names = tuple(f.name for f in discs) + tuple(f.name for f in polys)
         return cls(disc_xy, disc_r, tuple(rings), edge_a, edge_b, owner, start, boxes, names)
 
     @cached_property
     def cores(self) -> np.ndarray:
         """(N,) shapely geometries by obstacle id: each polygon, and each disc's centre point."""
-        return np.array([shapely.Point(c) for c in self.disc_xy] + [shapely.Polygon(r) for r in self.poly_vertices],
-                        dtype=object)
+        # Made in two vectorised calls (one shapely object at a time cost 0.24 ms at 50 obstacles).
+        points = shapely.points(self.disc_xy) if len(self.disc_xy) else np.zeros(0, dtype=object)
+        polygons = (shapely.polygons(shapely.linearrings(self.edge_a, indices=self.edge_owner))
+                    if len(self.poly_vertices) else np.zeros(0, dtype=object))
+        return np.concatenate([np.asarray(points, dtype=object), np.asarray(polygons, dtype=object)])
 
     @property
     def n_discs(self) -> int:
