@@ -68,7 +68,7 @@ class Colliders:
         # FCL objects are made when a query first reaches a collider: the broad phase below
         # keeps most of them from ever being asked (0.7 ms a world at 50 obstacles made eagerly).
         self._objects: list[Optional[fcl.CollisionObject]] = [None] * len(nodes)
-        boxes = np.array([scene.aabb(n.name) for n in nodes], dtype=float).reshape(-1, 2, 3)
+        boxes = scene.aabbs([n.name for n in nodes])
         self.lo = boxes[:, 0, :]
         self.hi = boxes[:, 1, :]
         self._unsigned = fcl.DistanceRequest(enable_signed_distance=False)

@@ -21,7 +21,7 @@ from worldgen.floats import round_float
 from worldgen.scene.mover import Mover
 from worldgen.scene.names import NAME_PATTERN
 from worldgen.scene.pose import Pose
-from worldgen.scene.shapes import Mesh, Shape, unit_inertia
+from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, unit_inertia
 
 __all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN", "Mover"]
 
@@ -261,6 +261,32 @@ class Scene:
             box.flags.writeable = False
             cache[name] = box
         return cache[name]
+
+    def aabbs(self, names) -> np.ndarray:
+        """(n, 2, 3) :meth:`aabb` of each named node; the boxes not yet known made together."""
+        cache = self._aabb_cache
+        todo = [name for name in names if name not in cache]
+        boxes = [name for name in todo if isinstance(self._by_name[name].shape, Box)]
+        if len(boxes) > 1:
+            m = np.stack([self.world_matrix(name) for name in boxes])
+            half = np.array([self._by_name[name].shape.size for name in boxes], dtype=float) / 2.0
+            # Each box's reach along the world axes, |R| half, as aabb() computes it one at a time.
+            self._cache_boxes(boxes, m[:, :3, 3], np.einsum("kij,kj->ki", np.abs(m[:, :3, :3]), half))
+        cylinders = [name for name in todo if isinstance(self._by_name[name].shape, Cylinder)]
+        if len(cylinders) > 1:
+            m = np.stack([self.world_matrix(name) for name in cylinders])
+            length = np.array([self._by_name[name].shape.length for name in cylinders], dtype=float)
+            radius = np.array([self._by_name[name].shape.radius for name in cylinders], dtype=float)
+            axis = m[:, :3, 2]  # as _tight_round_corners, for all of them at once
+            reach = np.abs(axis) * length[:, None] / 2 + radius[:, None] * np.sqrt(np.clip(1 - axis**2, 0, 1))
+            self._cache_boxes(cylinders, m[:, :3, 3], reach)
+        return np.array([self.aabb(name) for name in names], dtype=float).reshape(-1, 2, 3)
+
+    def _cache_boxes(self, names, centres: np.ndarray, reaches: np.ndarray) -> None:
+        for name, centre, reach in zip(names, centres, reaches):
+            box = np.array([centre - reach, centre + reach])
+            box.flags.writeable = False
+            self._aabb_cache[name] = box
 
     @cached_property
     def _aabb_cache(self) -> dict[str, np.ndarray]:
