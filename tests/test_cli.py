@@ -205,7 +205,9 @@ MISTAKES = {
                    r"error: no feasible 'cluttered' world for seed 5 within max_attempts=3: "
                    r"obstacle_placement failed 3x \(first obstacle_placement: could not place 400 obstacles .*\)"),
     "no path": (["generate", "cluttered", "--seed", "1", *BLOCKED, "--out", "{out}"],
-                r"error: no feasible 'cluttered' world for seed 1 within max_attempts=2: .*path_exists failed 2x.*"),
+                # The hint is the first check that failed in running order: no path, not its missing clearance.
+                r"error: no feasible 'cluttered' world for seed 1 within max_attempts=2: .*path_exists failed 2x"
+                r".* \(first path_exists: task_0: no path .*\)"),
 }
 
 

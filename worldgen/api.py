@@ -86,7 +86,9 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
     if allow_infeasible and last is not None:
         return last
     summary = ", ".join(f"{check} failed {count}x" for check, count in sorted(failures.items()))
-    first = sorted(failures)[0] if failures else None
+    # The detail of the first check that failed, in the order the checks run (a path that does not
+    # exist also has no clearance: the hint names path_exists, not the alphabetically first).
+    first = next(iter(details), None)
     hint = f" (first {first}: {details[first]})" if first and details.get(first) else ""
     raise InfeasibleError(
         f"no feasible '{name}' world for seed {seed} within max_attempts={budget}: {summary}{hint}",
