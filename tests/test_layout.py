@@ -48,11 +48,10 @@ def imports_of(name: str, path: Path, known: set[str]) -> set[str]:
 
 
 def import_graph() -> dict[str, set[str]]:
+    """Module -> the worldgen modules it imports. A submodule importing its own package is an edge to the
+    package's __init__, a cycle only when that __init__ imports the submodule back."""
     mods = modules()
-    graph = {name: imports_of(name, path, set(mods)) for name, path in mods.items()}
-    # Importing a.b.c runs a/__init__ and a/b/__init__ first: a package's own submodules importing
-    # their package is the usual way in, and only a cycle when the package imports them back.
-    return graph
+    return {name: imports_of(name, path, set(mods)) for name, path in mods.items()}
 
 
 def cycles(graph: dict[str, set[str]]) -> list[list[str]]:

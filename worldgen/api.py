@@ -68,11 +68,11 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **para
         draft = spec.build(resolved, attempt_rng(seed, attempt))
         if not draft.rejected:
             draft = _with_common_extras(spec, resolved, draft, robot, seed, attempt)
-        if draft.rejected or draft.scene is None:
-            reason = draft.rejected or "no_scene"
-            failures[reason] += 1
-            details.setdefault(reason, draft.detail)
+        if draft.rejected:
+            failures[draft.rejected] += 1
+            details.setdefault(draft.rejected, draft.detail)
             continue
+        assert draft.scene is not None, "a draft that is not rejected has a scene"
         if map_extent is None:  # the map's size follows from the floor: refuse before planning on it
             map_extent = occupancy.extent(draft.scene, resolved["map_resolution"])
         report = feasibility.check(draft.scene, draft.tasks, robot)
@@ -104,8 +104,7 @@ def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt:
     RNG stream (worldgen.generators.movers), laid out after any goal walls so they avoid them.
     """
     scene = draft.scene
-    if scene is None:  # a draw without a scene is a rejected one: nothing to add to
-        return draft
+    assert scene is not None, "a draft that is not rejected has a scene"
     if resolved.get("infeasible") and "infeasible" not in {p.name for p in spec.params}:
         scene, reason = wall_in_goals(scene, draft.tasks, robot, resolved["friction"])
         if reason:

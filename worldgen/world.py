@@ -108,10 +108,7 @@ class World:
 
     def _render(self, fmt: str, sdf_version: str) -> str:
         if fmt == "sdf":
-            if sdf_version not in SDF_VERSIONS:
-                raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, "
-                                     f"got {sdf_version!r}")
-            from worldgen.export import sdf
+            from worldgen.export import sdf  # which checks the version
             scene = self.scene
             if scene.movers and not self.params.get("sdf_actors", True):
                 # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.

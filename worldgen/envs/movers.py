@@ -1,14 +1,16 @@
 """Movers in the environment: each mover's MuJoCo mocap body driven along its script, every physics step.
 
 The scripts are world.json's ``dynamic_obstacles[].trajectory`` (``t, x, y``
-rows, straight legs at constant speed, looping or waiting at the end), read
-exactly as :func:`worldgen.scene.motion.mover_positions` reads them, but for all the
-physics steps of one control period at once.
+rows, straight legs at constant speed, looping or waiting at the end), read by
+:func:`worldgen.scene.motion.positions_at` (as :func:`~worldgen.scene.motion.mover_positions`
+reads them) for all the physics steps of one control period at once.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+from worldgen.scene.motion import positions_at
 
 __all__ = ["MoverScript"]
 
@@ -26,14 +28,7 @@ class MoverScript:
 
     def positions(self, times: np.ndarray) -> np.ndarray:
         """(len(times), movers, 2): where each mover's centre is at each time (s)."""
-        times = np.asarray(times, dtype=float)
-        out = np.zeros((len(times), len(self.tracks), 2))
-        for i, (traj, loop) in enumerate(zip(self.tracks, self.loops)):
-            period = traj[-1, 0]
-            tt = np.mod(times, period) if loop else np.minimum(times, period)
-            out[:, i, 0] = np.interp(tt, traj[:, 0], traj[:, 1])
-            out[:, i, 1] = np.interp(tt, traj[:, 0], traj[:, 2])
-        return out
+        return positions_at(self.tracks, self.loops, times)
 
     def place(self, data, mocap: np.ndarray, xy: np.ndarray) -> None:
         """Write positions ``xy`` (movers, 2) into ``data.mocap_pos`` for the mocap indices ``mocap``."""

@@ -212,11 +212,7 @@ class _ModelWriter:
                 out.close("collision")
             out.open("visual", ' name="visual"')
             _write_geometry(out, geometry)
-            colour = fmt_seq(rgba)
-            out.open("material")
-            out.leaf("ambient", colour)
-            out.leaf("diffuse", colour)
-            out.close("material")
+            _write_material(out, rgba)
             if rgba[3] < 1.0:
                 out.leaf("transparency", fmt(1.0 - rgba[3]))
             out.close("visual")
@@ -299,6 +295,14 @@ def _geometry(shape) -> tuple[str, tuple[tuple[str, str], ...]]:
     raise WorldgenError(f"the SDF exporter has no geometry for shape {shape!r}")
 
 
+def _write_material(out: XmlText, rgba) -> None:
+    colour = fmt_seq(rgba)
+    out.open("material")
+    out.leaf("ambient", colour)
+    out.leaf("diffuse", colour)
+    out.close("material")
+
+
 def _write_geometry(out: XmlText, geometry) -> None:
     kind, fields = geometry
     out.open("geometry")
@@ -321,16 +325,13 @@ def _sdf_actor(out: XmlText, mover: Mover) -> None:
     out.open("actor", f' name="{mover.name}"')
     out.open("link", ' name="body"')
     out.leaf("pose", fmt_seq((0.0, 0.0, mover.height / 2.0, 0.0, 0.0, 0.0)))
+    cylinder = ("cylinder", (("radius", fmt(mover.radius)), ("length", fmt(mover.height))))
     out.open("collision", ' name="collision"')
-    _cylinder(out, mover)
+    _write_geometry(out, cylinder)
     out.close("collision")
     out.open("visual", ' name="visual"')
-    _cylinder(out, mover)
-    colour = fmt_seq(MOVER_RGBA)
-    out.open("material")
-    out.leaf("ambient", colour)
-    out.leaf("diffuse", colour)
-    out.close("material")
+    _write_geometry(out, cylinder)
+    _write_material(out, MOVER_RGBA)
     out.close("visual")
     out.close("link")
     out.open("script")
@@ -346,12 +347,3 @@ def _sdf_actor(out: XmlText, mover: Mover) -> None:
     out.close("trajectory")
     out.close("script")
     out.close("actor")
-
-
-def _cylinder(out: XmlText, mover: Mover) -> None:
-    out.open("geometry")
-    out.open("cylinder")
-    out.leaf("radius", fmt(mover.radius))
-    out.leaf("length", fmt(mover.height))
-    out.close("cylinder")
-    out.close("geometry")

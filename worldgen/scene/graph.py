@@ -255,57 +255,56 @@ class Scene:
 
     def aabb(self, name: str) -> np.ndarray:
         """(2, 3) world-frame axis-aligned box [[min], [max]] of node ``name``'s shape (read-only)."""
-        cache = self._aabb_cache
-        if name not in cache:
-            box = self._aabb(name)
-            box.flags.writeable = False
-            cache[name] = box
-        return cache[name]
+        if name not in self._aabb_cache:
+            self._fill_aabbs([name])
+        return self._aabb_cache[name]
 
     def aabbs(self, names) -> np.ndarray:
-        """(n, 2, 3) :meth:`aabb` of each named node; the boxes not yet known made together."""
+        """(n, 2, 3) :meth:`aabb` of each named node; those not yet known made together."""
         cache = self._aabb_cache
-        todo = [name for name in names if name not in cache]
-        boxes = [name for name in todo if isinstance(self._by_name[name].shape, Box)]
-        if len(boxes) > 1:
-            m = np.stack([self.world_matrix(name) for name in boxes])
-            half = np.array([self._by_name[name].shape.size for name in boxes], dtype=float) / 2.0
-            # Each box's reach along the world axes, |R| half, as aabb() computes it one at a time.
-            self._cache_boxes(boxes, m[:, :3, 3], np.einsum("kij,kj->ki", np.abs(m[:, :3, :3]), half))
-        cylinders = [name for name in todo if isinstance(self._by_name[name].shape, Cylinder)]
-        if len(cylinders) > 1:
-            m = np.stack([self.world_matrix(name) for name in cylinders])
-            length = np.array([self._by_name[name].shape.length for name in cylinders], dtype=float)
-            radius = np.array([self._by_name[name].shape.radius for name in cylinders], dtype=float)
-            axis = m[:, :3, 2]  # as _tight_round_corners, for all of them at once
-            reach = np.abs(axis) * length[:, None] / 2 + radius[:, None] * np.sqrt(np.clip(1 - axis**2, 0, 1))
-            self._cache_boxes(cylinders, m[:, :3, 3], reach)
-        return np.array([self.aabb(name) for name in names], dtype=float).reshape(-1, 2, 3)
-
-    def _cache_boxes(self, names, centres: np.ndarray, reaches: np.ndarray) -> None:
-        for name, centre, reach in zip(names, centres, reaches):
-            box = np.array([centre - reach, centre + reach])
-            box.flags.writeable = False
-            self._aabb_cache[name] = box
+        self._fill_aabbs([name for name in names if name not in cache])
+        return np.array([cache[name] for name in names], dtype=float).reshape(-1, 2, 3)
 
     @cached_property
     def _aabb_cache(self) -> dict[str, np.ndarray]:
         return {}
 
-    def _aabb(self, name: str) -> np.ndarray:
-        node = self._by_name[name]
-        if node.shape is None:
-            p = self.world_matrix(name)[:3, 3]
-            return np.array([p, p])
-        m = self.world_matrix(name)
-        if node.shape.kind in ("cylinder", "sphere"):
-            corners = _tight_round_corners(node.shape, m)
-        elif node.shape.kind == "mesh":  # tight: the turned vertices, not a turned box
-            corners = node.shape.scaled_vertices() @ m[:3, :3].T + m[:3, 3]
-        else:  # a box: its half extents through the rotation's absolute values, no corners
-            reach = np.abs(m[:3, :3]) @ (np.asarray(node.shape.size, dtype=float) / 2.0)
-            return np.array([m[:3, 3] - reach, m[:3, 3] + reach])
-        return np.array([corners.min(axis=0), corners.max(axis=0)])
+    def _fill_aabbs(self, names) -> None:
+        """Remember the world boxes of ``names``: boxes and cylinders each in one vectorised pass (tight:
+        a box's half extents through |R|, a cylinder's |a_i| h/2 + r sqrt(1 - a_i^2) along world axis i)."""
+        boxes = [name for name in names if isinstance(self._by_name[name].shape, Box)]
+        if boxes:
+            m = np.stack([self.world_matrix(name) for name in boxes])
+            half = np.array([self._by_name[name].shape.size for name in boxes], dtype=float) / 2.0
+            self._cache_boxes(boxes, m[:, :3, 3], np.einsum("kij,kj->ki", np.abs(m[:, :3, :3]), half))
+        cylinders = [name for name in names if isinstance(self._by_name[name].shape, Cylinder)]
+        if cylinders:
+            m = np.stack([self.world_matrix(name) for name in cylinders])
+            length = np.array([self._by_name[name].shape.length for name in cylinders], dtype=float)
+            radius = np.array([self._by_name[name].shape.radius for name in cylinders], dtype=float)
+            axis = m[:, :3, 2]
+            reach = np.abs(axis) * length[:, None] / 2 + radius[:, None] * np.sqrt(np.clip(1 - axis**2, 0, 1))
+            self._cache_boxes(cylinders, m[:, :3, 3], reach)
+        for name in names:
+            if name in self._aabb_cache:
+                continue
+            node, m = self._by_name[name], self.world_matrix(name)
+            if node.shape is None:
+                self._cache_boxes([name], m[None, :3, 3], np.zeros((1, 3)))
+            elif isinstance(node.shape, Mesh):  # tight: the turned vertices, not a turned box
+                pts = node.shape.scaled_vertices() @ m[:3, :3].T + m[:3, 3]
+                self._remember(name, pts.min(axis=0), pts.max(axis=0))
+            else:  # a sphere
+                self._cache_boxes([name], m[None, :3, 3], np.full((1, 3), node.shape.radius))
+
+    def _cache_boxes(self, names, centres: np.ndarray, reaches: np.ndarray) -> None:
+        for name, centre, reach in zip(names, centres, reaches):
+            self._remember(name, centre - reach, centre + reach)
+
+    def _remember(self, name: str, lo: np.ndarray, hi: np.ndarray) -> None:
+        box = np.array([lo, hi])
+        box.flags.writeable = False
+        self._aabb_cache[name] = box
 
     def colliders(self) -> list[Node]:
         """Nodes with collision geometry that a robot on the floor can hit (the floor excluded)."""
@@ -339,18 +338,6 @@ class Scene:
 
     def with_movers(self, movers: Iterable[Mover]) -> "Scene":
         return Scene(self.nodes, self.joints, self.bounds, self.physics, tuple(movers))
-
-
-def _tight_round_corners(shape, m: np.ndarray) -> np.ndarray:
-    """Extreme points of a cylinder or sphere along the world axes, as (2, 3)."""
-    centre = m[:3, 3]
-    if shape.kind == "sphere":
-        r = np.full(3, shape.radius)
-        return np.array([centre - r, centre + r])
-    axis = m[:3, 2]
-    # A cylinder's half extent along world axis i: |a_i| h/2 + r sqrt(1 - a_i^2).
-    half = np.abs(axis) * shape.length / 2 + shape.radius * np.sqrt(np.clip(1 - axis**2, 0, 1))
-    return np.array([centre - half, centre + half])
 
 
 def _canonical_shape(shape) -> Optional[dict]:

@@ -10,7 +10,6 @@ movers, so a test can drive a world it only has as files.
 
 from __future__ import annotations
 
-import math
 from typing import Mapping
 
 import numpy as np
@@ -18,7 +17,7 @@ import numpy as np
 from worldgen.scene.graph import Scene
 from worldgen.scene.mover import Mover
 
-__all__ = ["mover_names", "mover_positions", "drive_mocap"]
+__all__ = ["mover_names", "mover_positions", "positions_at", "drive_mocap"]
 
 
 def _mover_rows(source) -> list[tuple[str, float, np.ndarray, bool]]:
@@ -51,14 +50,19 @@ def mover_positions(source, t: float) -> np.ndarray:
     waits at its last point.
     """
     rows = _mover_rows(source)
-    out = np.zeros((len(rows), 2))
-    for i, (_, _, traj, loop) in enumerate(rows):
+    return positions_at([traj for _, _, traj, _ in rows], [loop for *_, loop in rows], np.array([t]))[0]
+
+
+def positions_at(tracks, loops, times: np.ndarray) -> np.ndarray:
+    """(len(times), movers, 2): where each mover (its (k, 3) ``t, x, y`` track, looping or not) is at each time."""
+    times = np.asarray(times, dtype=float)
+    out = np.zeros((len(times), len(tracks), 2))
+    for i, (traj, loop) in enumerate(zip(tracks, loops)):
         period = traj[-1, 0]
-        tt = math.fmod(t, period) if loop else min(t, period)
-        if tt < 0:
-            tt += period
-        out[i, 0] = np.interp(tt, traj[:, 0], traj[:, 1])
-        out[i, 1] = np.interp(tt, traj[:, 0], traj[:, 2])
+        tt = np.fmod(times, period) if loop else np.minimum(times, period)
+        tt = np.where(tt < 0, tt + period, tt)
+        out[:, i, 0] = np.interp(tt, traj[:, 0], traj[:, 1])
+        out[:, i, 1] = np.interp(tt, traj[:, 0], traj[:, 2])
     return out
 
 
