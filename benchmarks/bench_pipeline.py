@@ -36,8 +36,8 @@ from pathlib import Path
 
 import worldgen
 from worldgen import feasibility
-from worldgen.api import attempt_rng
 from worldgen.generators import get, robot_from_params
+from worldgen.seeding import attempt_rng
 
 RESULTS = Path(__file__).resolve().parent / "results" / "pipeline.json"
 

@@ -32,8 +32,8 @@ def missing_tool(what: str):
 
 def draft(generator: str = "cluttered", seed: int = 0, **params):
     """One unchecked draw of a generator: (scene, tasks). Fast; no feasibility."""
-    from worldgen.api import attempt_rng
     from worldgen.generators import get
+    from worldgen.seeding import attempt_rng
 
     spec = get(generator)
     resolved = spec.resolve(params)

@@ -2,9 +2,9 @@
 
     params + seed -> generator -> Scene -> feasibility -> World (exporters on demand)
 
-The seed becomes a ``numpy.random.Generator`` here and nowhere else. Attempt
-``k`` draws from ``SeedSequence(seed, spawn_key=(k,))``, so a world never
-depends on how many attempts a caller allowed, only on which one succeeded.
+The seed becomes random streams through :mod:`worldgen.seeding` (attempt ``k``
+draws from its own stream, so a world never depends on how many attempts a
+caller allowed, only on which one succeeded).
 """
 
 from __future__ import annotations
@@ -12,31 +12,17 @@ from __future__ import annotations
 from collections import Counter
 from typing import Any
 
-import numpy as np
-
 from worldgen import feasibility
-from worldgen.errors import InfeasibleError, ParameterError
+from worldgen.errors import InfeasibleError
 from worldgen.generators import Draft, get, robot_from_params
 from worldgen.generators.infeasible import wall_in_goals
-from worldgen.generators.movers import mover_rng, place_movers
+from worldgen.generators.movers import place_movers
 from worldgen.groundtruth import occupancy
 from worldgen.params import validate_params
+from worldgen.seeding import attempt_rng, check_seed, mover_rng
 from worldgen.world import World
 
-__all__ = ["generate", "attempt_rng", "MAX_SEED"]
-
-MAX_SEED = 2**63 - 1
-
-
-def attempt_rng(seed: int, attempt: int) -> np.random.Generator:
-    """The RNG of draw number ``attempt`` (0-based) for ``seed``."""
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(attempt,)))
-
-
-def check_seed(seed: Any) -> int:
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
-        raise ParameterError(f"parameter 'seed' must be an integer in [0, {MAX_SEED}], got {seed!r}")
-    return int(seed)
+__all__ = ["generate"]
 
 
 def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **params: Any) -> World:

@@ -19,11 +19,11 @@ from typing import Any, Optional, Sequence
 import click
 
 import worldgen
-from worldgen.api import MAX_SEED
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError
 from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
+from worldgen.seeding import MAX_SEED
 
 __all__ = ["main", "cli", "parse_settings", "describe_param"]
 

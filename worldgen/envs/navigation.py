@@ -63,14 +63,11 @@ from worldgen.envs.reward import StepOutcome, reward
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.envs.source import PackSource, make_source
 from worldgen.errors import ParameterError
+from worldgen.seeding import check_seed, draw_seed, env_rngs
 
 gym = require_gymnasium()
 
-__all__ = ["NavigationEnv", "WORLD_STREAM", "NOISE_STREAM"]
-
-#: Spawn keys of the two random streams derived from a reset's seed.
-WORLD_STREAM, NOISE_STREAM = 0, 1
-_MAX_SEED = 2**63 - 1
+__all__ = ["NavigationEnv"]
 
 
 class NavigationEnv(gym.Env):
@@ -108,9 +105,8 @@ class NavigationEnv(gym.Env):
 
     # -- episode --------------------------------------------------------------------------------------------
     def _reseed(self, seed: Optional[int]) -> None:
-        entropy = seed if seed is not None else int(self.np_random.integers(0, _MAX_SEED))
-        self._world_rng = np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(WORLD_STREAM,)))
-        self._noise_rng = np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=(NOISE_STREAM,)))
+        entropy = seed if seed is not None else draw_seed(self.np_random)
+        self._world_rng, self._noise_rng = env_rngs(entropy)
 
     def _next_world(self, options: dict):
         if isinstance(self.source, PackSource):
@@ -121,10 +117,7 @@ class NavigationEnv(gym.Env):
             self._next_index = (int(index) + 1) % len(self.source)
             return self.source.world(int(index)), {"world_index": int(index)}
         seed = options.get("world_seed")
-        if seed is None:
-            seed = int(self._world_rng.integers(0, _MAX_SEED))
-        elif isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= seed <= _MAX_SEED:
-            raise ParameterError(f"option 'world_seed' must be an integer in [0, {_MAX_SEED}], got {seed!r}")
+        seed = draw_seed(self._world_rng) if seed is None else check_seed(seed, "option 'world_seed'")
         return self.source.world(seed), {"world_seed": seed}
 
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):

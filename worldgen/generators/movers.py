@@ -3,7 +3,7 @@
 Any generator gets them through the common parameters ``n_movers``,
 ``mover_radius``, ``mover_height``, ``mover_speed`` and ``mover_waypoints``:
 the pipeline (:func:`worldgen.api.generate`) calls :func:`place_movers` on each
-draft with its own RNG stream (:func:`mover_rng`), so adding or changing movers
+draft with its own RNG stream (:func:`worldgen.seeding.mover_rng`), so adding or changing movers
 never moves an obstacle or a task.
 
 A mover's path is a closed polygon of ``mover_waypoints`` points walked at
@@ -29,22 +29,13 @@ from worldgen.floats import round_float
 from worldgen.scene import Mover, Robot, Scene, Task
 from worldgen.scene.footprint import FootprintIndex, scene_footprints
 
-__all__ = ["MOVER_STREAM", "PATH_TRIES", "mover_rng", "place_movers"]
-
-#: The spawn-key element of the movers' RNG stream: far from the small integers
-#: generators use for their own ``rng.spawn()`` children.
-MOVER_STREAM = 0x6D6F76
+__all__ = ["PATH_TRIES", "place_movers"]
 #: Fresh whole paths tried per mover before the draft counts as overcrowded.
 PATH_TRIES = 40
 #: Candidate points drawn at once (screened together, then tried in order).
 _BATCH = 64
 #: Extra distance (m) kept from obstacles, so 6-decimal rounding never tips a leg into contact.
 _SLACK = 1e-3
-
-
-def mover_rng(seed: int, attempt: int) -> np.random.Generator:
-    """The movers' own RNG for draw ``attempt`` of ``seed`` (independent of the generator's)."""
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(attempt, MOVER_STREAM)))
 
 
 class _Floor:

@@ -34,12 +34,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
-import numpy as np
 import yaml
 
 from worldgen.errors import InfeasibleError, ParameterError, WorldgenError, quoted, read_user_text
 from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.floats import round_float
+from worldgen.seeding import MAX_SEED, recipe_rng
 
 __all__ = ["Job", "Recipe", "load_recipe", "parse_recipe", "TOP_KEYS", "ENTRY_KEYS", "PHYSICS_PARAMS"]
 
@@ -186,7 +186,6 @@ class _Reader:
         return out
 
     def seeds(self, node) -> tuple[int, ...]:
-        from worldgen.api import MAX_SEED
 
         value = self.value(node)
         if _is_int(value):
@@ -287,8 +286,7 @@ class _Reader:
 
 def _sample(kind: str, bounds, seed: int, entry: int, name: str):
     """A value in ``bounds`` drawn from the world's own stream: seed, entry and parameter name."""
-    tag = int.from_bytes(hashlib.sha256(name.encode()).digest()[:4], "big")
-    rng = np.random.default_rng(np.random.SeedSequence([seed, entry, tag]))
+    rng = recipe_rng(seed, entry, name)
     lo, hi = bounds
     if kind == "int":
         return int(rng.integers(lo, hi, endpoint=True))

@@ -1,0 +1,81 @@
+"""Every random stream worldgen uses comes from a seed through this module, and only this one.
+
+A stream is ``SeedSequence(entropy, spawn_key=key)``: the seed is the entropy, and the key names
+what the stream is for, so adding a kind of random thing never reshuffles another. The keys:
+
+==============================  ============================  =====================================
+stream                          key                           used by
+==============================  ============================  =====================================
+draw ``k`` of a world           ``(k,)``                      ``api.generate``, every generator
+its movers                      ``(k, MOVER_STREAM)``         ``generators.movers``
+an environment's worlds         ``(WORLD_STREAM,)``           ``envs.navigation`` (reset's seed)
+an environment's sensor noise   ``(NOISE_STREAM,)``           ``envs.navigation`` (reset's seed)
+a recipe's sampled parameter    ``[seed, entry, tag(name)]``  ``pack.recipe`` (entropy, no key)
+==============================  ============================  =====================================
+
+>>> float(attempt_rng(7, 0).random()) == float(attempt_rng(7, 0).random())
+True
+>>> check_seed(-1)
+Traceback (most recent call last):
+...
+worldgen.errors.ParameterError: parameter 'seed' must be an integer in [0, 9223372036854775807], got -1
+"""
+
+from __future__ import annotations
+
+import hashlib
+from typing import Any
+
+import numpy as np
+
+from worldgen.errors import ParameterError
+
+__all__ = ["MAX_SEED", "MOVER_STREAM", "WORLD_STREAM", "NOISE_STREAM", "check_seed", "attempt_rng", "mover_rng",
+           "env_rngs", "draw_seed", "recipe_rng"]
+
+#: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
+MAX_SEED = 2**63 - 1
+#: Key of the movers' stream, beside the draw number (an arbitrary tag far from the small integers
+#: generators use for their own ``rng.spawn()`` children).
+MOVER_STREAM = 0x6D6F76
+#: Keys of the two streams an environment derives from a reset's seed.
+WORLD_STREAM, NOISE_STREAM = 0, 1
+
+
+def check_seed(seed: Any, what: str = "parameter 'seed'") -> int:
+    """``seed`` as an int, or a one-line :class:`ParameterError` naming ``what`` and the range."""
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
+        raise ParameterError(f"{what} must be an integer in [0, {MAX_SEED}], got {seed!r}")
+    return int(seed)
+
+
+def _stream(entropy, *key: int) -> np.random.Generator:
+    return np.random.default_rng(np.random.SeedSequence(entropy, spawn_key=key))
+
+
+def attempt_rng(seed: int, attempt: int) -> np.random.Generator:
+    """The RNG of draw number ``attempt`` (0-based) for ``seed``: a world never depends on how many
+    attempts a caller allowed, only on which one succeeded."""
+    return _stream(seed, attempt)
+
+
+def mover_rng(seed: int, attempt: int) -> np.random.Generator:
+    """The movers' own RNG for draw ``attempt`` of ``seed`` (independent of the generator's)."""
+    return _stream(seed, attempt, MOVER_STREAM)
+
+
+def env_rngs(entropy: int) -> tuple[np.random.Generator, np.random.Generator]:
+    """An environment's (world seeds, sensor noise) streams for a reset's seed."""
+    return _stream(entropy, WORLD_STREAM), _stream(entropy, NOISE_STREAM)
+
+
+def draw_seed(rng: np.random.Generator) -> int:
+    """A fresh seed in [0, MAX_SEED) drawn from ``rng``."""
+    return int(rng.integers(0, MAX_SEED))
+
+
+def recipe_rng(seed: int, entry: int, name: str) -> np.random.Generator:
+    """The stream of one sampled parameter of a recipe: the world's seed, the recipe entry and the
+    parameter's name (hashed, so renaming another parameter leaves this one's values alone)."""
+    tag = int.from_bytes(hashlib.sha256(name.encode()).digest()[:4], "big")
+    return np.random.default_rng(np.random.SeedSequence([seed, entry, tag]))
