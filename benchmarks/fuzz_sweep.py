@@ -24,7 +24,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
 import numpy as np  # noqa: E402
-from fuzzing import draw_request, run_requests  # noqa: E402
+from support.fuzzing import draw_request, run_requests  # noqa: E402
 
 from worldgen.generators import names  # noqa: E402
 

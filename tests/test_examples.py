@@ -18,7 +18,7 @@ def _need_extra(script: Path) -> None:
 
     module = NEEDS.get(script.name)
     if module and importlib.util.find_spec(module) is None:
-        from conftest import missing_tool
+        from support import missing_tool
         missing_tool(f"{module} (pip install 'worldgen[rl]'), for {script.name}")
 
 
@@ -74,7 +74,7 @@ def test_the_readme_uses_the_shipped_recipes():
 
 
 def test_ci_smoke_recipe_builds_and_verifies(tmp_path):
-    from test_cli import run
+    from support.cli import run
 
     out = tmp_path / "ci_smoke"
     built = run("pack", "build", RECIPES / "ci_smoke.yaml", "--out", out, "--jobs", "1")

@@ -2,14 +2,14 @@
 
 Every request ends in a world that passes the independent re-check or in one
 WorldgenError line: never another exception, never a native crash, never a hang
-(see tests/fuzzing.py). Derandomised: the same requests on every run.
+(see tests/support/fuzzing.py). Derandomised: the same requests on every run.
 """
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
-from fuzzing import draw_request, run_requests
+from support.fuzzing import draw_request, run_requests
 
 REQUESTS_PER_GENERATOR = 80
 

@@ -110,3 +110,22 @@ def test_modules_stay_small_and_declare_their_exports(name):
         for n in tree.body)
     if not (declared or name.endswith("__main__")):
         pytest.fail(f"{name} has no __all__")
+
+
+TESTS = Path(__file__).resolve().parent
+
+
+def test_tests_mirror_the_package_and_share_helpers_only_through_support():
+    """A folder of tests/ is named for the worldgen subpackage it tests; helpers come from tests/support,
+    never from another test file (a test module imported twice runs its module-level code twice)."""
+    subpackages = {p.name for p in PACKAGE.iterdir() if (p / "__init__.py").exists()}
+    for folder in TESTS.iterdir():
+        if folder.is_dir() and folder.name not in {"support", "tools", ".cache", "__pycache__"}:
+            assert folder.name in subpackages, f"tests/{folder.name}/ names no worldgen subpackage"
+    for path in TESTS.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else \
+                [node.module or ""] if isinstance(node, ast.ImportFrom) else []
+            for name in names:
+                assert not name.split(".")[0].startswith(("test_", "conftest")), \
+                    f"{path.relative_to(TESTS)} imports {name}: shared helpers belong in tests/support"

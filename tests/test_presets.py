@@ -9,9 +9,8 @@ from importlib import resources
 
 import numpy as np
 import pytest
-from test_cli import run, world_dirs
-from test_corridor import recheck
-from test_minimal import ray
+from support.checks import ray, recheck
+from support.cli import run, world_dirs
 
 import worldgen
 from worldgen import presets

@@ -15,8 +15,8 @@ from pathlib import Path
 
 import pytest
 import shapely
-from reftools_sdf import check_sdf
-from reftools_urdf import check_urdf
+from support.reftools_sdf import check_sdf
+from support.reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.export import metadata

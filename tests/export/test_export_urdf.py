@@ -9,10 +9,10 @@ import mujoco
 import numpy as np
 import pytest
 import trimesh
-from conftest import draft
-from export_scenes import rock_mesh, showcase_scene
-from reftools_mujoco import load_and_step
-from reftools_urdf import check_urdf
+from support import draft
+from support.reftools_mujoco import load_and_step
+from support.reftools_urdf import check_urdf
+from support.scenes import rock_mesh, showcase_scene
 
 from worldgen.export import meshes, urdf
 from worldgen.export.xml import parse_bytes

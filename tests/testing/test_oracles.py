@@ -193,7 +193,7 @@ def test_scenario_yaml_is_listed_and_matches_the_task(wall, wall_folder):
 
 def test_folder_colliders_match_the_scene_for_every_shape(tmp_path):
     """world.json entities (tilted boxes and cylinders, spheres, STL meshes, a hinged leaf) rebuild the same FCL world."""
-    from export_scenes import showcase_scene
+    from support.scenes import showcase_scene
 
     from worldgen import feasibility
     from worldgen.generators import get, robot_from_params

@@ -7,9 +7,9 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from conftest import draft
-from export_scenes import DOOR_INITIAL, showcase_scene
-from reftools_mujoco import load_and_step
+from support import draft
+from support.reftools_mujoco import load_and_step
+from support.scenes import DOOR_INITIAL, showcase_scene
 
 from worldgen.export import mjcf
 from worldgen.export.xml import parse_bytes

@@ -7,9 +7,9 @@ import math
 
 import numpy as np
 import pytest
-from conftest import draft
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import draft
 
 from worldgen import feasibility
 from worldgen.feasibility import REQUIRED_CHECKS

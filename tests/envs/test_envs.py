@@ -13,7 +13,7 @@ import textwrap
 
 import numpy as np
 import pytest
-from conftest import missing_tool
+from support import missing_tool
 
 try:
     import gymnasium
@@ -245,7 +245,7 @@ def test_the_reference_path_follower_reaches_the_goal_with_spl_near_1():
         assert info["spl"] > 0.9
         assert info["path_length"] < info["reference_path_length"] * 1.1
         assert info["min_clearance"] > 0.0 and info["duration"] <= env.task["time_limit"]
-        from reftools_mujoco import assert_no_warnings
+        from support.reftools_mujoco import assert_no_warnings
         assert_no_warnings(env._sim.model, env._sim.data, info["world_id"])
 
 

@@ -155,7 +155,7 @@ def _unreadable(tmp_path):
 def test_a_recipe_that_is_not_readable_text_is_one_line_and_exit_2(tmp_path, kind, message):
     import re
 
-    from test_cli import run
+    from support.cli import run
 
     path = tmp_path / "recipe.yaml"
     if kind == "binary":

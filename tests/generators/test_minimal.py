@@ -4,26 +4,13 @@ from __future__ import annotations
 
 import math
 
-import mujoco
-import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from test_corridor import recheck, reference_tools
+from support.checks import ray, recheck, reference_tools
 
 import worldgen
 from worldgen.errors import ParameterError
-
-
-def ray(world, origin_xy, direction, z):
-    """(distance, geom name) of MuJoCo's mj_ray on the world's MJCF from (x, y, z) along ``direction`` (rad)."""
-    model = mujoco.MjModel.from_xml_string(world.to_mjcf())
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    geom = np.zeros(1, dtype=np.int32)
-    d = mujoco.mj_ray(model, data, np.array([origin_xy[0], origin_xy[1], z]),
-                      np.array([math.cos(direction), math.sin(direction), 0.0]), None, True, -1, geom)
-    return d, (model.geom(int(geom[0])).name if geom[0] >= 0 else None)
 
 
 def test_a_wall_two_metres_ahead_is_two_metres_away_in_mujoco():

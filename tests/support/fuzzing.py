@@ -1,7 +1,7 @@
 """Fuzzing every generator's parameter space, each request in a child process.
 
 A request is (generator, seed, params). Children are long-lived worker
-processes (``python tests/fuzzing.py --worker``) reading one JSON request per
+processes (``python tests/support/fuzzing.py --worker``) reading one JSON request per
 line and answering one JSON line; a child that dies (a native abort inside
 FCL, MuJoCo or lxml) or hangs is recorded as that request's ``crash`` or
 ``timeout`` and replaced, so one crash fails the test instead of ending the run.

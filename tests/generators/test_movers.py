@@ -15,9 +15,9 @@ import sys
 import mujoco
 import numpy as np
 import pytest
-from reftools_mujoco import assert_no_warnings, load_and_step
-from reftools_sdf import check_sdf
-from reftools_urdf import check_urdf
+from support.reftools_mujoco import assert_no_warnings, load_and_step
+from support.reftools_sdf import check_sdf
+from support.reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError

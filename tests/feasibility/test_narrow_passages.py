@@ -13,15 +13,15 @@ from __future__ import annotations
 
 import math
 
-import exact_reference
 import mujoco
 import numpy as np
 import pytest
 import shapely
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from reftools_mujoco import load
-from test_requires_door_open import _with_probe
+from support import exact_reference
+from support.checks import with_probe
+from support.reftools_mujoco import load
 
 import worldgen
 from worldgen import feasibility
@@ -51,7 +51,7 @@ def gap_world(gap: float, yaw: float, offset: float) -> Scene:
 def probe_clearance(scene: Scene, robot: Robot, waypoints) -> float:
     """MuJoCo's smallest distance from a probe cylinder (the footprint) to any collider along the path."""
     mjcf = World("hand_built", 0, {}, scene, (), robot, None, 1).to_mjcf()
-    model = load(_with_probe(mjcf, robot.radius, robot.height))
+    model = load(with_probe(mjcf, robot.radius, robot.height))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     probe = model.geom("probe").id

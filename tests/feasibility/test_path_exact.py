@@ -14,11 +14,11 @@ from __future__ import annotations
 import math
 import os
 
-import exact_reference
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import exact_reference
 
 import worldgen
 from worldgen import feasibility

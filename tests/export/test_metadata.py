@@ -17,7 +17,7 @@ import jsonschema
 import numpy as np
 import pytest
 import shapely
-from conftest import draft
+from support import draft
 
 import worldgen
 from worldgen.export import metadata

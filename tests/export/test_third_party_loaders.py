@@ -13,7 +13,7 @@ import os
 
 import pytest
 from lxml import etree
-from reftools_sdf import check_sdf
+from support.reftools_sdf import check_sdf
 
 import worldgen
 from worldgen.export.xml import safe_parser

@@ -12,9 +12,9 @@ import json
 import mujoco
 import numpy as np
 import pytest
-from conftest import draft
-from export_scenes import showcase_scene
-from reftools_mujoco import load
+from support import draft
+from support.reftools_mujoco import load
+from support.scenes import showcase_scene
 
 from worldgen.export import meshes, metadata, mjcf, urdf
 from worldgen.feasibility import FeasibilityReport

@@ -6,7 +6,7 @@ import shutil
 import subprocess
 from pathlib import Path
 
-from conftest import missing_tool
+from support import missing_tool
 
 __all__ = ["check_urdf"]
 

@@ -7,8 +7,8 @@ import math
 import mujoco
 import numpy as np
 import pytest
-from conftest import draft
-from export_scenes import showcase_scene
+from support import draft
+from support.scenes import showcase_scene
 
 import worldgen
 from worldgen.errors import ParameterError

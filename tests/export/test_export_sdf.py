@@ -15,8 +15,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import draft
-from reftools_sdf import check_sdf, dump_sdf
+from support import draft
+from support.reftools_sdf import check_sdf, dump_sdf
 
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.export.meshes import mesh_files
@@ -299,12 +299,12 @@ def test_output_bytes_are_deterministic(version):
 def test_output_bytes_match_in_a_fresh_process():
     code = (
         "import hashlib, sys; sys.path.insert(0, 'tests')\n"
-        "from conftest import draft\n"
+        "from support import draft\n"
         "from worldgen.export.sdf import to_sdf\n"
         "scene, _ = draft('cluttered', seed=0)\n"
         "print(hashlib.sha256(to_sdf(scene, '1.9') + to_sdf(scene, '1.6')).hexdigest())\n"
     )
-    root = Path(__file__).resolve().parent.parent
+    root = Path(__file__).resolve().parents[2]
     out = subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True, check=True)
     scene, _ = draft("cluttered", seed=0)
     here = hashlib.sha256(to_sdf(scene, "1.9") + to_sdf(scene, "1.6")).hexdigest()
@@ -348,7 +348,7 @@ def test_world_to_sdf_names_the_world_after_its_id():
 
 
 def test_a_missing_compiler_is_reported_not_crashed(monkeypatch):
-    import reftools_sdf
+    from support import reftools_sdf
 
     monkeypatch.setattr(reftools_sdf.shutil, "which", lambda name: None)
     assert reftools_sdf._build.__wrapped__() == "missing:g++ (to build tests/tools/sdf_check.cc)"

@@ -8,9 +8,9 @@ import textwrap
 import numpy as np
 import pytest
 import shapely
-from conftest import draft
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from support import draft
 
 import worldgen
 from worldgen.generators import get

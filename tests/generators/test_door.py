@@ -15,9 +15,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from lxml import etree
-from reftools_mujoco import load, load_and_step
-from reftools_sdf import check_sdf, dump_sdf
-from reftools_urdf import check_urdf
+from support.reftools_mujoco import load, load_and_step
+from support.reftools_sdf import check_sdf, dump_sdf
+from support.reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
@@ -151,7 +151,7 @@ def check_doors(meta: dict, params: dict) -> None:
     for task in meta["tasks"]:
         closed_on_path = any(d["state"] == "closed" and crosses_wall(task["path"]["waypoints"], d["passage"]["center"][0])
                              for d in meta["doors"])
-        if closed_on_path:  # a closed leaf in the way; ajar ones are judged by tests/test_requires_door_open.py
+        if closed_on_path:  # a closed leaf in the way; ajar ones are judged by tests/feasibility/test_requires_door_open.py
             assert task["requires_door_open"] is True
 
 

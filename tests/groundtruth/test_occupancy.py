@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import shapely
 import yaml
-from export_scenes import showcase_scene
+from support.scenes import showcase_scene
 
 import worldgen
 from worldgen.errors import ParameterError

@@ -16,13 +16,12 @@ import mujoco
 import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
-from lxml import etree
-from reftools_mujoco import load
+from support.checks import with_probe
+from support.reftools_mujoco import load
 
 import worldgen
 from worldgen.export.metadata import DOOR_TIME, TIME_FACTOR, TIME_MARGIN
 from worldgen.export.scenario import scenario
-from worldgen.export.xml import safe_parser
 
 #: Probe positions along the path (m). The union of discs this far apart falls short of the exact
 #: swept disc by at most STEP^2 / (8 r) = 2e-5 m for r = 0.15 m, far inside BAND.
@@ -30,14 +29,6 @@ STEP = 0.005
 #: Cases where the footprint passes a leaf closer than this to touching (either side) are not judged:
 #: sampling and MuJoCo's convex solver are not exact to the micrometre.
 BAND = 1e-3
-
-
-def _with_probe(mjcf: str, radius: float, height: float) -> str:
-    root = etree.fromstring(mjcf.encode(), safe_parser())
-    body = etree.SubElement(root.find("worldbody"), "body", name="probe", mocap="true", pos=f"0 0 {height / 2}")
-    etree.SubElement(body, "geom", name="probe", type="cylinder", size=f"{radius} {height / 2}",
-                     contype="0", conaffinity="0")
-    return etree.tostring(root).decode()
 
 
 def _samples(waypoints) -> np.ndarray:
@@ -53,7 +44,7 @@ def probe_distances(world) -> list[dict[str, float]]:
     """Per task: the smallest signed distance (m) from the probe to each leaf along the path."""
     meta = world.metadata
     robot = meta["robot"]
-    model = load(_with_probe(world.to_mjcf(), robot["radius"], robot["height"]))
+    model = load(with_probe(world.to_mjcf(), robot["radius"], robot["height"]))
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     for door in meta["doors"]:  # the hinges stand at their initial angles, as world.json says

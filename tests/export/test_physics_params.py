@@ -13,8 +13,8 @@ import json
 import mujoco
 import numpy as np
 import pytest
-from reftools_sdf import dump_sdf
-from reftools_urdf import check_urdf
+from support.reftools_sdf import dump_sdf
+from support.reftools_urdf import check_urdf
 
 import worldgen
 from worldgen.errors import ParameterError

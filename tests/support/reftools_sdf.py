@@ -18,11 +18,11 @@ import subprocess
 import tempfile
 from pathlib import Path
 
-from conftest import missing_tool
+from support import missing_tool
 
 __all__ = ["SOURCE", "checker", "check_sdf", "dump_sdf"]
 
-HERE = Path(__file__).resolve().parent
+HERE = Path(__file__).resolve().parents[1]
 SOURCE = HERE / "tools" / "sdf_check.cc"
 CACHE = HERE / ".cache"
 #: Generous: a cold build of the checker takes a few seconds here.
