@@ -195,14 +195,18 @@ MISTAKES = {
 }
 
 
+#: Well-formed requests for worlds that do not exist: one line, exit status 3 (not a usage mistake).
+NO_SUCH_WORLD = ("infeasible", "no path")
+
+
 @pytest.mark.parametrize("mistake", sorted(MISTAKES))
-def test_mistake_gives_one_line_and_status_2(tmp_path, mistake):
+def test_mistake_gives_one_line_and_status_2_or_3_when_no_such_world_exists(tmp_path, mistake):
     args, pattern = MISTAKES[mistake]
     out = tmp_path / "out"
     afile = tmp_path / "afile"
     afile.write_text("not a folder")
     r = run(*[a.format(out=out, file=afile) for a in args], cwd=tmp_path)
-    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert r.returncode == (3 if mistake in NO_SUCH_WORLD else 2), (r.stdout, r.stderr)
     assert "Traceback" not in r.stderr and r.stdout == ""
     lines = r.stderr.splitlines()
     assert len(lines) == 1, r.stderr
@@ -239,7 +243,7 @@ def test_failure_on_world_3_of_5_leaves_worlds_1_2_complete(tmp_path):
     start = _fragile_run_start()
     sets = [a for k, v in FRAGILE.items() for a in ("--set", f"{k}={v if not isinstance(v, list) else ','.join(map(str, v))}")]
     r = run("generate", "cluttered", "--seed", start, "--count", 5, *sets, "--out", tmp_path)
-    assert r.returncode == 2
+    assert r.returncode == 3
     assert "Traceback" not in r.stderr
     [line] = r.stderr.splitlines()
     assert line.startswith(f"error: no feasible 'cluttered' world for seed {start + 2} within max_attempts=1: ")

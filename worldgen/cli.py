@@ -2,8 +2,9 @@
 
 It parses, calls :func:`worldgen.generate` and :meth:`World.write`, and turns
 every :class:`~worldgen.errors.WorldgenError` (and every click usage error)
-into one line on stderr, ``error: ...``, with exit status 2: a user's mistake
-never shows a traceback. Anything else that escapes is a bug and keeps its
+into one line on stderr, ``error: ...``, with exit status 2 for a usage mistake
+and 3 when no such world exists (docs/cli.md): a user's mistake never shows a
+traceback. Anything else that escapes is a bug and keeps its
 traceback on purpose.
 """
 
@@ -19,7 +20,7 @@ from typing import Any, Optional, Sequence
 import click
 
 import worldgen
-from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError
+from worldgen.errors import EXIT_USAGE, InfeasibleError, OutputError, ParameterError, WorldgenError
 from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
@@ -27,8 +28,6 @@ from worldgen.seeding import MAX_SEED
 
 __all__ = ["main", "cli", "parse_settings", "describe_param"]
 
-#: Exit status of every user mistake (click's own usage errors use it too).
-USAGE_STATUS = 2
 _CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
@@ -304,7 +303,7 @@ def _one_line(text: str) -> str:
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Run the command line; return the exit status (0 ok, 2 user mistake)."""
+    """Run the command line; return the exit status (0 ok, 1 a check failed, 2 a usage mistake, 3 no such world)."""
     try:
         rv = cli.main(args=list(argv) if argv is not None else None, prog_name="worldgen", standalone_mode=False)
         return rv if isinstance(rv, int) else 0
@@ -315,10 +314,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         ctx = getattr(exc, "ctx", None)  # usage errors carry the command they are about; other errors do not
         hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
         click.echo(f"error: {_one_line(exc.format_message())}{hint}", err=True)
-        return USAGE_STATUS
+        return EXIT_USAGE
     except WorldgenError as exc:
         click.echo(f"error: {_one_line(str(exc))}", err=True)
-        return USAGE_STATUS
+        return exc.exit_status
     except click.Abort:
         click.echo("error: aborted", err=True)
         return 130

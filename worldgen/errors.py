@@ -23,8 +23,15 @@ __all__ = [
 QUOTE_LIMIT = 80
 
 
+#: Exit statuses of the ``worldgen`` command, documented in docs/cli.md.
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_NO_WORLD = 0, 1, 2, 3
+
+
 class WorldgenError(Exception):
     """Root of every error worldgen raises for a user's input or request."""
+
+    #: The command's exit status when this error ends it: a usage mistake.
+    exit_status = EXIT_USAGE
 
 
 class ParameterError(WorldgenError, ValueError):
@@ -42,8 +49,12 @@ class SceneError(WorldgenError, ValueError):
 class InfeasibleError(WorldgenError):
     """No drivable world was found within the attempt budget.
 
-    ``failures`` maps each feasibility check's name to how many draws failed it.
+    ``failures`` maps each feasibility check's name to how many draws failed it. Not a usage
+    mistake: the request was well formed and no such world exists, so the command says so with
+    its own exit status.
     """
+
+    exit_status = EXIT_NO_WORLD
 
     def __init__(self, message: str, failures: dict[str, int] | None = None):
         super().__init__(message)
