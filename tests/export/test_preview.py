@@ -16,7 +16,8 @@ from PIL import Image
 import worldgen
 from worldgen.cli import main
 from worldgen.errors import ParameterError
-from worldgen.export.preview import COLOURS, NOGO_ALPHA, PREVIEW_NAME, draw, layout, render
+from worldgen.export.preview import COLOURS, NOGO_ALPHA, draw, layout, render
+from worldgen.files import PREVIEW_NAME
 
 
 @pytest.fixture(scope="module")

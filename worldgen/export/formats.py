@@ -6,12 +6,11 @@ from typing import Iterable
 
 from worldgen.errors import ParameterError
 
-__all__ = ["FORMATS", "FILE_NAMES", "METADATA_NAME", "SDF_VERSIONS", "normalise_formats"]
+__all__ = ["FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats"]
 
 #: Every format a world can be written in, in the order they are written.
 FORMATS = ("sdf", "mjcf", "urdf")
 FILE_NAMES = {"sdf": "world.sdf", "mjcf": "world.mjcf.xml", "urdf": "world.urdf"}
-METADATA_NAME = "world.json"
 #: Versions the SDF exporter writes: 1.9 for Gazebo Fortress-Harmonic, 1.6 for Gazebo classic.
 SDF_VERSIONS = ("1.9", "1.6")
 

@@ -27,7 +27,6 @@ from __future__ import annotations
 import io
 import json
 import math
-import os
 from pathlib import Path
 from typing import Any, Mapping, Optional
 
@@ -43,7 +42,6 @@ from worldgen.export.preview_frame import (
     MAX_WIDTH,
     MIN_WIDTH,
     NOGO_ALPHA,
-    PREVIEW_NAME,
     SUPERSAMPLE,
     Layout,
     footer,
@@ -51,9 +49,10 @@ from worldgen.export.preview_frame import (
     text_font,
     title,
 )
+from worldgen.files import METADATA_NAME, PREVIEW_NAME, write_atomically
 from worldgen.scene.pose import rpy_matrix
 
-__all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
+__all__ = ["DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
            "Layout", "layout", "draw", "render", "blocking"]
 
 # -- geometry from the metadata ------------------------------------------------
@@ -282,7 +281,7 @@ def write_preview(folder, width: int = DEFAULT_WIDTH) -> Path:
     reader never sees half a picture. world.json is only read.
     """
     folder = Path(folder)
-    source = folder / "world.json"
+    source = folder / METADATA_NAME
     try:
         meta = json.loads(source.read_bytes())
     except FileNotFoundError:
@@ -297,11 +296,8 @@ def write_preview(folder, width: int = DEFAULT_WIDTH) -> Path:
         raise ParameterError(f"argument WORLD_DIR '{folder}': world.json cannot be drawn "
                              f"({type(exc).__name__}: {exc})") from None
     target = folder / PREVIEW_NAME
-    tmp = folder / f".{PREVIEW_NAME}.{os.getpid()}.tmp"
     try:
-        tmp.write_bytes(png)
-        os.replace(tmp, target)
+        write_atomically(target, png)
     except OSError as exc:
-        tmp.unlink(missing_ok=True)
         raise OutputError(f"cannot write '{target}': {exc.strerror or exc}") from None
     return target

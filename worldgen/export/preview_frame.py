@@ -13,10 +13,9 @@ from PIL import Image, ImageDraw, ImageFont
 
 from worldgen.errors import ParameterError
 
-__all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA", "SUPERSAMPLE",
+__all__ = ["DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA", "SUPERSAMPLE",
            "HIDDEN_ROLES", "Layout", "layout", "text_font", "title", "footer"]
 
-PREVIEW_NAME = "preview.png"
 DEFAULT_WIDTH = 800
 MIN_WIDTH, MAX_WIDTH = 400, 4000
 

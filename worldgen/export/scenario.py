@@ -33,9 +33,10 @@ from __future__ import annotations
 
 from typing import Any, Optional
 
-__all__ = ["SCENARIO_NAME", "scenario", "dumps", "files", "read"]
+from worldgen.files import SCENARIO_NAME
 
-SCENARIO_NAME = "scenario.yaml"
+__all__ = ["scenario", "dumps", "files", "read"]
+
 
 
 def scenario(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, Any]:

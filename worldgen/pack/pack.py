@@ -15,8 +15,9 @@ from pathlib import Path, PurePosixPath
 from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from worldgen.errors import ParameterError
+from worldgen.files import MANIFEST_NAME, METADATA_NAME
 from worldgen.pack.archive import ArchiveReader, is_archive
-from worldgen.pack.manifest import MANIFEST_NAME, METRICS, SCHEMA_ID, world_folder
+from worldgen.pack.manifest import METRICS, SCHEMA_ID, world_folder
 from worldgen.pack.where import parse_where
 
 __all__ = ["Pack", "PackWorld", "open_source"]
@@ -91,7 +92,7 @@ class PackWorld:
     @cached_property
     def metadata(self) -> dict:
         """world.json as a dict."""
-        return json.loads(self.read("world.json"))
+        return json.loads(self.read(METADATA_NAME))
 
 
 class Pack:

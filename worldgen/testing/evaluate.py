@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional
 
 from worldgen.errors import ParameterError
+from worldgen.files import SCENARIO_NAME
 from worldgen.testing.figures import Run, load
 from worldgen.testing.figures import run as run_figures
 
@@ -92,7 +93,7 @@ def scenario_of(world) -> dict:
 
     if isinstance(world, (str, Path)):
         return scenario.read(world)
-    if getattr(world, "path", None) is not None and (Path(world.path) / scenario.SCENARIO_NAME).is_file():
+    if getattr(world, "path", None) is not None and (Path(world.path) / SCENARIO_NAME).is_file():
         return scenario.read(world.path)
     return scenario.scenario(world)
 

@@ -26,6 +26,7 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.files import METADATA_NAME
 
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
@@ -85,7 +86,7 @@ def load(world) -> Ground:
         return Ground(world.metadata, read=world.read)
     if isinstance(world, (str, Path)):
         folder = Path(world)
-        path = folder / "world.json" if folder.is_dir() else folder
+        path = folder / METADATA_NAME if folder.is_dir() else folder
         try:
             meta = json.loads(path.read_text())
         except (OSError, ValueError) as exc:
