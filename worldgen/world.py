@@ -8,7 +8,8 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional, Sequence
 
-from worldgen.errors import OutputError, ParameterError
+from worldgen.errors import OutputError
+from worldgen.export import formats as formats_table
 from worldgen.export.formats import FILE_NAMES, FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.files import METADATA_NAME, PREVIEW_NAME, refuse_other_world, write_folder_atomically
 from worldgen.scene import Robot, Scene, Task
@@ -105,20 +106,7 @@ class World:
         return text
 
     def _render(self, fmt: str, sdf_version: str) -> str:
-        if fmt == "sdf":
-            from worldgen.export import sdf  # which checks the version
-            scene = self.scene
-            if scene.movers and not self.params.get("sdf_actors", True):
-                # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.
-                scene = scene.with_movers(())
-            return sdf.to_sdf(scene, version=sdf_version, name=self.world_id).decode()
-        if fmt == "mjcf":
-            from worldgen.export import mjcf
-            return mjcf.to_mjcf(self.scene, name=self.world_id).decode()
-        if fmt == "urdf":
-            from worldgen.export import urdf
-            return urdf.to_urdf(self.scene, name=self.world_id).decode()
-        raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {fmt!r}")
+        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version).decode()
 
     def mesh_files(self) -> dict[str, bytes]:
         """Mesh files the exported formats refer to: relative path -> bytes."""
@@ -134,7 +122,7 @@ class World:
         """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
         formats = normalise_formats(formats)
         files = {fmt: (FILE_NAMES[fmt], self.export(fmt, sdf_version).encode()) for fmt in formats}
-        if "sdf" in formats or "urdf" in formats:
+        if formats_table.uses_meshes(formats):
             for rel, data in self.mesh_files().items():
                 files[f"mesh:{rel}"] = (rel, data)
         from worldgen.groundtruth import truth

@@ -103,7 +103,7 @@ def episode_world(world) -> EpisodeWorld:
     from worldgen.testing.figures import Ground
 
     task = _task_of_world(world)
-    movers = [mover_entry(m) for m in world.scene.movers]
+    movers = [mover_entry(m, world.params) for m in world.scene.movers]
     robot = world.robot
     light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": movers,
              "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance}}

@@ -19,14 +19,14 @@ from typing import Any, Mapping
 import numpy as np
 import shapely
 
+from worldgen.export.formats import movers_note
 from worldgen.floats import round_float
 from worldgen.groundtruth import truth
 from worldgen.params import COMMON_PARAMS
 from worldgen.scene.doors import door_records, leaves_in_the_way
 from worldgen.scene.footprint import scene_footprints
 
-__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "time_limit", "free_area_ratio", "mover_entry",
-           "FORMATS_NOTE"]
+__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "time_limit", "free_area_ratio", "mover_entry"]
 
 #: The value of world.json's ``schema`` field; a breaking change bumps the number.
 SCHEMA_ID = "worldgen.world/1"
@@ -66,7 +66,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
         "entities": [_entity(scene, node) for node in scene.nodes],
         "doors": door_records(scene),
-        "dynamic_obstacles": [mover_entry(m) for m in scene.movers],
+        "dynamic_obstacles": [mover_entry(m, world.params) for m in scene.movers],
         "tasks": [_task(task, path, speed, _in_the_way(world, path)) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
@@ -109,19 +109,16 @@ def dumps(meta: Mapping[str, Any]) -> str:
     return _emit(meta, "") + "\n"
 
 
-#: How each exported format carries a mover; URDF cannot express a scripted motion.
-FORMATS_NOTE = {"sdf": "actor", "mjcf": "mocap_body", "urdf": None}
-
-
-def mover_entry(mover) -> dict:
-    """The mover's ``dynamic_obstacles[]`` entry of world.json."""
+def mover_entry(mover, params: Mapping[str, Any]) -> dict:
+    """The mover's ``dynamic_obstacles[]`` entry of world.json, for a world of ``params`` (which say
+    whether the SDF carries movers)."""
     return {
         "name": mover.name,
         "radius": mover.radius,
         "height": mover.height,
         "trajectory": [list(row) for row in mover.trajectory],
         "loop": mover.loop,
-        "formats": dict(FORMATS_NOTE),
+        "formats": movers_note(params),
     }
 
 
