@@ -34,6 +34,7 @@ from __future__ import annotations
 from typing import Any, Iterable, Optional
 
 from worldgen.export.formats import FILE_NAMES, FORMATS, normalise_formats
+from worldgen.export.tasks import leaves_on_path, task_entry
 from worldgen.files import SCENARIO_NAME
 
 __all__ = ["scenario", "dumps", "files", "read"]
@@ -42,15 +43,14 @@ __all__ = ["scenario", "dumps", "files", "read"]
 
 def scenario(world, formats: Iterable[str] = FORMATS) -> dict[str, Any]:
     """The scenario spec of ``world`` as a plain dict; ``world`` names the first written of SDF, MJCF, URDF."""
-    from worldgen.export.metadata import _default, _in_the_way, time_limit
     from worldgen.floats import round_float
 
-    speed = world.params.get("robot_speed", _default("robot_speed"))
     paths = list(world.feasibility.paths) + [None] * len(world.tasks)
     tasks = []
     for task, path in zip(world.tasks, paths):
-        leaves = _in_the_way(world, path)
-        limit: Optional[float] = None if path is None else round_float(time_limit(path.length, speed, len(leaves)))
+        leaves = leaves_on_path(world, path)
+        seconds = task_entry(world, task, path, leaves)["time_limit"]
+        limit: Optional[float] = None if seconds is None else round_float(seconds)
         success = [{"type": "robot_reaches_waypoint", "waypoint": [round_float(task.goal.x), round_float(task.goal.y)],
                     "tolerance": round_float(task.goal_tolerance)}]
         failure: list[dict[str, Any]] = [{"type": "collision"}]

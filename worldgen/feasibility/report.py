@@ -9,7 +9,7 @@ import numpy as np
 
 __all__ = ["Check", "TaskPath", "FeasibilityReport", "REQUIRED_CHECKS"]
 
-#: Checks every report carries, in this order (METADATA.md names them).
+#: Checks every report carries, in this order (docs/world-json.md names them).
 REQUIRED_CHECKS = ("inside_bounds", "spawn_free", "goal_free", "path_exists", "path_clearance")
 
 

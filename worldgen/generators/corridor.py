@@ -17,7 +17,7 @@ spawn and goal), so every gap on the way is at least ``min_passage`` wide.
 Width: a corridor narrower than 2 x (robot_radius + clearance) cannot be driven,
 and :func:`check` says so with the numbers (:class:`~worldgen.errors.InfeasibleError`).
 The checker plans exactly in the continuous plane with a safety margin of
-:data:`~worldgen.feasibility.check.SAFETY` (0.1 mm) on each side, so every
+:data:`~worldgen.scene.footprint.SAFETY` (0.1 mm) on each side, so every
 corridor from :func:`proven_width` = 2 x (robot_radius + clearance + SAFETY)
 (plus the walls' rounding to 6 decimals) on is proven passable: 1 mm more than
 the footprint needs is enough. ``generate(..., allow_infeasible=True)`` still
@@ -32,12 +32,12 @@ from typing import Any, Mapping
 import numpy as np
 
 from worldgen.errors import InfeasibleError, ParameterError
-from worldgen.feasibility.check import SAFETY
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.room import FLOOR_RGBA, FLOOR_THICKNESS, WALL_RGBA
 from worldgen.params import Param
 from worldgen.scene import Box, Material, Node, Physics, Pose, Scene, Task
+from worldgen.scene.footprint import SAFETY
 
 __all__ = ["SPEC", "build", "check", "layout", "proven_width", "Layout"]
 
