@@ -68,7 +68,6 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
                 for c in report.checks
             ],
             "narrowest_passage": narrowest,
-            "resolution": finite_or_none(report.resolution),
             "attempts": int(world.attempts),
             "informational": [
                 {"name": c.name, "ok": bool(c.ok), "value": finite_or_none(c.value), "detail": c.detail}

@@ -26,7 +26,7 @@ from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.passage import narrowest_passage
 from worldgen.feasibility.planner import Planner
-from worldgen.feasibility.report import Check, FeasibilityReport, TaskPath
+from worldgen.feasibility.report import CHECKER, Check, FeasibilityReport, TaskPath
 from worldgen.feasibility.route import waypoints
 from worldgen.feasibility.verify import verify_path
 from worldgen.floats import DECIMALS
@@ -141,7 +141,7 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     informational = ()
     if door_joints(initial):
         informational = (_reachable_initial(initial, tasks, robot),)
-    return FeasibilityReport(checks, tuple(paths), narrowest, "fcl", None, informational)
+    return FeasibilityReport(checks, tuple(paths), narrowest, CHECKER, informational)
 
 
 def _reachable_initial(initial: Scene, tasks, robot: Robot) -> Check:
