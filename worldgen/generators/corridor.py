@@ -55,6 +55,8 @@ _SEGMENT_COUNT = {"straight": 1, "L": 2, "U": 3}
 ZIGZAG_SEGMENTS = 4
 
 PARAMS = (
+    # One task, from one end of the corridor to the other: a request for more is refused, not dropped.
+    Param("n_tasks", "int", 1, "spawn/goal pairs per world: one here, from one end to the other", 1, 1),
     Param("shape", "choice", "straight", "layout of the centreline", choices=("straight", "L", "U", "zigzag")),
     Param("width", "float", 1.5, "free width between the side walls", 0.05, 50.0, unit="m"),
     Param("length", "float", 10.0, "centreline length of every segment (unless 'segments' is given)",
@@ -221,6 +223,15 @@ def check(params: Mapping[str, Any]) -> None:
             raise ParameterError(
                 f"parameter 'n_obstacles' must be 0 in a corridor {w:g} m wide: obstacles need width >= passage + "
                 f"0.05 = {g + 0.05:.3f} m (or set 'min_passage' as low as {proven:.5f}), got {params['n_obstacles']!r}")
+    if params["n_obstacles"]:
+        shortest = params["obstacle_length"][0] + 2 * g
+        longest = max(hi - lo for lo, hi in _usable(lay, params))
+        if longest < shortest:
+            raise ParameterError(
+                f"parameter 'n_obstacles' must be 0 in this corridor: an obstacle needs {shortest:.3g} m of a leg "
+                f"({params['obstacle_length'][0]:g} m long and {g:g} m of passage on each side), and the longest leg "
+                f"has {max(longest, 0.0):.3g} m left after the spawn's and goal's room; lengthen the corridor, "
+                f"got {params['n_obstacles']!r}")
     if params["side_openings"] and params["opening_width"] > max(b - a for a, b in
                                                                  (lay.straight_part(i) for i in range(k))):
         raise ParameterError(f"parameter 'opening_width' must fit in a leg's straight part, got {params['opening_width']!r}")
@@ -235,6 +246,22 @@ def check(params: Mapping[str, Any]) -> None:
             f"from {proven:.5f} m wide")
 
 
+def _usable(lay, params: Mapping[str, Any]) -> list[tuple[float, float]]:
+    """Per leg, the along-leg interval where openings and obstacles may go: the straight part, less the
+    spawn's and the goal's room on the first and last legs."""
+    e, inflation = _end_offset(params), params["robot_radius"] + params["clearance"]
+    k = len(lay.lengths)
+    usable = []
+    for i in range(k):
+        lo, hi = lay.straight_part(i)
+        if i == 0:
+            lo = e + inflation
+        if i == k - 1:
+            hi = lay.lengths[i] - e - inflation
+        usable.append((lo, hi))
+    return usable
+
+
 def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     opening_rng, obstacle_rng = rng.spawn(2)
     lay = layout(params)
@@ -244,16 +271,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     k = len(lay.lengths)
     e = _end_offset(params)
     g = _passage(params, proven_width(params))
-    inflation = params["robot_radius"] + params["clearance"]
-    # Per leg: the along-leg intervals already taken (openings, obstacles) and where things may go.
-    usable = []
-    for i in range(k):
-        lo, hi = lay.straight_part(i)
-        if i == 0:
-            lo = e + inflation
-        if i == k - 1:
-            hi = lay.lengths[i] - e - inflation
-        usable.append((lo, hi))
+    usable = _usable(lay, params)
     taken: list[list[tuple[float, float]]] = [[] for _ in range(k)]
 
     openings: list[list[tuple[float, float]]] = [[] for _ in range(2 * k)]  # per (leg, side)
@@ -261,8 +279,9 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     for _ in range(params["side_openings"]):
         spot = _place(opening_rng, usable, taken, lambda: ow, 0.2)
         if spot is None:
+            n = params["side_openings"]
             return Draft(None, rejected="opening_placement",
-                         detail=f"could not fit {params['side_openings']} openings of {ow:g} m in the side walls")
+                         detail=f"could not fit {n} side opening{'s' if n != 1 else ''} of {ow:g} m in the side walls")
         leg, a, b = spot
         side = int(opening_rng.integers(2))
         openings[2 * leg + side].append((a, b))
@@ -275,8 +294,12 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     for j in range(params["n_obstacles"]):
         spot = _place(obstacle_rng, usable, taken, lambda: obstacle_rng.uniform(lo_len, hi_len), g)
         if spot is None:
+            n = params["n_obstacles"]
+            room = sum(max(hi - lo, 0.0) for lo, hi in usable)
             return Draft(None, rejected="obstacle_placement",
-                         detail=f"could not fit {params['n_obstacles']} obstacles {g:g} m apart along the corridor")
+                         detail=f"placed {j} of {n} obstacle{'s' if n != 1 else ''} {lo_len:g}-{hi_len:g} m long, each "
+                                f"{g:g} m from the others and from the corridor's ends, in {room:.3g} m of usable "
+                                f"corridor (the rest is kept free at the spawn and goal)")
         leg, a, b = spot
         side = 1.0 if obstacle_rng.random() < 0.5 else -1.0
         depth = round_float(obstacle_rng.uniform(min(0.1, w - g), w - g))
