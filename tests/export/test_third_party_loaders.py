@@ -1,6 +1,6 @@
 """Third-party consumers load what worldgen writes: Drake every generator's SDF (movers left out with
 ``sdf_actors=false``) and URDF; pybullet every URDF. pybullet's ``loadSDF`` rejects door worlds (it
-cannot attach a joint to ``world``), so the README sends pybullet users to the URDF.
+cannot attach a joint to ``world``; the SDF is valid), so docs/formats.md sends pybullet users to the URDF.
 
 Both are in the ``test`` extra; without them the tests skip, except on CI (CI=true), where a missing
 consumer is a failure.
