@@ -21,6 +21,7 @@ from numbers import Integral
 from typing import Any, Optional, Sequence, Union
 
 from worldgen.errors import MissingDependencyError, ParameterError
+from worldgen.floats import finite_or_none  # None where scipy gives NaN or an infinity: JSON has neither
 
 __all__ = [
     "INSTALL_HINT", "FIGURES", "NOTE", "require_scipy",
@@ -135,11 +136,6 @@ def _var(xs: Sequence[float]) -> float:
     return math.fsum((x - m) ** 2 for x in xs) / (len(xs) - 1)
 
 
-def _finite(x: Any) -> Optional[float]:
-    """A float for JSON: None where scipy gives NaN or an infinity."""
-    return float(x) if x is not None and math.isfinite(float(x)) else None
-
-
 def welch(a: Sequence[float], b: Sequence[float], confidence: float = 0.95) -> dict[str, Any]:
     """Welch's t-test (unequal variances) of mean(A) - mean(B), its confidence interval, and Hedges' g.
 
@@ -163,8 +159,8 @@ def welch(a: Sequence[float], b: Sequence[float], confidence: float = 0.95) -> d
         warnings.filterwarnings("ignore", "Precision loss occurred", RuntimeWarning)
         res = st.ttest_ind(a, b, equal_var=False)
     ci = res.confidence_interval(confidence_level=confidence)
-    out.update(t=_finite(res.statistic), df=_finite(res.df), p=_finite(res.pvalue),
-               ci_low=_finite(ci.low), ci_high=_finite(ci.high))
+    out.update(t=finite_or_none(res.statistic), df=finite_or_none(res.df), p=finite_or_none(res.pvalue),
+               ci_low=finite_or_none(ci.low), ci_high=finite_or_none(ci.high))
     pooled = math.sqrt(((na - 1) * va + (nb - 1) * vb) / (na + nb - 2))
     d = diff / pooled
     df = na + nb - 2
@@ -180,7 +176,7 @@ def mann_whitney(a: Sequence[float], b: Sequence[float]) -> dict[str, Any]:
         return {"u": len(a) * len(b) / 2, "p": 1.0, "rank_biserial": 0.0}
     res = st.mannwhitneyu(a, b, alternative="two-sided")
     u = float(res.statistic)  # U of A: pairs where A is larger, ties counted half
-    return {"u": u, "p": _finite(res.pvalue), "rank_biserial": 2.0 * u / (len(a) * len(b)) - 1.0}
+    return {"u": u, "p": finite_or_none(res.pvalue), "rank_biserial": 2.0 * u / (len(a) * len(b)) - 1.0}
 
 
 def fisher(ka: int, na: int, kb: int, nb: int, confidence: float = 0.95) -> dict[str, Any]:
