@@ -89,6 +89,9 @@ def test_success_rate_with_confidence_19_of_20(wall):
     assert row["required"] == ">= 0.95 (95% conf.)" and row["measured"] == f"{c.measured:.6g} (19/20)"
     assert ("navigation.success_rate: one-sided 95% Clopper-Pearson lower bound of 19/20 = 0.7839; "
             "73 more clean runs would make it pass") in str(report).splitlines()
+    row = report.to_dict()["criteria"][0]  # what report.json carries for a judge or a CI script
+    assert {k: row[k] for k in ("confidence", "successes", "runs", "more_clean_runs", "passed")} == \
+        {"confidence": 0.95, "successes": 19, "runs": 20, "more_clean_runs": 73, "passed": False}
     # The same runs against the point estimate pass, as before.
     assert evaluate(clean_runs(wall, 19) + [(crash, wall)], {"navigation": {"success_rate": 0.95}}).passed
 

@@ -7,6 +7,8 @@ import warnings
 
 import pytest
 import scipy.stats
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from worldgen.errors import MissingDependencyError, ParameterError
 from worldgen.testing import stats
@@ -55,6 +57,19 @@ def test_runs_needed_is_the_smallest(k, n, minimum, confidence):
     assert m > 0
     assert lower_bound_by_bisection(k + m, n + m, confidence) >= minimum - 1e-12
     assert lower_bound_by_bisection(k + m - 1, n + m - 1, confidence) < minimum
+
+
+@settings(max_examples=60, deadline=None)
+@given(n=st.integers(0, 300), data=st.data(), minimum=st.floats(0.01, 0.99), confidence=st.floats(0.5, 0.995))
+def test_runs_needed_is_minimal_everywhere(n, data, minimum, confidence):
+    k = data.draw(st.integers(0, n))
+    m = stats.runs_needed(k, n, minimum, confidence)
+
+    def bound(k, n):  # straight from scipy's beta quantile, not through the function under test
+        return 0.0 if k == 0 else scipy.stats.beta.ppf(1 - confidence, k, n - k + 1)
+
+    assert bound(k + m, n + m) >= minimum
+    assert m == 0 or bound(k + m - 1, n + m - 1) < minimum
 
 
 def test_runs_needed_for_19_of_20():
