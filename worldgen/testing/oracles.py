@@ -18,6 +18,7 @@ from worldgen.testing.figures import (
     Ground,
     Run,
     as_trajectory,
+    barn_score,
     collisions,
     load,
     min_clearance,
@@ -32,5 +33,5 @@ from worldgen.testing.figures import (
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "min_separation", "run", "evaluate",
+    "collisions", "min_separation", "run", "evaluate", "barn_score",
 ]
