@@ -15,7 +15,8 @@ from support.checks import recheck, reference_tools
 
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
-from worldgen.generators.corridor import layout, proven_width
+from worldgen.generators.corridor import proven_width
+from worldgen.generators.corridor_layout import layout
 
 #: The passage figure is the checker's: connectivity between cell centres puts the radius within
 #: half a cell diagonal, so the width within sqrt(2) cells, plus the bisection's 1/8 cell

@@ -1,9 +1,11 @@
 """``worldgen.Pack``: a built pack (folder or archive), read through its manifest.
 
-    >>> pack = worldgen.Pack.open("packs/small")          # or "packs/small.tar.gz"
-    >>> len(pack), pack[0].world_id, pack["cluttered-s3-1f3a9c0b"].seed
-    >>> hard = pack.filter("narrowest_passage < 1.0 and obstacle_count >= 5")
-    >>> meta = hard[0].metadata                            # its world.json as a dict
+Usage, on a pack built with ``worldgen pack build`` (docs/packs.md)::
+
+    pack = worldgen.Pack.open("packs/small")          # or "packs/small.tar.gz"
+    len(pack), pack[0].world_id, pack["cluttered-s3-1f3a9c0b"].seed
+    hard = pack.filter("narrowest_passage < 1.0 and obstacle_count >= 5")
+    meta = hard[0].metadata                            # its world.json as a dict
 """
 
 from __future__ import annotations

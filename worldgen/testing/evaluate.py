@@ -1,9 +1,11 @@
 """Judge many runs in many worlds against acceptance criteria read from YAML.
 
-    >>> report = evaluate([(trajectory, world), ...], "criteria.yaml")
-    >>> print(report)                 # a table: criterion, required, measured, verdict, by how much
-    >>> report.passed, report.failures
-    >>> report.write_csv("report.csv"); report.write_json("report.json")
+Usage (an example that runs is in :mod:`worldgen.testing.oracles`)::
+
+    report = evaluate([(trajectory, world), ...], "criteria.yaml")
+    print(report)                 # a table: criterion, required, measured, verdict, by how much
+    report.passed, report.failures
+    report.write_csv("report.csv"); report.write_json("report.json")
 
 The criteria file's sections and keys are in :mod:`worldgen.testing.criteria`.
 What is averaged over what, so that a crash cannot flatter a figure:

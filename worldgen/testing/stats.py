@@ -3,9 +3,12 @@
 Pure functions over counts and samples, returning plain dicts, on :mod:`scipy.stats`
 (the optional ``stats`` extra, imported on first use):
 
-    >>> success_bound(19, 20, minimum=0.95, confidence=0.95)["lower_bound"]   # 0.7839
+    >>> round(success_bound(19, 20, minimum=0.95, confidence=0.95)["lower_bound"], 4)
+    0.7839
     >>> runs_needed(19, 20, minimum=0.95, confidence=0.95)                    # clean runs to add
-    >>> compare_runs(runs_a, runs_b)     # Welch, Mann-Whitney U, Fisher, with effect sizes and counts
+    73
+    >>> compare_runs(runs_a, runs_b)  # doctest: +SKIP
+    ... # Welch, Mann-Whitney U, Fisher, with effect sizes and counts (docs/statistics.md)
 
 A success rate over n runs is a binomial proportion; its one-sided Clopper-Pearson lower
 bound at confidence c is the (1 - c) quantile of Beta(k, n - k + 1) (0 when k = 0): the
