@@ -17,6 +17,7 @@ to 6 decimals. Half of it pays for the polygons written round arcs.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Optional, Sequence
 
 import numpy as np
@@ -58,90 +59,106 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     """
     initial = scene
     scene = open_scene(initial)  # the scene itself when it has no door to open
-    bounds = scene.bounds
     colliders = Colliders(scene)
     initial_colliders = colliders if scene is initial else Colliders(initial)
-    obstacles = Obstacles2D.from_footprints(robot_footprints(scene, robot))
     spawns = np.array([[t.spawn.x, t.spawn.y] for t in tasks], dtype=float).reshape(-1, 2)
     goals = np.array([[t.goal.x, t.goal.y] for t in tasks], dtype=float).reshape(-1, 2)
-    radius = robot.inflation + SAFETY
-
-    # inside_bounds: the inflated disc at spawn and goal within the floor area.
-    margins = np.minimum(_bounds_margin(bounds, spawns), _bounds_margin(bounds, goals)) - robot.inflation
-    inside = _aggregate("inside_bounds", tasks, margins, margins >= 0,
-                        lambda i: f"{tasks[i].id}: spawn {_p(spawns[i])} / goal {_p(goals[i])} leave the "
-                                  f"{robot.inflation:g} m disc {-margins[i]:.4f} m outside the bounds",
-                        lambda v: f"smallest margin {v:.4f} m")
-
-    # spawn_free / goal_free with FCL.
-    free = {}
-    for label, pts in (("spawn", spawns), ("goal", goals)):
-        near = [colliders.nearest(robot, p[None, :]) for p in pts]
-        if initial_colliders is not colliders:  # doors: free both as they start and opened
-            near = [min(n, initial_colliders.nearest(robot, p[None, :]), key=lambda m: m.distance)
-                    for n, p in zip(near, pts)]
-        values = np.array([n.distance for n in near])
-        free[label] = _aggregate(
-            f"{label}_free", tasks, values, values >= robot.clearance,
-            lambda i, near=near, pts=pts, label=label: (
-                f"{tasks[i].id}: {label} {_p(pts[i])} is {near[i].distance:.4f} m from {near[i].name} "
-                f"(needs >= {robot.clearance:g} m)"),
-            lambda v: f"smallest clearance {v:.4f} m")
-
-    # The exact shortest path of each task in the configuration space of the disc.
-    cspace = ConfigSpace.build(obstacles, radius, bounds)
-    planner = Planner(cspace)
-    slack = cspace.points_clearance(np.vstack([spawns, goals]))
-    start_slack, goal_slack = slack[: len(tasks)], slack[len(tasks):]
-    paths: list[Optional[TaskPath]] = []
-    passages: list[float] = []
-    no_path: list[str] = []
-    clearances = np.full(len(tasks), np.nan)
-    clearance_detail: dict[int, str] = {}
-    for i, task in enumerate(tasks):
-        s, g = spawns[i], goals[i]
-        if start_slack[i] < 0 or goal_slack[i] < 0:
-            paths.append(None)
-            which = "spawn" if start_slack[i] < 0 else "goal"
-            no_path.append(f"{task.id}: the {which} is not free for a {robot.inflation:g} m disc")
-            continue
-        route = planner.shortest(s, g)
-        if route is None:
-            paths.append(None)
-            no_path.append(f"{task.id}: no path for a {robot.inflation:g} m disc from {_p(s)} to {_p(g)}")
-            continue
-        line = np.round(waypoints(cspace, route, SAFETY / 2), DECIMALS)
-        line[0], line[-1] = s, g
-        nearest = verify_path(colliders, robot, line)
-        clearance = nearest.distance
-        if not np.isfinite(clearance):  # nothing to hit: the floor's edge is the only limit
-            clearance = float(_bounds_margin(bounds, line).min() - robot.radius)
-        clearances[i] = clearance
-        if clearance < robot.clearance:
-            clearance_detail[i] = (f"{task.id}: the path passes {clearance:.4f} m from {nearest.name} at "
-                                   f"{_p(nearest.where)} (needs >= {robot.clearance:g} m)")
-        paths.append(TaskPath(task.id, line, route.length, clearance))
-        passages.append(narrowest_passage(obstacles, bounds, s, g))
-
-    found = [p for p in paths if p is not None]
-    path_exists = Check("path_exists", not no_path,
-                        max(p.length for p in found) if found and not no_path else None,
-                        "; ".join(no_path) if no_path else f"{len(found)} path(s), longest {max(p.length for p in found):.3f} m"
-                        if found else "no tasks")
-    if no_path:
-        path_clearance = Check("path_clearance", False,
-                               float(np.nanmin(clearances)) if found else None,
-                               "no path to verify for " + ", ".join(d.split(":")[0] for d in no_path))
-    else:
-        path_clearance = _aggregate("path_clearance", tasks, clearances, clearances >= robot.clearance,
-                                    lambda i: clearance_detail.get(i, ""),
-                                    lambda v: f"smallest FCL clearance {v:.4f} m along the swept paths")
-    checks = (inside, free["spawn"], free["goal"], path_exists, path_clearance)
-    narrowest = min(passages) if passages and not no_path else None
+    inside = _inside_bounds(scene.bounds, tasks, robot, spawns, goals)
+    free = {label: _free(label, tasks, robot, pts, colliders, initial_colliders)
+            for label, pts in (("spawn", spawns), ("goal", goals))}
+    plans = _Plans.of(scene, tasks, robot, colliders, spawns, goals)
+    checks = (inside, free["spawn"], free["goal"], plans.path_exists(), plans.path_clearance(tasks, robot))
+    narrowest = min(plans.passages) if plans.passages and not plans.no_path else None
     informational = ()
     if door_joints(initial):
         informational = (_reachable_initial(initial, tasks, robot),)
-    return FeasibilityReport(checks, tuple(paths), narrowest, CHECKER, informational)
+    return FeasibilityReport(checks, tuple(plans.paths), narrowest, CHECKER, informational)
+
+
+def _inside_bounds(bounds, tasks, robot: Robot, spawns: np.ndarray, goals: np.ndarray) -> Check:
+    """inside_bounds: the inflated disc at spawn and goal within the floor area."""
+    margins = np.minimum(_bounds_margin(bounds, spawns), _bounds_margin(bounds, goals)) - robot.inflation
+    return _aggregate("inside_bounds", tasks, margins, margins >= 0,
+                      lambda i: f"{tasks[i].id}: spawn {_p(spawns[i])} / goal {_p(goals[i])} leave the "
+                                f"{robot.inflation:g} m disc {-margins[i]:.4f} m outside the bounds",
+                      lambda v: f"smallest margin {v:.4f} m")
+
+
+def _free(label: str, tasks, robot: Robot, pts: np.ndarray, colliders, initial_colliders) -> Check:
+    """spawn_free / goal_free with FCL; with doors, free both as they start and opened."""
+    near = [colliders.nearest(robot, p[None, :]) for p in pts]
+    if initial_colliders is not colliders:
+        near = [min(n, initial_colliders.nearest(robot, p[None, :]), key=lambda m: m.distance)
+                for n, p in zip(near, pts)]
+    values = np.array([n.distance for n in near])
+    return _aggregate(
+        f"{label}_free", tasks, values, values >= robot.clearance,
+        lambda i: (f"{tasks[i].id}: {label} {_p(pts[i])} is {near[i].distance:.4f} m from {near[i].name} "
+                   f"(needs >= {robot.clearance:g} m)"),
+        lambda v: f"smallest clearance {v:.4f} m")
+
+
+@dataclass
+class _Plans:
+    """Each task's exact shortest path in the configuration space of the disc, proven with FCL."""
+
+    paths: list[Optional[TaskPath]] = field(default_factory=list)
+    passages: list[float] = field(default_factory=list)
+    no_path: list[str] = field(default_factory=list)
+    clearances: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    clearance_detail: dict[int, str] = field(default_factory=dict)
+
+    @classmethod
+    def of(cls, scene: Scene, tasks, robot: Robot, colliders, spawns: np.ndarray, goals: np.ndarray) -> "_Plans":
+        bounds = scene.bounds
+        obstacles = Obstacles2D.from_footprints(robot_footprints(scene, robot))
+        cspace = ConfigSpace.build(obstacles, robot.inflation + SAFETY, bounds)
+        planner = Planner(cspace)
+        slack = cspace.points_clearance(np.vstack([spawns, goals]))
+        start_slack, goal_slack = slack[: len(tasks)], slack[len(tasks):]
+        out = cls(clearances=np.full(len(tasks), np.nan))
+        for i, task in enumerate(tasks):
+            s, g = spawns[i], goals[i]
+            if start_slack[i] < 0 or goal_slack[i] < 0:
+                out.paths.append(None)
+                which = "spawn" if start_slack[i] < 0 else "goal"
+                out.no_path.append(f"{task.id}: the {which} is not free for a {robot.inflation:g} m disc")
+                continue
+            route = planner.shortest(s, g)
+            if route is None:
+                out.paths.append(None)
+                out.no_path.append(f"{task.id}: no path for a {robot.inflation:g} m disc from {_p(s)} to {_p(g)}")
+                continue
+            line = np.round(waypoints(cspace, route, SAFETY / 2), DECIMALS)
+            line[0], line[-1] = s, g
+            nearest = verify_path(colliders, robot, line)
+            clearance = nearest.distance
+            if not np.isfinite(clearance):  # nothing to hit: the floor's edge is the only limit
+                clearance = float(_bounds_margin(bounds, line).min() - robot.radius)
+            out.clearances[i] = clearance
+            if clearance < robot.clearance:
+                out.clearance_detail[i] = (f"{task.id}: the path passes {clearance:.4f} m from {nearest.name} at "
+                                           f"{_p(nearest.where)} (needs >= {robot.clearance:g} m)")
+            out.paths.append(TaskPath(task.id, line, route.length, clearance))
+            out.passages.append(narrowest_passage(obstacles, bounds, s, g))
+        return out
+
+    def path_exists(self) -> Check:
+        found = [p for p in self.paths if p is not None]
+        if self.no_path:
+            return Check("path_exists", False, None, "; ".join(self.no_path))
+        longest = max((p.length for p in found), default=None)
+        return Check("path_exists", True, longest,
+                     f"{len(found)} path(s), longest {longest:.3f} m" if found else "no tasks")
+
+    def path_clearance(self, tasks, robot: Robot) -> Check:
+        if self.no_path:
+            found = any(p is not None for p in self.paths)
+            return Check("path_clearance", False, float(np.nanmin(self.clearances)) if found else None,
+                         "no path to verify for " + ", ".join(d.split(":")[0] for d in self.no_path))
+        return _aggregate("path_clearance", tasks, self.clearances, self.clearances >= robot.clearance,
+                          lambda i: self.clearance_detail.get(i, ""),
+                          lambda v: f"smallest FCL clearance {v:.4f} m along the swept paths")
 
 
 def _reachable_initial(initial: Scene, tasks, robot: Robot) -> Check:

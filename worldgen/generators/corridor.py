@@ -132,19 +132,19 @@ def check(params: Mapping[str, Any]) -> None:
             raise ParameterError(
                 f"parameter 'n_obstacles' must be 0 in a corridor {w:g} m wide: obstacles need width >= passage + "
                 f"0.05 = {g + 0.05:.3f} m (or set 'min_passage' as low as {proven:.5f}), got {params['n_obstacles']!r}")
-    if params["n_obstacles"]:
-        shortest = params["obstacle_length"][0] + 2 * g
-        longest = max(hi - lo for lo, hi in _usable(lay, params))
-        if longest < shortest:
-            raise ParameterError(
-                f"parameter 'n_obstacles' must be 0 in this corridor: an obstacle needs {shortest:.3g} m of a leg "
-                f"({params['obstacle_length'][0]:g} m long and {g:g} m of passage on each side), and the longest leg "
-                f"has {max(longest, 0.0):.3g} m left after the spawn's and goal's room; lengthen the corridor, "
-                f"got {params['n_obstacles']!r}")
     if params["side_openings"] and params["opening_width"] > max(b - a for a, b in
                                                                  (lay.straight_part(i) for i in range(k))):
         raise ParameterError(f"parameter 'opening_width' must fit in a leg's straight part, got {params['opening_width']!r}")
     # Last, so that allow_infeasible (which skips this error) still had every other check.
+    if params["n_obstacles"]:
+        shortest = params["obstacle_length"][0] + 2 * g
+        longest = max(hi - lo for lo, hi in _usable(lay, params))
+        if longest < shortest:
+            raise InfeasibleError(
+                f"no corridor of this shape holds {params['n_obstacles']} obstacle(s): one needs {shortest:.3g} m of a leg "
+                f"({params['obstacle_length'][0]:g} m long and {g:g} m of passage on each side), and the longest leg "
+                f"has {max(longest, 0.0):.3g} m left after the spawn's and goal's room; lengthen the corridor or set "
+                f"n_obstacles=0")
     if w < need:
         raise InfeasibleError(
             f"corridor width {w:g} m cannot pass a {r:g} m radius robot with {c:g} m clearance (needs >= {_m(need)} m)")
