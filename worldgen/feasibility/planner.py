@@ -33,7 +33,15 @@ import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.route import Contact, Route
-from worldgen.feasibility.tangents import EdgeIndex, TangentBatch, Tangents, TangentStore, every_side, tangents
+from worldgen.feasibility.tangents import (
+    TangentBatch,
+    Tangents,
+    TangentStore,
+    every_side,
+    grown_edges,
+    lonely_circles,
+    tangents,
+)
 
 __all__ = ["Planner"]
 
@@ -80,8 +88,8 @@ class Planner:
         self._angle0 = np.arctan2(cs.cone_a[:, 1], cs.cone_a[:, 0])
         self._full = cs.full
         self._hull_max = float(cs.hull_r.max()) if n else 0.0
-        self._arc_free = self._lonely_circles()
-        self._edges = self._grown_edges()
+        self._arc_free = lonely_circles(cs)
+        self._edges = grown_edges(cs)
 
     # -- the search --------------------------------------------------------
     def shortest(self, start, goal) -> Optional[Route]:
@@ -116,11 +124,20 @@ class Planner:
         self._tie += 1
 
     def _expand(self, batch: list[tuple[float, int]]) -> None:
-        cs, nodes, goal = self.cs, self._nodes, self._goal
-        live = []
-        fresh_circles = []
+        """Expand a batch of nodes popped together: their tangents to the goal and along the grown edges,
+        their departures to the obstacles in each node's band, then the best arrival and the new nodes."""
+        live, fresh_circles = self._admit(batch)
+        out, goals = TangentBatch(), TangentBatch()
+        if fresh_circles:
+            self._from_fresh_circles(fresh_circles, out, goals)
+        self._departures(live, out)
+        self._settle(goals, out)
+
+    def _admit(self, batch: list[tuple[float, int]]) -> tuple[list[tuple[float, int]], list[int]]:
+        """The batch less the nodes dominated on their circle; fresh nodes get their lower bounds."""
+        nodes = self._nodes
+        live, fresh_circles, fresh = [], [], []
         dominated = self._dominated([i for _, i in batch if nodes[i].lb is None and nodes[i].circle >= 0])
-        fresh = []
         for key, i in batch:
             node = nodes[i]
             if node.lb is None:
@@ -134,28 +151,32 @@ class Planner:
         if fresh:
             for node, lb in zip(fresh, self._bounds(fresh)):
                 node.lb = lb
-        out = TangentBatch()
-        goals = TangentBatch()
-        # Fresh nodes on circles: straight to the goal, and along the grown edge to the next corner.
-        if fresh_circles:
-            idx = np.array(fresh_circles)
-            circles = np.array([nodes[i].circle for i in fresh_circles])
-            sides = np.array([nodes[i].side for i in fresh_circles])
-            # Tangents to the goal once per (circle, side); every node there may take them.
-            key = circles * 2 + (sides < 0)
-            uniq, first = np.unique(key, return_index=True)
-            among = self._blockers([nodes[i] for i in fresh_circles], None)
-            tans = tangents(cs, circles[first], np.full(len(first), -1), sides[first],
-                            np.ones(len(first), dtype=np.int64), dst_xy=goal, among=among)
-            if len(tans):
-                tkey = tans.src * 2 + (tans.s1 < 0)
-                for k in range(len(idx)):
-                    rows = np.flatnonzero(tkey == key[k])
-                    goals.add(np.full(len(rows), idx[k]), tans.take(rows))
-            edge_rows = self._edges.pick(circles, sides)
-            keep = edge_rows >= 0
-            out.add(idx[keep], self._edges.tans.take(edge_rows[keep]))
-        # Departures to the obstacles in each node's band.
+        return live, fresh_circles
+
+    def _from_fresh_circles(self, fresh_circles: list[int], out: TangentBatch, goals: TangentBatch) -> None:
+        """Fresh nodes on circles: straight to the goal, and along the grown edge to the next corner."""
+        cs, nodes, goal = self.cs, self._nodes, self._goal
+        idx = np.array(fresh_circles)
+        circles = np.array([nodes[i].circle for i in fresh_circles])
+        sides = np.array([nodes[i].side for i in fresh_circles])
+        # Tangents to the goal once per (circle, side); every node there may take them.
+        key = circles * 2 + (sides < 0)
+        uniq, first = np.unique(key, return_index=True)
+        among = self._blockers([nodes[i] for i in fresh_circles], None)
+        tans = tangents(cs, circles[first], np.full(len(first), -1), sides[first],
+                        np.ones(len(first), dtype=np.int64), dst_xy=goal, among=among)
+        if len(tans):
+            tkey = tans.src * 2 + (tans.s1 < 0)
+            for k in range(len(idx)):
+                rows = np.flatnonzero(tkey == key[k])
+                goals.add(np.full(len(rows), idx[k]), tans.take(rows))
+        edge_rows = self._edges.pick(circles, sides)
+        keep = edge_rows >= 0
+        out.add(idx[keep], self._edges.tans.take(edge_rows[keep]))
+
+    def _departures(self, live: list[tuple[float, int]], out: TangentBatch) -> None:
+        """Departures to the obstacles in each node's band; a node with bounds beyond it goes back on the heap."""
+        cs, nodes = self.cs, self._nodes
         requests = []
         for key, i in live:
             node = nodes[i]
@@ -167,26 +188,30 @@ class Planner:
                 self._tie += 1
             if len(band):
                 requests.append((i, band, upto))
-        if requests:
-            self._fill_tables(requests)
-            picked, owners = [], []
-            for i, band, upto in requests:
-                node = nodes[i]
-                if node.circle < 0:
-                    dst = cs.circles_of(band)
-                    src, dst, s1, s2 = every_side(np.full(len(dst), -1), dst, (1,), (1, -1))
-                    tans = tangents(cs, src, dst, s1, s2, src_xy=node.point, among=self._blockers([node], None))
-                    out.add(np.full(len(tans), i), tans)
-                    continue
-                rows = self._store.rows(node.circle, node.side)
-                if len(rows):
-                    # This request's band: the obstacles whose bound it has just passed.
-                    lb = node.lb[self._store.dst_owner[rows]]
-                    rows = rows[(lb > node.prev_done) & (lb <= upto)]
-                    picked.append(rows)
-                    owners.append(np.full(len(rows), i))
-            if picked:
-                out.add(np.concatenate(owners), self._store.take(np.concatenate(picked)))
+        if not requests:
+            return
+        self._fill_tables(requests)
+        picked, owners = [], []
+        for i, band, upto in requests:
+            node = nodes[i]
+            if node.circle < 0:
+                dst = cs.circles_of(band)
+                src, dst, s1, s2 = every_side(np.full(len(dst), -1), dst, (1,), (1, -1))
+                tans = tangents(cs, src, dst, s1, s2, src_xy=node.point, among=self._blockers([node], None))
+                out.add(np.full(len(tans), i), tans)
+                continue
+            rows = self._store.rows(node.circle, node.side)
+            if len(rows):
+                # This request's band: the obstacles whose bound it has just passed.
+                lb = node.lb[self._store.dst_owner[rows]]
+                rows = rows[(lb > node.prev_done) & (lb <= upto)]
+                picked.append(rows)
+                owners.append(np.full(len(rows), i))
+        if picked:
+            out.add(np.concatenate(owners), self._store.take(np.concatenate(picked)))
+
+    def _settle(self, goals: TangentBatch, out: TangentBatch) -> None:
+        """The best arrival at the goal so far, and a node for every unblocked tangent's end."""
         idx, tans = goals.merged()
         if idx is not None:
             g = self._leave(idx, tans)
@@ -343,33 +368,6 @@ class Planner:
             free = self.cs.arc_clearance(c.astype(np.int64), start, sweep) >= -1e-9
             out.update(int(k) for k in i[free])
         return out
-
-    def _lonely_circles(self) -> np.ndarray:
-        """(C,) bool: circles none of whose arcs can be blocked (no neighbour, disc inside the box)."""
-        cs = self.cs
-        lo, hi = cs.centre - cs.rho[:, None], cs.centre + cs.rho[:, None]
-        x0, y0, x1, y1 = cs.box
-        inside = (lo[:, 0] >= x0) & (lo[:, 1] >= y0) & (hi[:, 0] <= x1) & (hi[:, 1] <= y1)
-        return inside & (cs.nb_start[1:] == cs.nb_start[:-1])[cs.owner]
-
-    def _grown_edges(self) -> EdgeIndex:
-        """The grown edges between neighbouring corners, as tangents each way, where clear."""
-        cs = self.cs
-        corner = np.flatnonzero(cs.nxt >= 0)
-        nxt = cs.nxt[corner]
-        n = cs.cone_b[corner]
-        a = cs.centre[corner] + cs.rho[corner, None] * n
-        b = cs.centre[nxt] + cs.rho[nxt, None] * n
-        ok = cs.inside_box(a) & cs.inside_box(b)
-        row, o = cs.neighbour_pairs(corner)
-        ok[row[cs._pairs_hit(a[row], b[row], o)]] = False
-        corner, nxt, n, a, b = corner[ok], nxt[ok], n[ok], a[ok], b[ok]
-        length = np.hypot(*(b - a).T)
-        one = np.ones(len(corner), dtype=np.int64)
-        # Winding counter-clockwise (side +1) the path goes from a corner to the next; clockwise, back.
-        tans = Tangents.concat([Tangents(corner, nxt, one, one, a, b, n, n, length),
-                                Tangents(nxt, corner, -one, -one, b, a, n, n, length)])
-        return EdgeIndex(tans, cs.n_circles)
 
     # -- the answer --------------------------------------------------------
     def _route(self, start, goal) -> Route:

@@ -23,7 +23,8 @@ import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
 
-__all__ = ["Tangents", "tangents", "every_side", "SIDES", "TangentStore", "EdgeIndex", "TangentBatch"]
+__all__ = ["Tangents", "tangents", "every_side", "SIDES", "TangentStore", "EdgeIndex", "TangentBatch", "grown_edges",
+           "lonely_circles"]
 
 #: The four kinds of common tangent (s1, s2): both circles on the left, left-right, ...
 SIDES = ((1, 1), (1, -1), (-1, -1), (-1, 1))
@@ -188,3 +189,30 @@ class TangentBatch:
             return None, None
         idx = np.concatenate([p[0] for p in self.parts])
         return idx, Tangents.concat([p[1] for p in self.parts])
+
+
+def lonely_circles(cs) -> np.ndarray:
+    """(C,) bool: circles none of whose arcs can be blocked (no neighbour, disc inside the box)."""
+    lo, hi = cs.centre - cs.rho[:, None], cs.centre + cs.rho[:, None]
+    x0, y0, x1, y1 = cs.box
+    inside = (lo[:, 0] >= x0) & (lo[:, 1] >= y0) & (hi[:, 0] <= x1) & (hi[:, 1] <= y1)
+    return inside & (cs.nb_start[1:] == cs.nb_start[:-1])[cs.owner]
+
+
+def grown_edges(cs) -> EdgeIndex:
+    """The grown edges between neighbouring corners, as tangents each way, where clear."""
+    corner = np.flatnonzero(cs.nxt >= 0)
+    nxt = cs.nxt[corner]
+    n = cs.cone_b[corner]
+    a = cs.centre[corner] + cs.rho[corner, None] * n
+    b = cs.centre[nxt] + cs.rho[nxt, None] * n
+    ok = cs.inside_box(a) & cs.inside_box(b)
+    row, o = cs.neighbour_pairs(corner)
+    ok[row[cs._pairs_hit(a[row], b[row], o)]] = False
+    corner, nxt, n, a, b = corner[ok], nxt[ok], n[ok], a[ok], b[ok]
+    length = np.hypot(*(b - a).T)
+    one = np.ones(len(corner), dtype=np.int64)
+    # Winding counter-clockwise (side +1) the path goes from a corner to the next; clockwise, back.
+    tans = Tangents.concat([Tangents(corner, nxt, one, one, a, b, n, n, length),
+                            Tangents(nxt, corner, -one, -one, b, a, n, n, length)])
+    return EdgeIndex(tans, cs.n_circles)
