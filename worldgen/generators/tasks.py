@@ -60,55 +60,71 @@ def sample_tasks(
     instead of drawing them (a fixed pair skips ``min_distance``: the caller
     chose it); ``region`` h restricts drawn points to [-h, h] x [-h, h].
     """
-    separation = 2 * robot.inflation
-    spawns: list[np.ndarray] = []
-    goals: list[np.ndarray] = []
-    tasks: list[Task] = []
     for label, fixed in (("spawn", spawn), ("goal", goal)):
         if fixed is not None and not _free(index, bounds, robot, fixed[:2]):
             return [], f"the fixed {label} ({fixed[0]:g}, {fixed[1]:g}) is not free for a {robot.inflation:g} m disc"
-    fixed_goal = None if goal is None else np.array(goal[:2], dtype=float)
+    pairs = _Pairs(2 * robot.inflation, min_distance, goal_tolerance, goal)
     if spawn is not None:
-        spawns.append(np.array(spawn[:2], dtype=float))
-        spawn_yaw = round_float(spawn[2])
-        if fixed_goal is not None:
-            goals.append(fixed_goal)
-            tasks.append(_task(0, spawns[0], spawn_yaw, fixed_goal, 0.0, goal_tolerance))
-            fixed_goal = None
+        pairs.fix_spawn(np.array(spawn[:2], dtype=float), round_float(spawn[2]))
     draw_bounds = region_bounds(bounds, region, robot)
     for _ in range(_BATCHES):
-        if len(tasks) == n_tasks:
-            return tasks, None
+        if len(pairs.tasks) == n_tasks:
+            return pairs.tasks, None
         pts = free_points(rng, index, draw_bounds, robot, _BATCH)
         yaws = rng.uniform(-math.pi, math.pi, len(pts))
         for p, yaw in zip(pts, yaws):
-            if len(tasks) == n_tasks:
+            if len(pairs.tasks) == n_tasks:
                 break
-            if len(spawns) == len(tasks):  # looking for a spawn
-                if all(np.hypot(*(p - q)) >= separation for q in spawns):
-                    if fixed_goal is not None:  # the first task's goal is given: its spawn is drawn
-                        if np.hypot(*(p - fixed_goal)) < min_distance:
-                            continue
-                        spawns.append(p)
-                        goals.append(fixed_goal)
-                        tasks.append(_task(0, p, round_float(yaw), fixed_goal, 0.0, goal_tolerance))
-                        fixed_goal = None
-                        continue
-                    spawns.append(p)
-                    spawn_yaw = round_float(yaw)
-                continue
-            spawn_xy = spawns[-1]
-            if np.hypot(*(p - spawn_xy)) < min_distance:
-                continue
-            if not all(np.hypot(*(p - q)) >= separation for q in goals + spawns[:-1]):
-                continue
-            goals.append(p)
-            tasks.append(_task(len(tasks), spawn_xy, spawn_yaw, p, round_float(yaw), goal_tolerance))
-        if len(tasks) == n_tasks:
-            return tasks, None
+            pairs.offer(p, round_float(yaw))
+        if len(pairs.tasks) == n_tasks:
+            return pairs.tasks, None
     return [], (
-        f"found {len(tasks)} of {n_tasks} spawn/goal pairs at least {min_distance:g} m apart on free floor"
+        f"found {len(pairs.tasks)} of {n_tasks} spawn/goal pairs at least {min_distance:g} m apart on free floor"
     )
+
+
+class _Pairs:
+    """Spawn/goal pairs taking shape from free points offered in turn: a spawn, then its goal, and so on."""
+
+    def __init__(self, separation: float, min_distance: float, goal_tolerance: float, goal):
+        self.separation, self.min_distance, self.goal_tolerance = separation, min_distance, goal_tolerance
+        self.spawns: list[np.ndarray] = []
+        self.goals: list[np.ndarray] = []
+        self.tasks: list[Task] = []
+        self.spawn_yaw = 0.0
+        #: The first task's given goal, until that task is made.
+        self.fixed_goal = None if goal is None else np.array(goal[:2], dtype=float)
+
+    def fix_spawn(self, xy: np.ndarray, yaw: float) -> None:
+        """The first task's spawn is given (a fixed pair skips min_distance: the caller chose it)."""
+        self.spawns.append(xy)
+        self.spawn_yaw = yaw
+        if self.fixed_goal is not None:
+            self._add(xy, yaw, self.fixed_goal, 0.0)
+
+    def offer(self, p: np.ndarray, yaw: float) -> None:
+        """Take ``p`` (heading ``yaw``) as the next spawn or goal where it keeps every distance."""
+        if len(self.spawns) == len(self.tasks):  # looking for a spawn
+            if not all(np.hypot(*(p - q)) >= self.separation for q in self.spawns):
+                return
+            if self.fixed_goal is not None:  # the first task's goal is given: its spawn is drawn
+                if np.hypot(*(p - self.fixed_goal)) >= self.min_distance:
+                    self.spawns.append(p)
+                    self._add(p, yaw, self.fixed_goal, 0.0)
+                return
+            self.spawns.append(p)
+            self.spawn_yaw = yaw
+            return
+        spawn_xy = self.spawns[-1]
+        if np.hypot(*(p - spawn_xy)) < self.min_distance:
+            return
+        if all(np.hypot(*(p - q)) >= self.separation for q in self.goals + self.spawns[:-1]):
+            self._add(spawn_xy, self.spawn_yaw, p, yaw)
+
+    def _add(self, spawn_xy, spawn_yaw: float, goal_xy, goal_yaw: float) -> None:
+        self.goals.append(goal_xy)
+        self.tasks.append(_task(len(self.tasks), spawn_xy, spawn_yaw, goal_xy, goal_yaw, self.goal_tolerance))
+        self.fixed_goal = None
 
 
 def _task(i: int, spawn, spawn_yaw: float, goal, goal_yaw: float, goal_tolerance: float) -> Task:
