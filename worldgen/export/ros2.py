@@ -30,7 +30,8 @@ from typing import Any, Mapping, Optional
 from worldgen.errors import ParameterError
 
 __all__ = ["BUNDLE_DIR", "GZ_RELEASES", "DEFAULT_GZ_RELEASE", "DEFAULT_ROBOT_NAME", "TOPICS", "RECORDED_TOPICS",
-           "ros_name", "release_of", "plugins", "with_plugins", "bridge_config", "nav2_overrides", "tasks_spec", "bundle", "dumps"]
+           "ros_name", "release_of", "plugins", "with_plugins", "bridge_config", "nav2_overrides", "tasks_spec",
+           "bundle", "dumps"]
 
 BUNDLE_DIR = "ros2"
 DEFAULT_ROBOT_NAME = "robot"
