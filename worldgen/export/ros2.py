@@ -153,13 +153,13 @@ def nav2_overrides(world, task) -> dict[str, Any]:
 
     ``map_server.yaml_filename`` is relative to the world folder (the launch file makes it absolute).
     """
+    from worldgen.files import MAP_YAML_NAME
     from worldgen.floats import round_float
-    from worldgen.groundtruth.occupancy import YAML_NAME
 
     out: dict[str, Any] = {node: {"ros__parameters": {"use_sim_time": True}} for node in _NAV2_NODES}
     out["amcl"]["ros__parameters"].update({"set_initial_pose": True, "initial_pose": _spawn(task),
                                            "global_frame_id": "map"})
-    out["map_server"]["ros__parameters"]["yaml_filename"] = YAML_NAME
+    out["map_server"]["ros__parameters"]["yaml_filename"] = MAP_YAML_NAME
     radius = round_float(world.robot.radius)
     for costmap in ("local_costmap", "global_costmap"):
         out[costmap] = {costmap: {"ros__parameters": {"use_sim_time": True, "robot_radius": radius}}}
@@ -167,18 +167,21 @@ def nav2_overrides(world, task) -> dict[str, Any]:
 
 
 def tasks_spec(world) -> dict[str, Any]:
-    """Every task as a goal pose in the map frame with its tolerance and time limit (world.json's figures)."""
-    from worldgen.export.scenario import scenario
+    """Every task as a goal pose in the map frame with its tolerance and time limit: world.json's
+    figures, from the one builder of its task block (worldgen.export.tasks)."""
+    from worldgen.export.tasks import task_entry
     from worldgen.floats import round_float
 
-    limits = {t["id"]: next((c["seconds"] for c in t["failure_conditions"] if c["type"] == "timeout"), None)
-              for t in scenario(world)["tasks"]}
+    paths = list(world.feasibility.paths) + [None] * len(world.tasks)
     tasks = []
-    for task in world.tasks:
+    for task, path in zip(world.tasks, paths):
+        entry = task_entry(world, task, path)
+        limit = entry["time_limit"]
         tasks.append({"id": task.id, "spawn": _spawn(task),
                       "goal": {"frame_id": "map", "x": round_float(task.goal.x), "y": round_float(task.goal.y),
                                "yaw": round_float(task.goal.yaw)},
-                      "tolerance": round_float(task.goal_tolerance), "time_limit": limits[task.id]})
+                      "tolerance": round_float(entry["goal_tolerance"]),
+                      "time_limit": None if limit is None else round_float(limit)})
     return {"world_id": world.world_id, "world_name": world.world_id, "frame_id": "map", "tasks": tasks}
 
 
