@@ -128,6 +128,12 @@ def goal_command(task_id, result_path, run, seed):
             '--seed', str(int(seed)), '--ros-args', '-p', 'use_sim_time:=true']
 
 
+def _on_spawn_exit(event, context):
+    from launch.actions import Shutdown
+
+    return [Shutdown(reason='ros_gz_sim create failed to spawn the robot')] if event.returncode else []
+
+
 def _setup(context):
     from ament_index_python.packages import get_package_share_directory
     from launch.actions import ExecuteProcess, IncludeLaunchDescription, RegisterEventHandler, Shutdown, TimerAction
@@ -169,6 +175,8 @@ def _setup(context):
                # The run ends when the goal sender exits: on nav2's result or at the task's time limit.
                RegisterEventHandler(OnProcessExit(target_action=goal,
                                                   on_exit=[Shutdown(reason='goal finished or time limit reached')])),
+               # A robot that cannot be spawned ends the run at once (create exits non-zero).
+               RegisterEventHandler(OnProcessExit(target_action=spawn, on_exit=_on_spawn_exit)),
                # A backstop on the wall clock, for a simulation that stalls and never reaches the limit.
                TimerAction(period=wall_limit(task, arg('wall_limit')),
                            actions=[Shutdown(reason='wall-clock limit reached')])]

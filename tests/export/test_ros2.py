@@ -34,7 +34,7 @@ from worldgen.export import ros2
 BRIDGE_KEYS = {"topic_name", "ros_topic_name", "gz_topic_name", "ros_type_name", "gz_type_name", "direction",
                "publisher_queue", "subscriber_queue", "lazy", "qos_profile"}
 BRIDGE_DIRECTIONS = {"BIDIRECTIONAL", "GZ_TO_ROS", "ROS_TO_GZ"}
-#: ROS type -> Gazebo type pairs the bridge converts (ros_gz_bridge/README.md's table, the rows the bundle uses).
+#: ROS type -> Gazebo type pairs the bridge converts (the table in ros_gz_bridge's README, the rows the bundle uses).
 BRIDGE_TYPES = {"rosgraph_msgs/msg/Clock": "Clock", "tf2_msgs/msg/TFMessage": "Pose_V",
                 "ros_gz_interfaces/msg/Contacts": "Contacts", "geometry_msgs/msg/Twist": "Twist",
                 "nav_msgs/msg/Odometry": "Odometry", "sensor_msgs/msg/LaserScan": "LaserScan"}
@@ -248,8 +248,8 @@ def test_the_launch_file_starts_what_the_ros_documentation_names(world, folder):
         if isinstance(node, ast.ImportFrom) and node.module.split(".")[0] in {"launch", "launch_ros", "ament_index_python"}:
             imported.setdefault(node.module, set()).update(a.name for a in node.names)
     assert imported and all(names <= LAUNCH_API[module] for module, names in imported.items())
-    # Shutdown on the goal sender's exit and on a wall-clock backstop; never a process killed by name.
-    assert _calls(tree, "OnProcessExit") and len(_calls(tree, "Shutdown")) == 2 and _calls(tree, "TimerAction")
+    # Shutdown on the goal sender's exit, on a failed spawn and on a wall-clock backstop; never a kill by name.
+    assert len(_calls(tree, "OnProcessExit")) == 2 and len(_calls(tree, "Shutdown")) == 3 and _calls(tree, "TimerAction")
     assert not re.search(r"\b(pkill|killall|kill)\b", path.read_text())
 
 
