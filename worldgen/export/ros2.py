@@ -72,7 +72,6 @@ RECORDED_TOPICS = ("/odom", "/tf", "/tf_static", "/cmd_vel", "/clock", "/scan", 
 _NAV2_NODES = ("amcl", "bt_navigator", "controller_server", "planner_server", "smoother_server", "behavior_server",
                "velocity_smoother", "waypoint_follower", "collision_monitor", "map_server",
                "lifecycle_manager_localization", "lifecycle_manager_navigation")
-_TEMPLATES = ("launch.py", "send_goal.py", "run_loop.py")
 _NAME_RE = re.compile(r"[^A-Za-z0-9_]+")
 
 
@@ -193,7 +192,8 @@ def dumps(data: Any) -> bytes:
 
 
 def _template(name: str) -> str:
-    return resources.files("worldgen.templates").joinpath("ros2", name).read_text(encoding="utf-8")
+    """``templates/ros2/<name>.in``: .in, so that no tool takes the scripts for modules of worldgen."""
+    return resources.files("worldgen.templates").joinpath("ros2", name + ".in").read_text(encoding="utf-8")
 
 
 def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_GZ_RELEASE,
