@@ -57,9 +57,11 @@ CREATE_FLAGS = {"-world", "-file", "-param", "-string", "-topic", "-name", "-all
                 "-x", "-y", "-z", "-R", "-P", "-Y"}
 #: gz sim flags used (gz-sim's `gz sim --help`: -r run, -s server only, --headless-rendering, --seed).
 GZ_SIM_FLAGS = {"-r", "-s", "--headless-rendering", "--seed", "-v"}
-#: ros2 bag record flags used (rosbag2's ros2bag/verb/record.py: -o/--output, -s/--storage, --use-sim-time
-#: from Humble's backport, rosbag2 PR 1017).
-RECORD_FLAGS = {"-o", "--output", "-s", "--storage", "--use-sim-time"}
+#: ros2 bag record flags used (rosbag2's ros2bag/verb/record.py: -o/--output, -s/--storage,
+#: --include-hidden-topics; --use-sim-time from Humble's backport, rosbag2 PR 1017; --topics and
+#: --custom-data KEY=VALUE... on the releases after Humble, rosbag2 PR 1038 for the custom data).
+RECORD_FLAGS = {"-o", "--output", "-s", "--storage", "--use-sim-time", "--include-hidden-topics"}
+RECORD_FLAGS_AFTER_HUMBLE = RECORD_FLAGS | {"--topics", "--custom-data"}
 #: What the launch file imports from ROS's launch packages (launch, launch_ros, ament_index_python APIs).
 LAUNCH_API = {"launch": {"LaunchDescription"},
               "launch.actions": {"DeclareLaunchArgument", "OpaqueFunction", "ExecuteProcess", "IncludeLaunchDescription",
@@ -141,8 +143,8 @@ def test_every_ros_name_in_the_bundle_is_valid(world, folder, launch):
         assert valid_token(name)
     assert valid_token("worldgen_send_goal") and "node_name='worldgen_send_goal'" in (
         folder / "ros2" / "send_goal.py").read_text()
-    # The robot's model name is sanitised too, so /model/<robot>/pose stays a valid topic.
-    topics = {e["ros_topic_name"] for e in ros2.bridge_config("my-robot.v2")}
+    # The robot's model name is sanitised too, so Gazebo's /model/<robot>/pose stays a valid name.
+    topics = {e["gz_topic_name"] for e in ros2.bridge_config("my-robot.v2")}
     assert "/model/my_robot_v2/pose" in topics and all(valid_topic(t) for t in topics)
 
 
@@ -161,7 +163,10 @@ def test_bridge_config_uses_the_documented_keys_types_and_directions(release):
     by_topic = {e["ros_topic_name"]: e for e in config}
     assert by_topic["/clock"]["direction"] == "GZ_TO_ROS"  # the bridge README: a one-way /clock
     assert by_topic["/cmd_vel"]["direction"] == "ROS_TO_GZ"
-    assert by_topic["/model/robot/pose"]["ros_type_name"] == "tf2_msgs/msg/TFMessage"
+    # The ground truth: OdometryPublisher's Pose_V on /model/<robot>/pose, as TFMessage on /ground_truth,
+    # the topic worldgen judge reads first.
+    assert by_topic["/ground_truth"]["ros_type_name"] == "tf2_msgs/msg/TFMessage"
+    assert by_topic["/ground_truth"]["gz_topic_name"] == "/model/robot/pose"
     assert JUDGE_TOPICS - {"/tf_static"} <= set(by_topic)
 
 
@@ -267,11 +272,17 @@ def test_the_launch_files_commands_use_only_documented_flags(world, folder, laun
         launch.spawn_arguments(task, "", "", "robot")
     gz = launch.gz_args("/w/world.sdf", 4).split()
     assert {a for a in gz if a.startswith("-")} <= GZ_SIM_FLAGS and gz[-1] == "/w/world.sdf" and "4" in gz
-    record = launch.record_command("/bags/b", "mcap")
-    assert record[:3] == ["ros2", "bag", "record"]
-    assert {a for a in record if a.startswith("-")} <= RECORD_FLAGS
-    topics = [a for a in record if a.startswith("/") and a != "/bags/b"]
-    assert JUDGE_TOPICS <= set(topics) and "/model/robot/pose" in topics
+    custom = {"world_id": world.world_id, "task": "task_1", "run": 3, "seed": 9}
+    humble = launch.record_command("/bags/b", "mcap", "humble", custom)
+    assert humble[:3] == ["ros2", "bag", "record"] and {a for a in humble if a.startswith("-")} <= RECORD_FLAGS
+    topics = [a for a in humble if a.startswith("/") and a != "/bags/b"]
+    assert JUDGE_TOPICS <= set(topics) and {"/ground_truth", "/navigate_to_pose/_action/status"} <= set(topics)
+    jazzy = launch.record_command("/bags/b", "mcap", "jazzy", custom)
+    assert {a for a in jazzy if a.startswith("-")} <= RECORD_FLAGS_AFTER_HUMBLE
+    at, data = jazzy.index("--topics"), jazzy.index("--custom-data")
+    assert jazzy[at + 1:data] == topics and data > at  # --custom-data last: it takes every word after it
+    assert jazzy[data + 1:] == [f"worldgen.world_id={world.world_id}", "worldgen.task=task_1", "worldgen.run=3",
+                                "worldgen.seed=9"]
     goal = launch.goal_command("task_1", "/bags/b.result.yaml", 3, 9)
     assert goal[goal.index("--ros-args"):] == ["--ros-args", "-p", "use_sim_time:=true"]
     assert launch.bag_name(world.folder_name, "task_1", 3) == f"{world.folder_name}__task_1__run3"

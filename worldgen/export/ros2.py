@@ -55,19 +55,22 @@ _SYSTEMS = (("physics", "Physics", ""), ("user-commands", "UserCommands", ""),
 
 #: ROS topic -> (ROS type, Gazebo type suffix, Gazebo topic, direction); ``{robot}`` is the robot's
 #: model name. The ground truth comes from gz-sim's OdometryPublisher system on the robot model (its
-#: ``tf_topic`` defaults to /model/<name>/pose, Pose_V in a world-fixed frame), bridged as
-#: tf2_msgs/TFMessage; the robot's own topics keep the names nav2 expects.
+#: ``tf_topic`` defaults to /model/<name>/pose: Pose_V, the model's world pose), bridged as
+#: tf2_msgs/TFMessage on /ground_truth, the topic ``worldgen judge`` reads first; the robot's own
+#: topics keep the names nav2 expects.
 TOPICS: dict[str, tuple[str, str, str, str]] = {
     "/clock": ("rosgraph_msgs/msg/Clock", "Clock", "/clock", "GZ_TO_ROS"),
-    "/model/{robot}/pose": ("tf2_msgs/msg/TFMessage", "Pose_V", "/model/{robot}/pose", "GZ_TO_ROS"),
+    "/ground_truth": ("tf2_msgs/msg/TFMessage", "Pose_V", "/model/{robot}/pose", "GZ_TO_ROS"),
     "/contacts": ("ros_gz_interfaces/msg/Contacts", "Contacts", "/contacts", "GZ_TO_ROS"),
     "/cmd_vel": ("geometry_msgs/msg/Twist", "Twist", "/cmd_vel", "ROS_TO_GZ"),
     "/odom": ("nav_msgs/msg/Odometry", "Odometry", "/odom", "GZ_TO_ROS"),
     "/tf": ("tf2_msgs/msg/TFMessage", "Pose_V", "/tf", "GZ_TO_ROS"),
     "/scan": ("sensor_msgs/msg/LaserScan", "LaserScan", "/scan", "GZ_TO_ROS"),
 }
-#: What ``ros2 bag record`` keeps: what ``worldgen judge`` reads, plus the contacts.
-RECORDED_TOPICS = ("/odom", "/tf", "/tf_static", "/cmd_vel", "/clock", "/scan", "/model/{robot}/pose", "/contacts")
+#: What ``ros2 bag record`` keeps: what ``worldgen judge`` reads (the goal's time from the navigate_to_pose
+#: action's status, a hidden topic), plus the contacts.
+RECORDED_TOPICS = ("/odom", "/tf", "/tf_static", "/cmd_vel", "/clock", "/scan", "/ground_truth", "/contacts",
+                   "/navigate_to_pose/_action/status")
 #: The nav2 nodes that get ``use_sim_time`` explicitly (the launch file sets it on every node it finds too).
 _NAV2_NODES = ("amcl", "bt_navigator", "controller_server", "planner_server", "smoother_server", "behavior_server",
                "velocity_smoother", "waypoint_follower", "collision_monitor", "map_server",
