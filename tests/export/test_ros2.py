@@ -438,3 +438,15 @@ def test_a_pack_recipe_asks_for_the_bundle(tmp_path):
                                                              False, plain.ros)[1])
     with pytest.raises(RecipeError, match=r"<recipe>:1: key 'ros': must be true, false or a Gazebo release"):
         parse_recipe("ros: dome\nseeds: 1\nworlds:\n  - generator: minimal\n")
+
+
+@pytest.mark.parametrize("store", ["ROS2_HUMBLE", "ROS2_JAZZY"])
+def test_the_bridged_ros_types_exist_in_humble_and_jazzy(store):
+    """Every ROS type the bridge names is a message of that release (rosbags' shipped definitions);
+    ros_gz_interfaces is ros_gz's own package, not in the core set."""
+    from rosbags.typesys import Stores, get_typestore
+
+    types = get_typestore(getattr(Stores, store)).types
+    named = {e["ros_type_name"] for e in ros2.bridge_config()} | {"action_msgs/msg/GoalStatusArray"}
+    assert {t for t in named if not t.startswith("ros_gz_interfaces/")} <= set(types)
+    assert named - set(types) == {"ros_gz_interfaces/msg/Contacts"}
