@@ -131,11 +131,12 @@ def parameter_tables(specs) -> str:
 @click.option("--ros", is_flag=True,
               help="Also write the ROS 2 bundle in DIR/<world>/ros2/: bridge config, nav2 overrides, goals, a launch "
                    "file per world and a loop over runs (docs/ros2.md).")
-@click.option("--gz-release", type=click.Choice(tuple(GZ_RELEASES)), default=DEFAULT_GZ_RELEASE, show_default=True,
-              help="With --ros: the Gazebo release whose system plugins ros2/world.sdf names.")
+@click.option("--gz-release", type=click.Choice(tuple(GZ_RELEASES)), default=None,
+              help=f"With --ros: the Gazebo release whose system plugins ros2/world.sdf names "
+                   f"[default: {DEFAULT_GZ_RELEASE}].")
 def generate_command(generator: Optional[str], seed: int, settings: Sequence[str], out: Path, formats: str,
                      sdf_version: str, count: int, allow_infeasible: bool, overwrite: bool = False,
-                     preset_name: Optional[str] = None, ros: bool = False, gz_release: str = DEFAULT_GZ_RELEASE) -> None:
+                     preset_name: Optional[str] = None, ros: bool = False, gz_release: Optional[str] = None) -> None:
     """Generate, check and write worlds of GENERATOR.
 
     Prints one line per world: its folder, the reference path length of each
@@ -160,6 +161,8 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         if not allow_infeasible:
             raise
     chosen = normalise_formats(formats)
+    if gz_release is not None and not ros:
+        raise ParameterError(f"--gz-release {gz_release} names the Gazebo release of the ROS 2 bundle: add --ros")
     if seed + count - 1 > MAX_SEED:
         raise ParameterError(f"parameter 'count' must be in [1, {MAX_SEED - seed + 1}] for seed {seed}, got {count}")
     _check_out(out)
@@ -167,7 +170,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, **params)
         world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
         folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
-                             ros=gz_release if ros else False)
+                             ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
         failed = ",".join(c.name for c in world.feasibility.failed())
         verdict = f"\tinfeasible: {failed}" if failed else ""

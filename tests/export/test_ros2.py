@@ -421,6 +421,10 @@ def test_generate_with_ros_end_to_end(tmp_path):
     assert plain.returncode == 0 and not (world_dirs(tmp_path / "plain")[0] / "ros2").exists()
     bad = run("generate", "cluttered", "--seed", 5, *QUICK, "--out", tmp_path / "bad", "--ros", "--gz-release", "dome")
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "gz-release" in bad.stderr
+    alone = run("generate", "cluttered", "--seed", 5, *QUICK, "--out", tmp_path / "alone", "--gz-release", "ionic")
+    assert alone.returncode == 2 and alone.stderr == ("error: --gz-release ionic names the Gazebo release of the "
+                                                      "ROS 2 bundle: add --ros\n")
+    assert not (tmp_path / "alone").exists()
 
 
 def test_a_pack_recipe_asks_for_the_bundle(tmp_path):
