@@ -454,3 +454,80 @@ def test_the_bridged_ros_types_exist_in_humble_and_jazzy(store):
     named = {e["ros_type_name"] for e in ros2.bridge_config()} | {"action_msgs/msg/GoalStatusArray"}
     assert {t for t in named if not t.startswith("ros_gz_interfaces/")} <= set(types)
     assert named - set(types) == {"ros_gz_interfaces/msg/Contacts"}
+
+
+class _Recorded:
+    """A stand-in for one class of ROS's launch API: records how the launch file constructs it. ROS
+    cannot be installed here; this runs the launch file's own code paths, it does not emulate ROS."""
+
+    made: list = []
+
+    def __init__(self, *args, **kwargs):
+        self.args, self.kwargs = args, kwargs
+        _Recorded.made.append(self)
+
+
+def _fake_launch_api(monkeypatch, share: Path) -> None:
+    import types
+
+    names = {"launch": ["LaunchDescription"],
+             "launch.actions": sorted(LAUNCH_API["launch.actions"]),
+             "launch.event_handlers": ["OnProcessExit"],
+             "launch.launch_description_sources": ["PythonLaunchDescriptionSource"],
+             "launch_ros.actions": ["Node"]}
+    for module, classes in {**names, "launch_ros": [], "ament_index_python": []}.items():
+        fake = types.ModuleType(module)
+        for cls in classes:
+            setattr(fake, cls, type(cls, (_Recorded,), {}))
+        monkeypatch.setitem(sys.modules, module, fake)
+    packages = types.ModuleType("ament_index_python.packages")
+    packages.get_package_share_directory = lambda package: str(share / package)
+    monkeypatch.setitem(sys.modules, "ament_index_python.packages", packages)
+
+
+def test_the_launch_files_setup_runs_through(world, folder, launch, tmp_path, monkeypatch):
+    share = tmp_path / "share"
+    (share / "nav2_bringup" / "params").mkdir(parents=True)
+    (share / "nav2_bringup" / "params" / "nav2_params.yaml").write_text(yaml.safe_dump(
+        {"amcl": {"ros__parameters": {"use_sim_time": False, "max_particles": 2000}},
+         "controller_server": {"ros__parameters": {"use_sim_time": False, "controller_frequency": 20.0}}}))
+    _fake_launch_api(monkeypatch, share)
+    _Recorded.made = []
+    description = launch.generate_launch_description()
+    declared = {a.args[0]: a.kwargs["default_value"] for a in _Recorded.made if type(a).__name__ == "DeclareLaunchArgument"}
+    assert declared["task"] == "task_0" and declared["robot_name"] == "robot" and declared["storage"] == "mcap"
+    setup = next(a for a in _Recorded.made if type(a).__name__ == "OpaqueFunction").kwargs["function"]
+    assert type(description).__name__ == "LaunchDescription"
+
+    class Context:
+        launch_configurations = {**declared, "robot": str(tmp_path / "robot.urdf"), "task": "task_1", "run": "2",
+                                 "seed": "5", "out": str(tmp_path / "bags"), "robot_state_publisher": "true"}
+
+    (tmp_path / "robot.urdf").write_text("<robot name='r'/>")
+    monkeypatch.setenv("ROS_DISTRO", "jazzy")
+    _Recorded.made = []
+    actions = setup(Context())
+    kinds = [type(a).__name__ for a in actions]
+    assert kinds == ["IncludeLaunchDescription", "Node", "Node", "IncludeLaunchDescription", "ExecuteProcess",
+                     "ExecuteProcess", "RegisterEventHandler", "RegisterEventHandler", "TimerAction", "Node"]
+    gazebo, spawn, bridge, nav2, record, goal = actions[:6]
+    gz_args = dict(gazebo.kwargs["launch_arguments"])["gz_args"].split()
+    assert gz_args[-1] == str(folder / "ros2" / "world.sdf") and gz_args[gz_args.index("--seed") + 1] == "5"
+    assert spawn.kwargs["arguments"][spawn.kwargs["arguments"].index("-Y") + 1] == repr(world.tasks[1].spawn.yaw)
+    assert bridge.kwargs["parameters"] == [{"config_file": str(folder / "ros2" / "bridge.yaml"), "use_sim_time": True}]
+    nav2_args = dict(nav2.kwargs["launch_arguments"])
+    assert nav2_args["map"] == str(folder / "map.yaml") and nav2_args["use_sim_time"] == "true"
+    params = read_yaml(Path(nav2_args["params_file"]))
+    amcl = params["amcl"]["ros__parameters"]
+    x, y, z, _, _, yaw = world.metadata["tasks"][1]["spawn"]
+    assert amcl["max_particles"] == 2000 and amcl["initial_pose"] == {"x": x, "y": y, "z": z, "yaw": yaw}
+    assert params["controller_server"]["ros__parameters"] == {"use_sim_time": True, "controller_frequency": 20.0}
+    bag = str(tmp_path / "bags" / f"{world.folder_name}__task_1__run2")
+    assert record.kwargs["cmd"][record.kwargs["cmd"].index("-o") + 1] == bag
+    assert f"worldgen.world_id={world.world_id}" in record.kwargs["cmd"]
+    assert goal.kwargs["cmd"][goal.kwargs["cmd"].index("--result") + 1] == bag + ".result.yaml"
+    assert actions[8].kwargs["period"] == pytest.approx(10 * world.metadata["tasks"][1]["time_limit"] + 120)
+    assert actions[9].kwargs["parameters"][0]["robot_description"] == "<robot name='r'/>"
+    Path(bag).mkdir()
+    with pytest.raises(RuntimeError, match="exists already"):  # a recorded run is never overwritten
+        setup(Context())
