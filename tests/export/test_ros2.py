@@ -531,3 +531,83 @@ def test_the_launch_files_setup_runs_through(world, folder, launch, tmp_path, mo
     Path(bag).mkdir()
     with pytest.raises(RuntimeError, match="exists already"):  # a recorded run is never overwritten
         setup(Context())
+
+
+class _Time:
+    def __init__(self, ns):
+        self.nanoseconds = ns
+
+    def __sub__(self, other):
+        return _Time(self.nanoseconds - other.nanoseconds)
+
+    def to_msg(self):
+        return self.nanoseconds
+
+
+def _fake_nav2(monkeypatch, finishes_after: float, result: str, calls: list) -> None:
+    """Stand-ins for rclpy, geometry_msgs and nav2_simple_commander: a navigator whose task completes
+    after ``finishes_after`` simulated seconds (each isTaskComplete call advances 0.1 s) with ``result``."""
+    import types
+
+    class Navigator:
+        def __init__(self, node_name):
+            self.t = 100.0
+            calls.append(("init", node_name))
+
+        def __getattr__(self, name):
+            def call(*args):
+                calls.append((name,) + args)
+                if name == "isTaskComplete":
+                    self.t += 0.1
+                    return self.t - self.start >= finishes_after
+                if name == "goToPose":
+                    self.start = self.t
+                    return True
+                return getattr(TaskResult, result, None) if name == "getResult" else None
+            return call
+
+        def get_clock(self):
+            return types.SimpleNamespace(now=lambda: _Time(round(self.t * 1e9)))
+
+    TaskResult = types.SimpleNamespace(SUCCEEDED="S", CANCELED="C", FAILED="F")
+    pose = lambda: types.SimpleNamespace(  # noqa: E731
+        header=types.SimpleNamespace(frame_id="", stamp=None),
+        pose=types.SimpleNamespace(position=types.SimpleNamespace(x=0, y=0, z=0),
+                                   orientation=types.SimpleNamespace(x=0, y=0, z=0, w=1)))
+    modules = {"rclpy": {"init": lambda args: calls.append(("rclpy.init", args)), "shutdown": lambda: None},
+               "geometry_msgs": {}, "geometry_msgs.msg": {"PoseStamped": pose},
+               "nav2_simple_commander": {},
+               "nav2_simple_commander.robot_navigator": {"BasicNavigator": Navigator, "TaskResult": TaskResult}}
+    for name, attrs in modules.items():
+        module = types.ModuleType(name)
+        module.__dict__.update(attrs)
+        monkeypatch.setitem(sys.modules, name, module)
+
+
+@pytest.mark.parametrize("finishes_after, result, outcome, status", [
+    (5.0, "SUCCEEDED", "succeeded", 0), (5.0, "FAILED", "failed", 1), (1e9, None, "time_limit", 2)])
+def test_the_goal_sender_runs_through(folder, tmp_path, monkeypatch, finishes_after, result, outcome, status):
+    goal_module = load(folder / "ros2" / "send_goal.py", "bundle_send_goal_run")
+    calls: list = []
+    _fake_nav2(monkeypatch, finishes_after, result, calls)
+    out = tmp_path / "run.result.yaml"
+    code = goal_module.main(["--tasks", str(folder / "ros2" / "tasks.yaml"), "--task", "task_1", "--result", str(out),
+                             "--world-dir", str(folder), "--run", "4", "--seed", "7",
+                             "--ros-args", "-p", "use_sim_time:=true"])
+    assert code == status
+    names = [c[0] for c in calls]
+    # Active first, then the goal; the ROS arguments reach rclpy.
+    assert names[:4] == ["rclpy.init", "init", "waitUntilNav2Active", "goToPose"]
+    assert calls[0][1][1:] == ["--ros-args", "-p", "use_sim_time:=true"]
+    assert ("cancelTask" in names) == (outcome == "time_limit")
+    record = read_yaml(out)
+    spec = read_yaml(folder / "ros2" / "tasks.yaml")["tasks"][1]
+    assert record["outcome"] == outcome and record["task"] == "task_1" and (record["run"], record["seed"]) == (4, 7)
+    assert record["goal"] == spec["goal"] and record["world_dir"] == str(folder)
+    elapsed = record["finished_sim_time"] - record["goal_sent_sim_time"]
+    expected = spec["time_limit"] if outcome == "time_limit" else finishes_after
+    assert expected <= elapsed <= expected + 0.2  # the limit is simulation time from the goal
+    goal = [c for c in calls if c[0] == "goToPose"][0][1]
+    assert (goal.pose.position.x, goal.pose.position.y, goal.header.frame_id) == (
+        spec["goal"]["x"], spec["goal"]["y"], "map")
+    assert math.isclose(2 * math.atan2(goal.pose.orientation.z, goal.pose.orientation.w), spec["goal"]["yaw"])
