@@ -448,8 +448,9 @@ def test_a_pack_recipe_asks_for_the_bundle(tmp_path):
 def test_the_bridged_ros_types_exist_in_humble_and_jazzy(store):
     """Every ROS type the bridge names is a message of that release (rosbags' shipped definitions);
     ros_gz_interfaces is ros_gz's own package, not in the core set."""
-    from rosbags.typesys import Stores, get_typestore
-
+    # rosbags comes with the test extra once worldgen.ros (the bag reader) is in; until then this skips.
+    typesys = pytest.importorskip("rosbags.typesys")
+    Stores, get_typestore = typesys.Stores, typesys.get_typestore
     types = get_typestore(getattr(Stores, store)).types
     named = {e["ros_type_name"] for e in ros2.bridge_config()} | {"action_msgs/msg/GoalStatusArray"}
     assert {t for t in named if not t.startswith("ros_gz_interfaces/")} <= set(types)
