@@ -88,6 +88,7 @@ def test_every_module_ships_and_imports(wheel_venv, tmp_path):
     ["generate", "cluttered", "--seed", "0"],
     ["generate", "door", "--seed", "0"],
     ["generate", "--preset", "lidar_wall"],
+    ["generate", "minimal", "--seed", "0", "--ros"],
 ])
 def test_installed_cli_generates(wheel_venv, tmp_path, args):
     out = run(wheel_venv, wheel_venv / "bin" / "worldgen", *args, "--out", tmp_path / "w", cwd=tmp_path)
@@ -95,3 +96,6 @@ def test_installed_cli_generates(wheel_venv, tmp_path, args):
     (world_json,) = (tmp_path / "w").glob("*/world.json")
     for name in ("world.sdf", "world.mjcf.xml", "world.urdf", "map.pgm", "preview.png"):
         assert (world_json.parent / name).stat().st_size > 0
+    if "--ros" in args:  # the bundle's scripts ship as templates (templates/ros2/*.py.in)
+        for name in ("ros2/send_goal.py", "ros2/run_loop.py", "ros2/bridge.yaml"):
+            assert (world_json.parent / name).stat().st_size > 0

@@ -22,6 +22,7 @@ import click
 import worldgen
 from worldgen.errors import EXIT_USAGE, InfeasibleError, OutputError, ParameterError, WorldgenError
 from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
+from worldgen.export.ros2 import DEFAULT_GZ_RELEASE, GZ_RELEASES
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
 from worldgen.seeding import MAX_SEED
@@ -127,9 +128,15 @@ def parameter_tables(specs) -> str:
                    "its world.json says feasible false and which checks failed.")
 @click.option("--overwrite", is_flag=True,
               help="Replace a folder of the same name that holds another world (without it, that is an error).")
+@click.option("--ros", is_flag=True,
+              help="Also write the ROS 2 bundle in DIR/<world>/ros2/: bridge config, nav2 overrides, goals, a launch "
+                   "file per world and a loop over runs (docs/ros2.md).")
+@click.option("--gz-release", type=click.Choice(tuple(GZ_RELEASES)), default=None,
+              help=f"With --ros: the Gazebo release whose system plugins ros2/world.sdf names "
+                   f"[default: {DEFAULT_GZ_RELEASE}].")
 def generate_command(generator: Optional[str], seed: int, settings: Sequence[str], out: Path, formats: str,
                      sdf_version: str, count: int, allow_infeasible: bool, overwrite: bool = False,
-                     preset_name: Optional[str] = None) -> None:
+                     preset_name: Optional[str] = None, ros: bool = False, gz_release: Optional[str] = None) -> None:
     """Generate, check and write worlds of GENERATOR.
 
     Prints one line per world: its folder, the reference path length of each
@@ -154,13 +161,16 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         if not allow_infeasible:
             raise
     chosen = normalise_formats(formats)
+    if gz_release is not None and not ros:
+        raise ParameterError(f"--gz-release {gz_release} names the Gazebo release of the ROS 2 bundle: add --ros")
     if seed + count - 1 > MAX_SEED:
         raise ParameterError(f"parameter 'count' must be in [1, {MAX_SEED - seed + 1}] for seed {seed}, got {count}")
     _check_out(out)
     for s in range(seed, seed + count):
         world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, **params)
         world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
-        folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite)
+        folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
+                             ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
         failed = ",".join(c.name for c in world.feasibility.failed())
         verdict = f"\tinfeasible: {failed}" if failed else ""

@@ -6,7 +6,7 @@ import hashlib
 import json
 from functools import cached_property
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Optional, Sequence
+from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
 from worldgen.errors import OutputError
 from worldgen.export import formats as formats_table
@@ -161,12 +161,14 @@ class World:
 
     # -- disk --------------------------------------------------------------
     def write(self, out_dir, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
-              preview: bool = True, overwrite: bool = False) -> Path:
+              preview: bool = True, overwrite: bool = False, ros: Union[bool, str] = False) -> Path:
         """Write ``out_dir/<folder_name>/`` (the world's files and world.json); return that folder.
 
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
         ``preview`` adds preview.png, a top-down picture (worldgen.export.preview).
+        ``ros`` adds the ROS 2 bundle in ``ros2/`` (worldgen.export.ros2): True for the default
+        Gazebo release, or a release's name (``fortress``, ``harmonic``, ...).
         A folder of the same name that holds another world (another
         ``content_hash``, or no readable world.json) is an :class:`OutputError`
         unless ``overwrite``; the same world is simply written again.
@@ -174,13 +176,13 @@ class World:
         out_dir = Path(out_dir)
         if not overwrite:
             refuse_other_world(out_dir / self.folder_name, self.content_hash)
-        blobs = self.folder_blobs(formats, sdf_version, preview)
+        blobs = self.folder_blobs(formats, sdf_version, preview, ros)
         target = write_folder_atomically(out_dir, self.folder_name, blobs)
         self.path = target
         return target
 
     def folder_blobs(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9",
-                     preview: bool = True) -> dict[str, bytes]:
+                     preview: bool = True, ros: Union[bool, str] = False) -> dict[str, bytes]:
         """Every file :meth:`write` puts in the folder, world.json included: relative path -> bytes."""
         from worldgen.export import metadata
 
@@ -192,6 +194,9 @@ class World:
             from worldgen.export.preview import render
             blobs[PREVIEW_NAME] = render(meta)
         blobs[METADATA_NAME] = metadata.dumps(meta).encode()
+        if ros:  # derived from the world like preview.png, so not listed in world.json's `files` either
+            from worldgen.export.ros2 import bundle, release_of
+            blobs.update(bundle(self, sdf_version, release_of(ros)))
         return blobs
 
     def file(self, fmt: str) -> Path:

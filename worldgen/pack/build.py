@@ -94,7 +94,7 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
     summary = BuildSummary(total=len(recipe.jobs), skipped=len(recipe.jobs) - len(todo))
     start = time.monotonic()
     bar = _Progress(progress, len(todo))
-    args = (str(worlds_dir), recipe.formats, recipe.sdf_version, recipe.preview)
+    args = (str(worlds_dir), recipe.formats, recipe.sdf_version, recipe.preview, recipe.ros)
 
     def finished(rec: dict) -> None:
         job = recipe.jobs[rec["job"]]

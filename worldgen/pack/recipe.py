@@ -8,6 +8,7 @@ every mistake is one line ``RECIPE:LINE: key 'K': what is wrong``::
     formats: [sdf, mjcf, urdf]     # optional; default: every format
     sdf_version: "1.9"             # optional
     preview: false                 # optional; default false (preview.png costs ~40 ms a world)
+    ros: false                     # optional; true (or a Gazebo release: fortress, harmonic, ...) adds ros2/
     seeds: 10                      # a count (0..9), {start: 100, count: 10} or {min: 0, max: 9}
     worlds:                        # one entry per generator or preset
       - generator: cluttered       # or `preset: drl_arena`
@@ -43,7 +44,7 @@ from worldgen.seeding import MAX_SEED, recipe_rng
 
 __all__ = ["Job", "Recipe", "load_recipe", "parse_recipe", "TOP_KEYS", "ENTRY_KEYS", "PHYSICS_PARAMS"]
 
-TOP_KEYS = ("name", "formats", "sdf_version", "preview", "seeds", "worlds")
+TOP_KEYS = ("name", "formats", "sdf_version", "preview", "ros", "seeds", "worlds")
 ENTRY_KEYS = ("generator", "preset", "params", "physics", "seeds")
 #: Parameters a recipe may vary under ``physics:`` (every generator has them).
 PHYSICS_PARAMS = ("friction", "step_size", "real_time_factor")
@@ -87,6 +88,7 @@ class Recipe:
     preview: bool
     jobs: tuple[Job, ...]
     document: Any  # the recipe as plain data, recorded in the manifest
+    ros: Any = False  # the ROS 2 bundle: False, or the Gazebo release it is written for
 
     def __len__(self) -> int:
         return len(self.jobs)
@@ -137,6 +139,16 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
         preview = r.value(top["preview"])
         if not isinstance(preview, bool):
             r.fail(top["preview"], "preview", f"must be true or false, got {quoted(preview)}")
+    ros: Any = False
+    if "ros" in top:
+        from worldgen.export.ros2 import GZ_RELEASES, release_of
+
+        value = r.value(top["ros"])
+        try:
+            ros = value and release_of(value)
+        except ParameterError:
+            r.fail(top["ros"], "ros", f"must be true, false or a Gazebo release among {', '.join(GZ_RELEASES)}, "
+                                      f"got {quoted(value)}")
     default_seeds = r.seeds(top["seeds"]) if "seeds" in top else None
     worlds = top["worlds"]
     if not isinstance(worlds, yaml.SequenceNode) or not worlds.value:
@@ -148,7 +160,7 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
             jobs.append(Job(len(jobs), e, generator, seed, params, preset))
             if len(jobs) > MAX_WORLDS:
                 r.fail(worlds, "worlds", f"describes more than {MAX_WORLDS} worlds")
-    return Recipe(name, tuple(formats), sdf_version, preview, tuple(jobs), r.value(root))
+    return Recipe(name, tuple(formats), sdf_version, preview, tuple(jobs), r.value(root), ros)
 
 
 class _Reader:

@@ -19,7 +19,7 @@ from worldgen.pack.recipe import Job
 __all__ = ["render_job", "build_job"]
 
 
-def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict, dict[str, bytes]]:
+def render_job(job: Job, formats, sdf_version: str, preview: bool, ros=False) -> tuple[dict, dict[str, bytes]]:
     """Generate one world: its record and its folder's files (no disk; runs in any worker)."""
     import hashlib
 
@@ -36,7 +36,7 @@ def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict
     world.preset = job.preset
     if job.preset:
         rec["preset"] = job.preset
-    blobs = world.folder_blobs(formats, sdf_version, preview)
+    blobs = world.folder_blobs(formats, sdf_version, preview, ros)
     meta = json.loads(blobs[METADATA_NAME])
     folder = f"{WORLDS_DIR}/{world.folder_name}"
     rec.update(world_id=world.world_id, folder=world.folder_name, params=meta["params"], metrics=key_metrics(meta),
@@ -45,10 +45,9 @@ def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict
     return rec, blobs
 
 
-def build_job(job: Job, worlds_dir: str, formats, sdf_version: str, preview: bool) -> dict:
+def build_job(job: Job, worlds_dir: str, formats, sdf_version: str, preview: bool, ros=False) -> dict:
     """Build and write one world; return its record (runs in a local worker process)."""
-
-    rec, blobs = render_job(job, formats, sdf_version, preview)
+    rec, blobs = render_job(job, formats, sdf_version, preview, ros)
     if blobs:
         write_folder_atomically(Path(worlds_dir), rec["folder"], blobs)
     return rec
