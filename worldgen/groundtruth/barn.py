@@ -1,0 +1,237 @@
+"""BARN's five difficulty metrics, computed exactly as BARN's own code computes them.
+
+BARN (Perille et al., "Benchmarking Metric Ground Navigation", SSRR 2020) ranks
+worlds by five numbers that its generator's ``difficulty_quant.py``
+(dperille/jackal-map-creation, commit 947fe6f, its last change) computes on a
+C-space occupancy grid at the cells of a path. :func:`barn_metrics` is written
+here from that algorithm, vectorised with numpy (BARN's pure-Python loops take
+seconds on a 600 x 600 grid; this takes milliseconds), and returns the same
+floats: ``tests/groundtruth/test_barn.py`` holds numbers obtained by running
+BARN's unmodified code and requires agreement to 1e-9.
+
+What BARN computes, per path cell (row, col), row 0 at the top; a cell is a
+wall when its value is 1 (``== 1``: any other value is free):
+
+- ``closest_wall``: the Euclidean distance (cells) to the nearest wall cell of
+  the grid (the map's edge is not a wall); 0 on a wall cell. A grid without any
+  wall gives ``(rows - 1) / 2`` in Python 2's integer division, as BARN's code
+  (which imports ``Queue``: Python 2) does.
+- ``average_visibility``: the mean over the 8 grid directions of the free run
+  from the cell itself, each free cell counting the step's length (1 or sqrt 2),
+  up to a wall or the map's edge (a ray leaving the map counts up to the edge);
+  0 on a wall cell.
+- ``dispersion``: along 16 step directions, the 8 grid ones and the 8 knight
+  moves between them, whether a wall lies within ``disp_radius`` "steps", then
+  the number of wall / no-wall changes around the circle; -1 on a wall cell.
+  **BARN's quirk, kept on purpose**: it means a knight move to count two steps,
+  but tests ``move[0] == 2 or move[1] == 2``, so only the four knight moves with
+  a +2 component, (1, 2), (2, 1), (2, -1), (-1, 2), count two; the four with a
+  -2 component, (1, -2), (-2, -1), (-1, -2), (-2, 1), count one and so look
+  twice as far (radius 20: 20 knight moves, 2.24 m at 0.05 m, against 10).
+- ``characteristic_dimension``: the shortest, over 4 axes (the 2 grid axes and
+  2 diagonals), of the free run on both sides of the cell, the cell itself not
+  counted, each cell weighing its step's length; -1 on a wall cell.
+- ``tortuosity``: the sum of the Euclidean lengths between consecutive path
+  cells over the distance between the first and the last cell.
+
+Each of the first four is averaged over the path's cells in order. Sums are
+formed in BARN's order (one step length added at a time, directions in BARN's
+order, cells in path order), so the results are the same floats, not merely
+close. :func:`cspace` is BARN's C-space (``gen_world_ca.JackalMap``: a cell is a
+wall when the robot's square window, anchored at its top-left, meets a wall)
+and :func:`chain` turns a polyline into an 8-connected chain of cells, the kind
+of path BARN's A* returns.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+
+from worldgen.errors import ParameterError
+
+__all__ = ["barn_metrics", "cspace", "chain", "NAMES", "DISPERSION_MOVES", "BARN_COMMIT"]
+
+#: The commit of dperille/jackal-map-creation whose ``difficulty_quant.py`` this follows.
+BARN_COMMIT = "947fe6f497b12fe47c11dc43d8192ef99c050d7c"
+#: BARN's names, in the order of ``avg_all_metrics``.
+NAMES = ("closest_wall", "average_visibility", "dispersion", "characteristic_dimension", "tortuosity")
+#: BARN's 16 dispersion directions (row, col), in its order around the circle.
+DISPERSION_MOVES = ((0, 1), (1, 2), (1, 1), (2, 1), (1, 0), (2, -1), (1, -1), (1, -2),
+                    (0, -1), (-2, -1), (-1, -1), (-1, -2), (-1, 0), (-2, 1), (-1, 1), (-1, 2))
+#: BARN's visibility directions in its loop order (row step outer, column step inner).
+_VIS_MOVES = tuple((dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if (dr, dc) != (0, 0))
+#: BARN's characteristic-dimension axes, in its order.
+_AXES = ((0, 1), (1, 1), (1, 0), (1, -1))
+
+
+def barn_metrics(grid, path_cells, disp_radius) -> dict[str, Optional[float]]:
+    """BARN's five metrics of ``path_cells`` on ``grid``, in cells, as BARN's code returns them.
+
+    ``grid``: rows of 0/1 (1 = wall), row 0 at the top. ``path_cells``: (row, col)
+    integer cells inside the grid, in path order. ``disp_radius``: the dispersion
+    radius in BARN's steps. ``tortuosity`` is None when the path starts and ends
+    in the same cell (BARN's code divides by zero there).
+    """
+    occ = np.asarray(grid) == 1
+    if occ.ndim != 2 or occ.size == 0:
+        raise ParameterError(f"grid must be a non-empty 2-D array of rows of 0/1, got shape {np.shape(grid)}")
+    cells = np.asarray(path_cells)
+    if cells.ndim != 2 or cells.shape[1:] != (2,) or len(cells) == 0 or not np.issubdtype(cells.dtype, np.integer):
+        raise ParameterError(f"path_cells must be a non-empty list of integer (row, col) pairs, got shape {cells.shape}")
+    rows, cols = occ.shape
+    r, c = cells[:, 0].astype(np.int64), cells[:, 1].astype(np.int64)
+    if r.min() < 0 or c.min() < 0 or r.max() >= rows or c.max() >= cols:
+        raise ParameterError(f"path_cells must lie inside the {rows} x {cols} grid, got rows {r.min()}..{r.max()}, "
+                             f"cols {c.min()}..{c.max()}")
+    if not isinstance(disp_radius, (int, float, np.integer, np.floating)) or not math.isfinite(disp_radius):
+        raise ParameterError(f"disp_radius must be a finite number of steps, got {disp_radius!r}")
+    wall = occ[r, c]
+    runs = _free_runs(occ, r, c)  # {(dr, dc): free cells after the path cell along (dr, dc)}
+    longest = max(rows, cols) + 1
+    table = {1: np.arange(longest + 1, dtype=float), 2: _steps(math.sqrt(2), longest)}
+    return {
+        "closest_wall": _mean(_closest_wall(occ, r, c, wall)),
+        "average_visibility": _mean(_visibility(runs, wall, table)),
+        "dispersion": _mean(_dispersion(occ, r, c, wall, disp_radius)),
+        "characteristic_dimension": _mean(_char_dim(runs, wall, table, rows + cols)),
+        "tortuosity": _tortuosity(r, c),
+    }
+
+
+def cspace(occupied, kernel: int) -> np.ndarray:
+    """BARN's C-space of an obstacle grid: (rows - k + 1, cols - k + 1) of 0/1, a cell 1 when the
+    k x k window whose top-left corner it is meets an occupied cell (``JackalMap``'s construction)."""
+    occ = np.asarray(occupied, dtype=bool)
+    if kernel < 1 or kernel > min(occ.shape):
+        raise ParameterError(f"kernel must be in [1, {min(occ.shape)}] cells for a {occ.shape} grid, got {kernel!r}")
+    if kernel == 1:
+        return occ.astype(np.uint8)
+    # A 2-D window maximum as two 1-D ones (rows, then columns) over the strided views.
+    rows_max = sliding_window_view(occ, kernel, axis=0).any(axis=-1)
+    return sliding_window_view(rows_max, kernel, axis=1).any(axis=-1).astype(np.uint8)
+
+
+def chain(cells) -> np.ndarray:
+    """(m, 2) 8-connected chain through the given (row, col) cells in order: between two
+    consecutive cells, the cells of the digital straight line joining them (each step one
+    of the 8 grid moves, diagonal where the line is), without repeats."""
+    pts = np.asarray(cells, dtype=np.int64).reshape(-1, 2)
+    out = [pts[:1]]
+    for a, b in zip(pts[:-1], pts[1:]):
+        n = int(np.abs(b - a).max())
+        if n == 0:
+            continue
+        t = np.arange(1, n + 1)
+        # Round half away from a, so the same segment gives the same cells whichever way it is read.
+        step = (b - a)[None, :] * t[:, None]
+        line = a + np.sign(step) * ((np.abs(step) * 2 + n) // (2 * n))
+        out.append(line)
+    return np.vstack(out)
+
+
+# -- the metrics ------------------------------------------------------------------------------
+
+def _mean(values: np.ndarray) -> float:
+    """BARN's ``total = 0.0; total += v`` over the path, then ``total / len(path)``."""
+    return float(np.add.accumulate(np.asarray(values, dtype=float))[-1]) / len(values)
+
+
+def _steps(step: float, n: int) -> np.ndarray:
+    """[0, step, step + step, ...]: k steps added one at a time (BARN's loop), for k = 0..n."""
+    return np.r_[0.0, np.add.accumulate(np.full(n, step))]
+
+
+def _closest_wall(occ, r, c, wall) -> np.ndarray:
+    rows, cols = occ.shape
+    if not occ.any():
+        return np.full(len(r), float((rows - 1) // 2))  # BARN's fallback, Python 2's division
+    # BARN's best-first search pops cells by Euclidean distance from the start and stops at the
+    # first wall: the nearest wall cell of the grid. Exactly, in two passes: the vertical distance
+    # to the nearest wall of every column, then per path cell the least dx^2 + dy^2 over the
+    # columns (integers throughout, so the square root is BARN's math.sqrt of the same integer).
+    at = np.arange(rows)[:, None]
+    far = rows + cols  # a column without a wall: farther than any wall of the grid
+    below = np.minimum.accumulate(np.where(occ, at, rows + far)[::-1], axis=0)[::-1] - at
+    above = at - np.maximum.accumulate(np.where(occ, at, -far), axis=0)
+    dy = np.minimum(below, above)[r]  # (path cells, cols)
+    dx = np.arange(cols)[None, :] - c[:, None]
+    d2 = (dx * dx + dy * dy).min(axis=1)
+    return np.where(wall, 0.0, np.sqrt(d2.astype(float)))
+
+
+def _free_runs(occ, r, c) -> dict[tuple[int, int], np.ndarray]:
+    """For each of the 8 grid moves, the free cells after each path cell before a wall or the edge.
+
+    Only the lines (rows, columns, diagonals) through path cells are scanned: each is laid out
+    as a row of a (lines, length) array, cells off the grid counting as walls (a run stops at
+    the edge as at a wall), and the next and previous stop of every cell found by running
+    minima and maxima along it."""
+    rows, cols = occ.shape
+    out = {}
+    i = np.arange(rows)
+    # (line ids of the path cells, the lines' cells, the path cells' positions along their line)
+    layouts = {
+        (0, 1): (r, lambda ids: occ[ids], c),
+        (1, 0): (c, lambda ids: occ[:, ids].T, r),
+    }
+    for dc in (1, -1):
+        # Down-right diagonals keep c - r, down-left ones c + r; position along them is the row.
+        def lay(ids, dc=dc):
+            col = ids[:, None] + dc * i[None, :]
+            inside = (col >= 0) & (col < cols)
+            return np.where(inside, occ[i[None, :], np.clip(col, 0, cols - 1)], True)
+        layouts[(1, dc)] = (c - dc * r, lay, r)
+    for (dr, dc), (key, lay, pos) in layouts.items():
+        ids, line = np.unique(key, return_inverse=True)
+        cells = lay(ids)
+        n = cells.shape[1]
+        at = np.arange(n)[None, :]
+        nxt = np.flip(np.minimum.accumulate(np.flip(np.where(cells, at, n), 1), axis=1), 1)
+        prv = np.maximum.accumulate(np.where(cells, at, -1), axis=1)
+        out[(dr, dc)] = nxt[line, pos] - pos - 1
+        out[(-dr, -dc)] = pos - prv[line, pos] - 1
+    return out
+
+
+def _visibility(runs, wall, table) -> np.ndarray:
+    total = np.zeros(len(wall))
+    for dr, dc in _VIS_MOVES:  # BARN's order, one direction's run added at a time
+        total = total + table[abs(dr) + abs(dc)][runs[(dr, dc)] + 1]  # the cell itself counts
+    return np.where(wall, 0.0, total / 8)
+
+
+def _char_dim(runs, wall, table, limit: int) -> np.ndarray:
+    best = np.full(len(wall), float(limit))
+    for dr, dc in _AXES:
+        best = np.minimum(best, table[abs(dr) + abs(dc)][runs[(dr, dc)] + runs[(-dr, -dc)]])
+    return np.where(wall, -1.0, best)
+
+
+def _dispersion(occ, r, c, wall, radius) -> np.ndarray:
+    rows, cols = occ.shape
+    blocked = np.zeros((len(r), len(DISPERSION_MOVES)), dtype=bool)
+    for k, (dr, dc) in enumerate(DISPERSION_MOVES):
+        inc = 2 if dr == 2 or dc == 2 else 1  # BARN's test, quirk included (see the module docs)
+        # The loop takes steps while count < radius: ceil(radius / inc) of them; past the map's
+        # edge a straight walk never comes back, so no more than the map's size matter.
+        steps = min(max(math.ceil(radius / inc), 0), max(rows, cols)) if radius > 0 else 0
+        if steps == 0:
+            continue
+        i = np.arange(1, steps + 1)
+        rr, cc = r[:, None] + dr * i, c[:, None] + dc * i
+        inside = (rr >= 0) & (rr < rows) & (cc >= 0) & (cc < cols)
+        hit = occ[np.clip(rr, 0, rows - 1), np.clip(cc, 0, cols - 1)] & inside
+        blocked[:, k] = hit.any(axis=1)
+    changes = (blocked != np.roll(blocked, -1, axis=1)).sum(axis=1)
+    return np.where(wall, -1, changes)
+
+
+def _tortuosity(r, c) -> Optional[float]:
+    dr, dc = np.diff(r), np.diff(c)
+    arc = float(np.add.accumulate(np.r_[0.0, np.sqrt((dr * dr + dc * dc).astype(float))])[-1])
+    chord = math.sqrt(float((r[-1] - r[0]) ** 2 + (c[-1] - c[0]) ** 2))
+    return arc / chord if chord > 0 else None
