@@ -49,11 +49,11 @@ import math
 from typing import Optional
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
 
 from worldgen.errors import ParameterError
 
-__all__ = ["barn_metrics", "cspace", "chain", "NAMES", "DISPERSION_MOVES", "BARN_COMMIT"]
+__all__ = ["barn_metrics", "cspace", "chain", "kernel_cells", "world_inputs", "world_metrics", "NAMES",
+           "DISPERSION_MOVES", "DISP_RADIUS", "BARN_COMMIT"]
 
 #: The commit of dperille/jackal-map-creation whose ``difficulty_quant.py`` this follows.
 BARN_COMMIT = "947fe6f497b12fe47c11dc43d8192ef99c050d7c"
@@ -62,6 +62,8 @@ NAMES = ("closest_wall", "average_visibility", "dispersion", "characteristic_dim
 #: BARN's 16 dispersion directions (row, col), in its order around the circle.
 DISPERSION_MOVES = ((0, 1), (1, 2), (1, 1), (2, 1), (1, 0), (2, -1), (1, -1), (1, -2),
                     (0, -1), (-2, -1), (-1, -1), (-1, -2), (-1, 0), (-2, 1), (-1, 1), (-1, 2))
+#: BARN's dispersion radius, in cells (``difficulty_quant.main``'s ``disp_radius``).
+DISP_RADIUS = 3
 #: BARN's visibility directions in its loop order (row step outer, column step inner).
 _VIS_MOVES = tuple((dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if (dr, dc) != (0, 0))
 #: BARN's characteristic-dimension axes, in its order.
@@ -106,13 +108,58 @@ def cspace(occupied, kernel: int) -> np.ndarray:
     """BARN's C-space of an obstacle grid: (rows - k + 1, cols - k + 1) of 0/1, a cell 1 when the
     k x k window whose top-left corner it is meets an occupied cell (``JackalMap``'s construction)."""
     occ = np.asarray(occupied, dtype=bool)
-    if kernel < 1 or kernel > min(occ.shape):
+    if occ.ndim != 2 or not 1 <= kernel <= min(occ.shape):
         raise ParameterError(f"kernel must be in [1, {min(occ.shape)}] cells for a {occ.shape} grid, got {kernel!r}")
-    if kernel == 1:
-        return occ.astype(np.uint8)
-    # A 2-D window maximum as two 1-D ones (rows, then columns) over the strided views.
-    rows_max = sliding_window_view(occ, kernel, axis=0).any(axis=-1)
-    return sliding_window_view(rows_max, kernel, axis=1).any(axis=-1).astype(np.uint8)
+    # Window counts from running sums, rows then columns: linear in the cells whatever k is.
+    s = np.cumsum(np.pad(occ, ((1, 0), (0, 0))), axis=0, dtype=np.int64)
+    rows_any = (s[kernel:] - s[:-kernel]) > 0
+    s = np.cumsum(np.pad(rows_any, ((0, 0), (1, 0))), axis=1, dtype=np.int64)
+    return ((s[:, kernel:] - s[:, :-kernel]) > 0).astype(np.uint8)
+
+
+def kernel_cells(robot_radius: float, resolution: float) -> int:
+    """BARN's robot kernel for a disc robot: the odd square of cells that holds the disc, 2h + 1
+    with h = ceil(radius / resolution) (BARN's Jackal is a 3 x 3 square of its 0.15 m cells)."""
+    return 2 * max(0, math.ceil(robot_radius / resolution - 1e-9)) + 1
+
+
+def world_inputs(occupied, origin, resolution: float, robot_radius: float, waypoints) -> tuple[np.ndarray, np.ndarray]:
+    """BARN's inputs for one path of a world: (C-space grid, 8-connected chain of its cells).
+
+    ``occupied``: the map (rows, cols) with row 0 at the bottom, as :class:`OccupancyMap`;
+    ``origin``: its lower-left corner (m); ``waypoints``: the path's polyline (k, 2) in metres.
+    The grid is :func:`cspace` of the map flipped to BARN's orientation (row 0 at the top)
+    with :func:`kernel_cells`; the path is the chain through the waypoints' map cells, each
+    moved by the kernel's half-width to the C-space cell whose window is centred on it and
+    kept inside the C-space (a cell nearer the map's edge than the half-width has no C-space
+    cell of its own: BARN's C-space is smaller than its map by the kernel).
+    """
+    occ = np.asarray(occupied, dtype=bool)[::-1]
+    rows, cols = occ.shape
+    k = min(kernel_cells(robot_radius, resolution), rows, cols)
+    half = k // 2
+    grid = cspace(occ, k)
+    w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+    col = np.floor((w[:, 0] - origin[0]) / resolution).astype(np.int64)
+    row = rows - 1 - np.floor((w[:, 1] - origin[1]) / resolution).astype(np.int64)
+    cells = chain(np.c_[row, col]) - half
+    cells = np.c_[np.clip(cells[:, 0], 0, grid.shape[0] - 1), np.clip(cells[:, 1], 0, grid.shape[1] - 1)]
+    keep = np.r_[True, (cells[1:] != cells[:-1]).any(axis=1)]
+    return grid, cells[keep]
+
+
+def world_metrics(occupied, origin, resolution: float, robot_radius: float, paths,
+                  disp_radius=DISP_RADIUS) -> dict[str, Optional[float]]:
+    """BARN's five metrics of a world: :func:`barn_metrics` on :func:`world_inputs` of each path
+    (polylines; None for a task without one), averaged over the paths; each None without a path
+    (tortuosity also where every path starts and ends in one cell)."""
+    per = [barn_metrics(*world_inputs(occupied, origin, resolution, robot_radius, p), disp_radius)
+           for p in paths if p is not None]
+    out: dict[str, Optional[float]] = {}
+    for name in NAMES:
+        values = [m[name] for m in per if m[name] is not None]
+        out[name] = float(np.mean(values)) if values else None
+    return out
 
 
 def chain(cells) -> np.ndarray:

@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import weakref
 
+from worldgen.groundtruth import barn as barn_grid
 from worldgen.groundtruth import lidar, metrics, occupancy
 from worldgen.params import COMMON_PARAMS
 from worldgen.scene import Pose
 from worldgen.scene.doors import open_scene
 
-__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "MAP_KEYS"]
+__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "barn",
+           "MAP_KEYS"]
 
 #: world.json ``files`` keys of the map's two files.
 MAP_KEYS = ("map_pgm", "map_yaml")
@@ -77,3 +79,11 @@ def map_files(world) -> dict[str, tuple[str, bytes]]:
 def difficulty(world) -> dict:
     """The five BARN-style figures of world.json's ``metrics``."""
     return metrics.difficulty(planning_scene(world), world.robot, world.tasks, world.feasibility.paths)
+
+
+def barn(world) -> dict:
+    """world.json's ``metrics.barn``: BARN's own five metrics (its code's definitions, in cells)
+    on BARN's inputs made from this world's map and reference paths (docs/metrics.md)."""
+    grid = occupancy_map(world)
+    paths = [None if p is None else p.waypoints for p in world.feasibility.paths]
+    return barn_grid.world_metrics(grid.occupied, grid.origin, grid.resolution, world.robot.radius, paths)
