@@ -173,9 +173,10 @@ def chain(cells) -> np.ndarray:
         if n == 0:
             continue
         t = np.arange(1, n + 1)
-        # Round half away from a, so the same segment gives the same cells whichever way it is read.
-        step = (b - a)[None, :] * t[:, None]
-        line = a + np.sign(step) * ((np.abs(step) * 2 + n) // (2 * n))
+        # The point a + (b - a) t / n, rounded half up in absolute coordinates (exact integers):
+        # the same segment gives the same cells whichever way it is read.
+        num = a[None, :] * n + (b - a)[None, :] * t[:, None]
+        line = (2 * num + n) // (2 * n)
         out.append(line)
     return np.vstack(out)
 
