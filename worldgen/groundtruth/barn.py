@@ -123,7 +123,8 @@ def kernel_cells(robot_radius: float, resolution: float) -> int:
     return 2 * max(0, math.ceil(robot_radius / resolution - 1e-9)) + 1
 
 
-def world_inputs(occupied, origin, resolution: float, robot_radius: float, waypoints) -> tuple[np.ndarray, np.ndarray]:
+def world_inputs(occupied, origin, resolution: float, robot_radius: float, waypoints,
+                 kernel: Optional[int] = None) -> tuple[np.ndarray, np.ndarray]:
     """BARN's inputs for one path of a world: (C-space grid, 8-connected chain of its cells).
 
     ``occupied``: the map (rows, cols) with row 0 at the bottom, as :class:`OccupancyMap`;
@@ -132,11 +133,12 @@ def world_inputs(occupied, origin, resolution: float, robot_radius: float, waypo
     with :func:`kernel_cells`; the path is the chain through the waypoints' map cells, each
     moved by the kernel's half-width to the C-space cell whose window is centred on it and
     kept inside the C-space (a cell nearer the map's edge than the half-width has no C-space
-    cell of its own: BARN's C-space is smaller than its map by the kernel).
+    cell of its own: BARN's C-space is smaller than its map by the kernel). ``kernel`` replaces
+    :func:`kernel_cells`; 1 gives the uninflated map and the chain in map cells.
     """
     occ = np.asarray(occupied, dtype=bool)[::-1]
     rows, cols = occ.shape
-    k = min(kernel_cells(robot_radius, resolution), rows, cols)
+    k = min(kernel_cells(robot_radius, resolution) if kernel is None else kernel, rows, cols)
     half = k // 2
     grid = cspace(occ, k)
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
@@ -201,11 +203,11 @@ def _closest_wall(occ, r, c, wall) -> np.ndarray:
     # first wall: the nearest wall cell of the grid. Exactly, in two passes: the vertical distance
     # to the nearest wall of every column, then per path cell the least dx^2 + dy^2 over the
     # columns (integers throughout, so the square root is BARN's math.sqrt of the same integer).
-    at = np.arange(rows)[:, None]
+    at = np.arange(rows, dtype=np.int32)[:, None]
     far = rows + cols  # a column without a wall: farther than any wall of the grid
-    below = np.minimum.accumulate(np.where(occ, at, rows + far)[::-1], axis=0)[::-1] - at
-    above = at - np.maximum.accumulate(np.where(occ, at, -far), axis=0)
-    dy = np.minimum(below, above)[r]  # (path cells, cols)
+    below = np.minimum.accumulate(np.where(occ, at, np.int32(rows + far))[::-1], axis=0)[::-1][r] - r[:, None]
+    above = r[:, None] - np.maximum.accumulate(np.where(occ, at, np.int32(-far)), axis=0)[r]
+    dy = np.minimum(below, above).astype(np.int64)  # (path cells, cols)
     dx = np.arange(cols)[None, :] - c[:, None]
     d2 = (dx * dx + dy * dy).min(axis=1)
     return np.where(wall, 0.0, np.sqrt(d2.astype(float)))
@@ -220,7 +222,9 @@ def _free_runs(occ, r, c) -> dict[tuple[int, int], np.ndarray]:
     minima and maxima along it."""
     rows, cols = occ.shape
     out = {}
-    i = np.arange(rows)
+    # The grid with `rows` wall columns either side: a diagonal leaving the grid runs into them.
+    padded = np.pad(occ, ((0, 0), (rows, rows)), constant_values=True).ravel()
+    start = np.arange(rows) * (cols + 2 * rows) + rows  # flat index of each row's first grid cell
     # (line ids of the path cells, the lines' cells, the path cells' positions along their line)
     layouts = {
         (0, 1): (r, lambda ids: occ[ids], c),
@@ -229,17 +233,15 @@ def _free_runs(occ, r, c) -> dict[tuple[int, int], np.ndarray]:
     for dc in (1, -1):
         # Down-right diagonals keep c - r, down-left ones c + r; position along them is the row.
         def lay(ids, dc=dc):
-            col = ids[:, None] + dc * i[None, :]
-            inside = (col >= 0) & (col < cols)
-            return np.where(inside, occ[i[None, :], np.clip(col, 0, cols - 1)], True)
+            return padded[ids[:, None] + (start + dc * np.arange(rows))[None, :]]
         layouts[(1, dc)] = (c - dc * r, lay, r)
     for (dr, dc), (key, lay, pos) in layouts.items():
         ids, line = np.unique(key, return_inverse=True)
         cells = lay(ids)
         n = cells.shape[1]
-        at = np.arange(n)[None, :]
-        nxt = np.flip(np.minimum.accumulate(np.flip(np.where(cells, at, n), 1), axis=1), 1)
-        prv = np.maximum.accumulate(np.where(cells, at, -1), axis=1)
+        at = np.arange(n, dtype=np.int32)[None, :]
+        nxt = np.flip(np.minimum.accumulate(np.flip(np.where(cells, at, np.int32(n)), 1), axis=1), 1)
+        prv = np.maximum.accumulate(np.where(cells, at, np.int32(-1)), axis=1)
         out[(dr, dc)] = nxt[line, pos] - pos - 1
         out[(-dr, -dc)] = pos - prv[line, pos] - 1
     return out
@@ -262,18 +264,20 @@ def _char_dim(runs, wall, table, limit: int) -> np.ndarray:
 def _dispersion(occ, r, c, wall, radius) -> np.ndarray:
     rows, cols = occ.shape
     blocked = np.zeros((len(r), len(DISPERSION_MOVES)), dtype=bool)
+    # The loop takes steps while count < radius: ceil(radius / inc) of them; past the map's edge a
+    # straight walk never comes back, so no more than the map's size matter.
+    most = min(max(math.ceil(radius), 0), max(rows, cols)) if radius > 0 else 0
+    if most == 0:
+        return np.where(wall, -1, 0)
+    pad = 2 * most  # off-grid cells, free, as far as any walk reaches (BARN stops there: no wall)
+    grid = np.pad(occ, pad).ravel()
+    width = cols + 2 * pad
+    at = (r + pad) * width + c + pad
     for k, (dr, dc) in enumerate(DISPERSION_MOVES):
         inc = 2 if dr == 2 or dc == 2 else 1  # BARN's test, quirk included (see the module docs)
-        # The loop takes steps while count < radius: ceil(radius / inc) of them; past the map's
-        # edge a straight walk never comes back, so no more than the map's size matter.
-        steps = min(max(math.ceil(radius / inc), 0), max(rows, cols)) if radius > 0 else 0
-        if steps == 0:
-            continue
+        steps = min(math.ceil(radius / inc), most)
         i = np.arange(1, steps + 1)
-        rr, cc = r[:, None] + dr * i, c[:, None] + dc * i
-        inside = (rr >= 0) & (rr < rows) & (cc >= 0) & (cc < cols)
-        hit = occ[np.clip(rr, 0, rows - 1), np.clip(cc, 0, cols - 1)] & inside
-        blocked[:, k] = hit.any(axis=1)
+        blocked[:, k] = grid[at[:, None] + (dr * width + dc) * i[None, :]].any(axis=1)
     changes = (blocked != np.roll(blocked, -1, axis=1)).sum(axis=1)
     return np.where(wall, -1, changes)
 
