@@ -77,7 +77,7 @@ def map_files(world) -> dict[str, tuple[str, bytes]]:
 
 
 def difficulty(world) -> dict:
-    """The five BARN-style figures of world.json's ``metrics``."""
+    """worldgen's five exact figures of world.json's ``metrics`` (after BARN's; not BARN's numbers)."""
     return metrics.difficulty(planning_scene(world), world.robot, world.tasks, world.feasibility.paths)
 
 
