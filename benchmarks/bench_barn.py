@@ -77,10 +77,12 @@ def compare(generator: str, seed: int) -> dict:
     cs, cells = barn.world_inputs(grid.occupied, grid.origin, res, world.robot.radius, waypoints)
     inside = float(cs[cells[:, 0], cells[:, 1]].mean())
     out: dict = {"generator": generator, "seed": seed, "params": params, "cells_in_cspace_walls": inside,
-                 "closest_difference_m": user["closest_wall"] * res - ours["closest_obstacle_distance_mean"]}
+                 "closest_difference_m": float(user["closest_wall"] or 0.0) * res - ours["closest_obstacle_distance_mean"]}
     for kind, values in (("user", user), ("barn", meta["metrics"]["barn"])):
         for name, (mine, length) in PAIRS.items():
-            value = values[name] * (res if length else 1.0)
+            got = values[name]
+            assert got is not None, (generator, seed, name)  # every world here has a path
+            value = got * (res if length else 1.0)
             out[f"{kind}:{name}"] = value / ours[mine] if ours[mine] else None
     return out
 

@@ -46,7 +46,7 @@ of path BARN's A* returns.
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import Callable, Optional
 
 import numpy as np
 
@@ -159,7 +159,7 @@ def world_metrics(occupied, origin, resolution: float, robot_radius: float, path
            for p in paths if p is not None]
     out: dict[str, Optional[float]] = {}
     for name in NAMES:
-        values = [m[name] for m in per if m[name] is not None]
+        values = [v for m in per if (v := m[name]) is not None]
         out[name] = float(np.mean(values)) if values else None
     return out
 
@@ -226,7 +226,7 @@ def _free_runs(occ, r, c) -> dict[tuple[int, int], np.ndarray]:
     padded = np.pad(occ, ((0, 0), (rows, rows)), constant_values=True).ravel()
     start = np.arange(rows) * (cols + 2 * rows) + rows  # flat index of each row's first grid cell
     # (line ids of the path cells, the lines' cells, the path cells' positions along their line)
-    layouts = {
+    layouts: dict[tuple[int, int], tuple[np.ndarray, Callable[..., np.ndarray], np.ndarray]] = {
         (0, 1): (r, lambda ids: occ[ids], c),
         (1, 0): (c, lambda ids: occ[:, ids].T, r),
     }
