@@ -43,6 +43,15 @@ def test_world_json_doc_lists_exactly_the_schema_fields():
     assert documented - fields == set(), "fields the doc describes that the schema does not have"
 
 
+def test_the_code_cites_documents_that_exist():
+    """A docstring or comment that names a .md document names one the repository has."""
+    sources = sorted((REPO / "worldgen").rglob("*.py")) + sorted((REPO / "tests").rglob("*.py"))
+    for path in (p for p in sources if p.name != "test_docs.py"):  # this file names a missing one on purpose
+        for cited in re.findall(r"([\w./-]+\.md)\b", path.read_text()):
+            assert (REPO / cited).exists() or (REPO / "docs" / cited).exists(), \
+                f"{path.relative_to(REPO)} cites {cited}, which the repository does not have"
+
+
 def test_readme_points_at_documents_that_exist():
     readme = (REPO / "README.md").read_text()
     assert "METADATA.md" not in readme

@@ -62,7 +62,7 @@ def test_a_folder_holding_another_world_is_never_replaced_silently(tmp_path):
     meta = json.loads((folder / "world.json").read_text())
     meta["content_hash"] = "sha256:" + "0" * 64  # as if another world had landed under this name
     (folder / "world.json").write_text(json.dumps(meta))
-    with pytest.raises(OutputError, match="already holds another world; remove it or pass --overwrite"):
+    with pytest.raises(OutputError, match=r"already holds another world; remove it, or pass overwrite=True to World.write \(--overwrite on the command line\)"):
         world.write(tmp_path)
     assert json.loads((folder / "world.json").read_text())["content_hash"] == "sha256:" + "0" * 64
     (folder / "world.json").unlink()

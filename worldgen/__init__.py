@@ -3,7 +3,10 @@
     >>> import worldgen
     >>> world = worldgen.generate("cluttered", seed=7, size=[20, 20], n_obstacles=50)
     >>> world.metadata["tasks"][0]["path"]["length"]        # ground truth for assertions
+    12.575701
     >>> folder = world.write("worlds")                      # worlds/<world_id>/world.sdf, ...
+    >>> sorted(p.name for p in folder.iterdir())[:3]
+    ['map.pgm', 'map.yaml', 'preview.png']
 """
 
 from importlib.metadata import PackageNotFoundError

@@ -223,6 +223,11 @@ from worldgen.pack.commands import pack_group  # noqa: E402
 
 cli.add_command(pack_group)
 
+# `worldgen compare A B` lives in worldgen/testing/compare_command.py; only wired in here.
+from worldgen.testing.compare_command import compare_command  # noqa: E402
+
+cli.add_command(compare_command)
+
 
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
     """``["key=value", ...]`` -> ``{key: value}``, each value parsed for its parameter's kind.

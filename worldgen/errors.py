@@ -14,6 +14,7 @@ __all__ = [
     "InfeasibleError",
     "SceneError",
     "OutputError",
+    "MissingDependencyError",
     "quoted",
     "read_user_text",
     "QUOTE_LIMIT",
@@ -63,6 +64,14 @@ class InfeasibleError(WorldgenError):
 
 class OutputError(WorldgenError, OSError):
     """The output folder cannot be written (missing permission, not a folder, ...)."""
+
+
+class MissingDependencyError(WorldgenError, ImportError):
+    """An optional dependency that a feature needs is not installed; the message says what to install.
+
+    Here rather than beside one feature, so every stage with an optional extra (testing's statistics,
+    the environments) raises the same class.
+    """
 
 
 def quoted(value, limit: int = QUOTE_LIMIT) -> str:

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from worldgen.errors import SceneError
 
-__all__ = ["DECIMALS", "round_float", "fmt", "fmt_seq"]
+__all__ = ["DECIMALS", "round_float", "fmt", "fmt_seq", "finite_or_none"]
 
 #: Decimals kept in every written float: 1e-6 m is far below any simulator's tolerance.
 DECIMALS = 6
@@ -42,3 +42,11 @@ def fmt(x: float) -> str:
 def fmt_seq(values) -> str:
     """Space-separated :func:`fmt` of each value, as XML attributes want them."""
     return " ".join(map(fmt, values))
+
+
+def finite_or_none(x):
+    """None for a missing or unbounded figure (e.g. no obstacle in reach): JSON has no inf."""
+    if x is None:
+        return None
+    x = float(x)
+    return x if x - x == 0 else None

@@ -127,6 +127,8 @@ def describe_range(p: Param) -> str:
         return "one of " + ", ".join(map(str, p.choices))
     if p.kind == "bool":
         return "true or false"
+    if p.low is not None and p.low == p.high:  # a common parameter a generator pins (corridor's n_tasks)
+        return f"exactly {_num(p.low)}"
     lo = "-inf" if p.low is None else _num(p.low)
     hi = "inf" if p.high is None else _num(p.high)
     return f"in [{lo}, {hi}]"

@@ -33,10 +33,11 @@ from typing import Any, Optional
 
 import numpy as np
 
+from worldgen.files import METADATA_NAME
+
 __all__ = ["CHECKS", "Outcome", "check_folder", "LENGTH_TOLERANCE"]
 
 CHECKS = ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "reproduce")
-METADATA_NAME = "world.json"
 #: Recorded and re-run path lengths may differ by this much (m): the 1e-6 of the
 #: contract plus half a unit in the 6th decimal that world.json rounds to.
 LENGTH_TOLERANCE = 1e-6 + 5e-7

@@ -4,15 +4,14 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import shutil
-import tempfile
 from functools import cached_property
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional, Sequence
 
-from worldgen.errors import OutputError, ParameterError
-from worldgen.export.formats import FILE_NAMES, FORMATS, METADATA_NAME, SDF_VERSIONS, normalise_formats
+from worldgen.errors import OutputError
+from worldgen.export import formats as formats_table
+from worldgen.export.formats import FILE_NAMES, FORMATS, SDF_VERSIONS, normalise_formats
+from worldgen.files import METADATA_NAME, PREVIEW_NAME, refuse_other_world, write_folder_atomically
 from worldgen.scene import Robot, Scene, Task
 
 __all__ = ["World", "FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats"]
@@ -107,20 +106,7 @@ class World:
         return text
 
     def _render(self, fmt: str, sdf_version: str) -> str:
-        if fmt == "sdf":
-            from worldgen.export import sdf  # which checks the version
-            scene = self.scene
-            if scene.movers and not self.params.get("sdf_actors", True):
-                # Drake rejects <actor> (the <link> SDFormat requires inside it): the parameter leaves them out.
-                scene = scene.with_movers(())
-            return sdf.to_sdf(scene, version=sdf_version, name=self.world_id).decode()
-        if fmt == "mjcf":
-            from worldgen.export import mjcf
-            return mjcf.to_mjcf(self.scene, name=self.world_id).decode()
-        if fmt == "urdf":
-            from worldgen.export import urdf
-            return urdf.to_urdf(self.scene, name=self.world_id).decode()
-        raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {fmt!r}")
+        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version).decode()
 
     def mesh_files(self) -> dict[str, bytes]:
         """Mesh files the exported formats refer to: relative path -> bytes."""
@@ -136,7 +122,7 @@ class World:
         """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
         formats = normalise_formats(formats)
         files = {fmt: (FILE_NAMES[fmt], self.export(fmt, sdf_version).encode()) for fmt in formats}
-        if "sdf" in formats or "urdf" in formats:
+        if formats_table.uses_meshes(formats):
             for rel, data in self.mesh_files().items():
                 files[f"mesh:{rel}"] = (rel, data)
         from worldgen.groundtruth import truth
@@ -203,7 +189,7 @@ class World:
         meta = self.metadata_for(files)  # afresh: a caller may have edited .metadata's dict
         blobs = {path: data for path, data in files.values()}
         if preview:  # a picture of world.json, not listed in its `files` (see worldgen.export.preview)
-            from worldgen.export.preview import PREVIEW_NAME, render
+            from worldgen.export.preview import render
             blobs[PREVIEW_NAME] = render(meta)
         blobs[METADATA_NAME] = metadata.dumps(meta).encode()
         return blobs
@@ -214,72 +200,3 @@ class World:
             raise OutputError("this world has not been written yet; call World.write(folder) first")
         return self.path / (METADATA_NAME if fmt == "json" else FILE_NAMES[fmt])
 
-
-def _safe_relative(rel: str) -> str:
-    parts = Path(rel).parts
-    if Path(rel).is_absolute() or ".." in parts or not parts:
-        raise OutputError(f"refusing to write {rel!r} outside the world folder")
-    return rel
-
-
-def creation_mode(full: int) -> int:
-    """``full`` (0o666 for files, 0o777 for folders) less the process umask, as open() and mkdir() would give.
-
-    tempfile makes 0600 files and 0700 folders whatever the umask; what is renamed
-    into place must look as if it had been created there.
-    """
-    umask = os.umask(0)
-    os.umask(umask)
-    return full & ~umask
-
-
-def refuse_other_world(target: Path, content_hash: str) -> None:
-    """Raise OutputError if ``target`` exists and is not a folder of the world ``content_hash``."""
-    if not os.path.lexists(target):
-        return
-    try:
-        recorded = json.loads((target / METADATA_NAME).read_text(encoding="utf-8")).get("content_hash")
-    except (OSError, ValueError, AttributeError):
-        recorded = None
-    if recorded != content_hash:
-        what = "another world" if recorded else "something that is not a world folder"
-        raise OutputError(f"'{target}' already holds {what}; remove it or pass --overwrite to replace it")
-
-
-def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]) -> Path:
-    """Write ``blobs`` (relative path -> bytes) as ``out_dir/name``; complete or absent."""
-    if "/" in name or name in ("", ".", ".."):
-        raise OutputError(f"refusing folder name {name!r}")
-    try:
-        out_dir.mkdir(parents=True, exist_ok=True)
-        if not out_dir.is_dir():
-            raise OutputError(f"output folder '{out_dir}' is not a folder")
-        tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".tmp", dir=out_dir))
-    except OutputError:
-        raise
-    except OSError as exc:
-        raise OutputError(f"cannot write to output folder '{out_dir}': {exc.strerror or exc}") from None
-    target = out_dir / name
-    try:
-        for rel, data in sorted(blobs.items()):
-            path = tmp / _safe_relative(rel)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with open(path, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
-        os.chmod(tmp, creation_mode(0o777))
-        if target.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=out_dir))
-            os.rename(target, old / "w")
-            os.rename(tmp, target)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.rename(tmp, target)
-    except OSError as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise OutputError(f"cannot write world folder '{target}': {exc.strerror or exc}") from None
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    return target

@@ -97,22 +97,6 @@ def test_registered_through_gymnasium_make_without_importing_worldgen_envs():
     assert run.stdout.split() == ["NavigationEnv", "cluttered", "(364,)"]
 
 
-def test_gymnasium_envs_entry_point_registers_the_id():
-    """The declared ``gymnasium.envs`` entry point (read by Gymnasium 0.26-0.29) resolves and registers the id."""
-    run = run_python("""
-        import sys
-        from importlib.metadata import entry_points
-        import gymnasium
-        (ep,) = [e for e in entry_points(group="gymnasium.envs") if e.name == "worldgen"]
-        assert "worldgen.envs" not in sys.modules
-        ep.load()()
-        env = gymnasium.make("worldgen/Navigation-v0", preset="drl_arena")
-        print(ep.value, type(env.unwrapped).__name__)
-    """)
-    assert run.returncode == 0, run.stderr
-    assert run.stdout.split() == ["worldgen.envs.registration:register_envs", "NavigationEnv"]
-
-
 def test_worldgen_and_its_pytest_plugin_do_not_import_gymnasium():
     run = run_python("""
         import sys

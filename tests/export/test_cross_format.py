@@ -18,6 +18,7 @@ from support.scenes import showcase_scene
 
 from worldgen.export import meshes, metadata, mjcf, urdf
 from worldgen.feasibility import FeasibilityReport
+from worldgen.feasibility.report import CHECKER
 from worldgen.scene import Robot, rpy_matrix
 from worldgen.world import World
 
@@ -169,7 +170,7 @@ def test_door_turns_the_same_way_in_mjcf_and_urdf():
 
 def _world_json(scene) -> dict:
     """world.json of ``scene`` through the metadata exporter, parsed back from its canonical text."""
-    world = World("cluttered", 0, {}, scene, (), Robot(0.2, 0.5, 0.1), FeasibilityReport((), (), None), 1)
+    world = World("cluttered", 0, {}, scene, (), Robot(0.2, 0.5, 0.1), FeasibilityReport((), (), None, CHECKER), 1)
     return json.loads(metadata.dumps(world.metadata_for({})))
 
 

@@ -21,7 +21,7 @@ from support import draft
 
 import worldgen
 from worldgen.export import metadata
-from worldgen.feasibility.report import REQUIRED_CHECKS, Check, FeasibilityReport, TaskPath
+from worldgen.feasibility.report import CHECKER, REQUIRED_CHECKS, Check, FeasibilityReport, TaskPath
 from worldgen.generators import get, robot_from_params
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Pose, Scene, Sphere, Task
 from worldgen.scene.footprint import scene_footprints
@@ -63,7 +63,7 @@ def fake_report(tasks, feasible=True, with_paths=True) -> FeasibilityReport:
         if with_paths else None
         for t in tasks
     )
-    return FeasibilityReport(checks, paths, 0.9 if with_paths else None, resolution=0.05)
+    return FeasibilityReport(checks, paths, 0.9 if with_paths else None, CHECKER)
 
 
 def hand_world(scene=None, tasks=None, feasible=True, with_paths=True, **params) -> World:
@@ -191,7 +191,7 @@ def test_unbounded_figures_become_null_not_infinity():
     report = world.feasibility
     world.feasibility = FeasibilityReport(
         tuple(Check(c.name, True, math.inf) for c in report.checks),
-        tuple(TaskPath(p.task_id, p.waypoints, p.length, math.inf) for p in report.paths), math.inf)
+        tuple(TaskPath(p.task_id, p.waypoints, p.length, math.inf) for p in report.paths), math.inf, CHECKER)
     meta = metadata.build(world, FILES)
     VALIDATOR.validate(meta)
     assert meta["feasibility"]["narrowest_passage"] is None
@@ -396,3 +396,9 @@ def test_in_memory_metadata_equals_the_written_one(written):
     world = worldgen.generate("cluttered", meta["seed"], **meta["params"])
     assert world.metadata == meta
     assert world.to_json() == (folder / "world.json").read_text()
+
+
+def test_feasibility_names_its_method_and_keeps_no_shim_fields():
+    meta = worldgen.generate("cluttered", 0, size=[6, 6], n_obstacles=3).metadata
+    assert meta["feasibility"]["checker"] == "exact_tangent_graph+fcl"
+    assert "resolution" not in meta["feasibility"]  # the grid planner's cell size: the exact planner has none

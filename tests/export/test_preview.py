@@ -16,7 +16,8 @@ from PIL import Image
 import worldgen
 from worldgen.cli import main
 from worldgen.errors import ParameterError
-from worldgen.export.preview import COLOURS, NOGO_ALPHA, PREVIEW_NAME, draw, layout, render
+from worldgen.export.preview import COLOURS, NOGO_ALPHA, draw, layout, render
+from worldgen.files import PREVIEW_NAME
 
 
 @pytest.fixture(scope="module")
@@ -109,7 +110,9 @@ def test_the_no_go_zone_and_the_path_are_where_they_belong(meta, image):
     import shapely
 
     grow = meta["robot"]["radius"] + meta["robot"]["clearance"]
-    zone_colour = tuple(round(f + (n - f) * NOGO_ALPHA) for f, n in zip(COLOURS["floor"], COLOURS["nogo"]))
+    # The zone over usable floor, or over floor no footprint from the spawn reaches (drawn muted).
+    zone_colours = [tuple(round(f + (n - f) * NOGO_ALPHA) for f, n in zip(COLOURS[under], COLOURS["nogo"]))
+                    for under in ("floor", "unreachable")]
     lay = layout(meta)
     path = shapely.LineString(meta["tasks"][0]["path"]["waypoints"])
     shadows = [shapely.Point(e["pose"][:2]).buffer(e["shape"]["radius"]) if e["shape"]["type"] == "cylinder"
@@ -128,7 +131,7 @@ def test_the_no_go_zone_and_the_path_are_where_they_belong(meta, image):
             if (min(abs(x - round(x)), abs(y - round(y))) < near_grid or path.distance(p) < 0.1
                     or min(s.distance(p) for s in shadows) < 0.3 * grow):
                 continue
-            assert _close(image.getpixel(_pixel_of(meta, x, y)), zone_colour), (e["name"], x, y)
+            assert any(_close(image.getpixel(_pixel_of(meta, x, y)), c) for c in zone_colours), (e["name"], x, y)
             checked += 1
     assert checked >= 5
     # The path's straight stretches, away from the markers: path orange.
@@ -202,3 +205,33 @@ def test_cli_preview_mistakes_are_one_line_and_status_2(tmp_path, capsys):
 def test_write_without_preview(tmp_path):
     folder = worldgen.generate("cluttered", seed=5).write(tmp_path, preview=False)
     assert not (folder / PREVIEW_NAME).exists()
+
+
+def test_the_legend_lists_what_the_world_has():
+    from worldgen.export.preview_frame import legend
+
+    def names(world):
+        return [text for text, _, _ in legend(world.metadata, unreachable=False)]
+
+    plain = names(worldgen.generate("cluttered", 0, size=[6, 6], n_obstacles=3))
+    assert "door" not in plain and "mover" not in plain and "path (opens a door)" not in plain and "path" in plain
+    moving = names(worldgen.generate("cluttered", 0, size=[8, 8], n_obstacles=3, n_movers=1))
+    assert "mover" in moving and "door" not in moving
+    door = worldgen.generate("door", 2)
+    assert door.metadata["tasks"][0]["requires_door_open"]
+    assert {"door", "path (opens a door)"} <= set(names(door)) and "path" not in names(door)
+
+
+def test_floor_no_footprint_reaches_is_muted_and_the_corridor_is_not(tmp_path):
+    world = worldgen.generate("corridor", 1, shape="L")
+    meta = world.metadata
+    image = Image.open(world.write(tmp_path) / PREVIEW_NAME).convert("RGB")
+    (x0, y0), (x1, y1) = meta["bounds"]["min"], meta["bounds"]["max"]
+    # The L runs along two sides of its bounds: the middle of the square is floor inside no corridor.
+    centre = _pixel_of(meta, (x0 + x1) / 2 + 0.3, (y0 + y1) / 2 + 0.3)
+    assert _close(image.getpixel(centre), COLOURS["unreachable"], tol=12)
+    # Along the reference path, the usable floor keeps its colour.
+    wp = np.asarray(meta["tasks"][0]["path"]["waypoints"])
+    a, b = wp[0], wp[1]
+    off = a + 0.25 * (b - a) + np.array([0.0, 0.25])
+    assert _close(image.getpixel(_pixel_of(meta, *off)), COLOURS["floor"], tol=12)

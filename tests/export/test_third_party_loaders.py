@@ -1,6 +1,6 @@
 """Third-party consumers load what worldgen writes: Drake every generator's SDF (movers left out with
 ``sdf_actors=false``) and URDF; pybullet every URDF. pybullet's ``loadSDF`` rejects door worlds (it
-cannot attach a joint to ``world``), so the README sends pybullet users to the URDF.
+cannot attach a joint to ``world``; the SDF is valid), so docs/formats.md sends pybullet users to the URDF.
 
 Both are in the ``test`` extra; without them the tests skip, except on CI (CI=true), where a missing
 consumer is a failure.
@@ -66,9 +66,13 @@ def test_sdf_actors_false_leaves_movers_out_of_the_sdf_only(tmp_path):
     sdf = etree.fromstring(without.to_sdf().encode(), safe_parser())
     assert sdf.findall(".//actor") == [] and len(etree.fromstring(with_actors.to_sdf().encode(), safe_parser())
                                                  .findall(".//actor")) == 2
-    # Movers stay everywhere else: the MJCF and world.json's dynamic_obstacles are unchanged.
+    # Movers stay everywhere else: the MJCF and world.json's dynamic_obstacles are unchanged, but for
+    # the note on how the SDF carries them: it no longer does.
     assert without.to_mjcf().replace(without.world_id, with_actors.world_id) == with_actors.to_mjcf()
-    assert without.metadata["dynamic_obstacles"] == with_actors.metadata["dynamic_obstacles"] != []
+    kept, dropped = with_actors.metadata["dynamic_obstacles"], without.metadata["dynamic_obstacles"]
+    assert [m["formats"] for m in kept] == [{"sdf": "actor", "mjcf": "mocap_body", "urdf": None}] * 2
+    assert [m["formats"] for m in dropped] == [{"sdf": None, "mjcf": "mocap_body", "urdf": None}] * 2
+    assert [dict(m, formats=None) for m in dropped] == [dict(m, formats=None) for m in kept] != []
     folder = without.write(tmp_path, preview=False)
     ok, messages = check_sdf(folder / "world.sdf")
     assert ok, messages

@@ -25,10 +25,9 @@ from support.reftools_mujoco import load
 
 import worldgen
 from worldgen import feasibility
-from worldgen.feasibility.check import SAFETY
 from worldgen.scene import Box, Node, Pose, Robot, Scene, Task
 from worldgen.scene.doors import open_scene
-from worldgen.scene.footprint import robot_footprints
+from worldgen.scene.footprint import SAFETY, robot_footprints
 from worldgen.world import World
 
 #: Probe samples along the path (m), as the issue asks.

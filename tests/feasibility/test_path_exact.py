@@ -22,10 +22,9 @@ from support import exact_reference
 
 import worldgen
 from worldgen import feasibility
-from worldgen.feasibility.check import SAFETY
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Robot, Scene, Task
 from worldgen.scene.doors import open_scene
-from worldgen.scene.footprint import robot_footprints
+from worldgen.scene.footprint import SAFETY, robot_footprints
 
 ROBOT = Robot(radius=0.2, height=0.4, clearance=0.05)
 R = ROBOT.inflation

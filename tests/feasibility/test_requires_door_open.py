@@ -20,8 +20,8 @@ from support.checks import with_probe
 from support.reftools_mujoco import load
 
 import worldgen
-from worldgen.export.metadata import DOOR_TIME, TIME_FACTOR, TIME_MARGIN
 from worldgen.export.scenario import scenario
+from worldgen.export.tasks import DOOR_TIME, TIME_FACTOR, TIME_MARGIN
 
 #: Probe positions along the path (m). The union of discs this far apart falls short of the exact
 #: swept disc by at most STEP^2 / (8 r) = 2e-5 m for r = 0.15 m, far inside BAND.

@@ -15,7 +15,8 @@ from support.checks import recheck, reference_tools
 
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
-from worldgen.generators.corridor import layout, proven_width
+from worldgen.generators.corridor import proven_width
+from worldgen.generators.corridor_layout import layout
 
 #: The passage figure is the checker's: connectivity between cell centres puts the radius within
 #: half a cell diagonal, so the width within sqrt(2) cells, plus the bisection's 1/8 cell
@@ -51,11 +52,12 @@ def corridor_params(draw):
 
 
 def _generate_or_refuse(seed, params):
-    """The world, or None where the request is refused as it must be (a zigzag that runs into itself)."""
+    """The world, or None where the request is refused as it must be (a zigzag that runs into itself, obstacles
+    in a corridor with no leg long enough for one)."""
     try:
         return worldgen.generate("corridor", seed=seed, **params)
     except ParameterError as exc:
-        assert "run into" in str(exc) or "longer than" in str(exc), str(exc)
+        assert "run into" in str(exc) or "longer than" in str(exc) or "must be 0 in this corridor" in str(exc), str(exc)
         return None
 
 
@@ -215,3 +217,13 @@ def test_same_seed_same_world_and_obstacles_vary_with_the_seed():
     c = worldgen.generate("corridor", seed=4, n_obstacles=3, side_openings=1)
     assert a.to_mjcf() == b.to_mjcf() and a.content_hash == b.content_hash
     assert a.content_hash != c.content_hash
+
+
+def test_a_corridor_with_no_room_for_an_obstacle_is_refused_at_once_saying_why():
+    with pytest.raises(ParameterError, match=r"^parameter 'n_obstacles' must be 0 in this corridor: an obstacle needs "
+                                             r"1\.6 m of a leg \(0\.2 m long and 0\.7 m of passage on each side\)"):
+        worldgen.generate("corridor", 0, length=2.0, n_obstacles=1)
+    # A longer corridor gets its obstacle.
+    world = worldgen.generate("corridor", 0, length=6.0, n_obstacles=1, obstacle_length=[0.2, 0.2])
+    assert sum(n.role == "obstacle" for n in world.scene.nodes) == 1
+

@@ -24,7 +24,7 @@ from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.export.metadata import validate
 from worldgen.export.xml import safe_parser
 
-SPACING_FRACTION = 0.25  # path samples every robot radius / 4, as METADATA.md asks
+SPACING_FRACTION = 0.25  # path samples every robot radius / 4, as docs/world-json.md asks
 
 
 # -- independent geometry ------------------------------------------------------

@@ -339,7 +339,7 @@ def test_a_pack_whose_every_job_is_rejected_fails_and_writes_no_manifest(tmp_pat
     recipe = tmp_path / "none.yaml"
     recipe.write_text("name: none\nseeds: 2\nworlds:\n  - generator: cluttered\n"
                       "    params: {size: [3, 3], n_obstacles: 40, max_attempts: 2}\n")
-    assert cli("pack", "build", recipe, "--out", tmp_path / "p") == 2
+    assert cli("pack", "build", recipe, "--out", tmp_path / "p") == 3  # no such world: the recipe was well formed
     err = capsys.readouterr().err.strip()
     assert err.startswith("error: no job of recipe 'none' made a world (2 rejected") and "\n" not in err
     assert not (tmp_path / "p" / "manifest.json").exists()

@@ -2,7 +2,9 @@
 
     >>> import gymnasium
     >>> env = gymnasium.make("worldgen.envs:worldgen/Navigation-v0", preset="drl_arena")
-    >>> obs, info = env.reset(seed=0)      # a fresh, checked world; info["reference_path_length"]
+    >>> obs, info = env.reset(seed=0)      # a fresh, checked world
+    >>> env.observation_space.contains(obs), info["reference_path_length"] > 0
+    (True, True)
 
 ``worldgen/Navigation-v0`` (:class:`NavigationEnv`): a differential-drive robot
 with a planar lidar in MuJoCo, a new world per episode from any generator or

@@ -9,16 +9,12 @@ from __future__ import annotations
 import importlib
 import importlib.util
 
-from worldgen.errors import WorldgenError
+from worldgen.errors import MissingDependencyError
 
 __all__ = ["MissingDependencyError", "INSTALL_HINT", "gymnasium_available", "require_gymnasium"]
 
 #: What to install for the environments (the ``rl`` extra of worldgen's pyproject.toml).
 INSTALL_HINT = "pip install 'worldgen[rl]'"
-
-
-class MissingDependencyError(WorldgenError, ImportError):
-    """An optional dependency that a feature needs is not installed; the message says what to install."""
 
 
 def gymnasium_available() -> bool:

@@ -4,6 +4,8 @@
     >>> env = gymnasium.make("worldgen/Navigation-v0", preset="drl_arena")
     >>> obs, info = env.reset(seed=0)             # a new checked world, in memory
     >>> obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+    >>> env.observation_space.contains(obs)
+    True
 
 Worlds: ``generator`` and ``params`` (any registered generator), or ``preset``
 (a preset's name or file, ``params`` on top), a new world per episode; or

@@ -1,26 +1,14 @@
 """Registering ``worldgen/Navigation-v0`` with Gymnasium.
 
-How Gymnasium finds it, by version:
+Gymnasium 1.x (the ``rl`` extra) has no plugin system: its 1.0 release removed the loading of the
+``gymnasium.envs`` entry-point group. An id is known once the module that registers it is imported,
+which ``gymnasium.make`` does itself for an id written ``"module:id"``::
 
-- Gymnasium 1.x (the ``rl`` extra) has no plugin system: its 1.0 release
-  removed the loading of the ``gymnasium.envs`` entry-point group. An id is
-  known once the module that registers it is imported, which ``gymnasium.make``
-  does itself for an id written ``"module:id"``::
+    gymnasium.make("worldgen.envs:worldgen/Navigation-v0", preset="drl_arena")
 
-      gymnasium.make("worldgen.envs:worldgen/Navigation-v0", preset="drl_arena")
-
-  or, after ``import worldgen.envs`` (registration happens on import),
-  ``gymnasium.make("worldgen/Navigation-v0", ...)``.
-- Gymnasium 0.26 to 0.29 loaded the ``gymnasium.envs`` entry points when it
-  was imported, calling each one inside its namespace; worldgen declares
-  ``worldgen = "worldgen.envs.registration:register_envs"`` in that group, so
-  there ``gymnasium.make("worldgen/Navigation-v0")`` would work with no import.
-  Those releases are not tested here (the ``rl`` extra asks for Gymnasium 1.x,
-  and 0.29 predates NumPy 2); the tests check that the entry point resolves to
-  this function and that calling it registers the id.
-
-The entry point names the environment class by its import path, so registering
-imports neither MuJoCo nor the environment's modules.
+or, after ``import worldgen.envs`` (registration happens on import),
+``gymnasium.make("worldgen/Navigation-v0", ...)``. The registration names the environment class by
+its import path, so registering imports neither MuJoCo nor the environment's modules.
 """
 
 from __future__ import annotations

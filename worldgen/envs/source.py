@@ -16,7 +16,6 @@ oracles' :class:`~worldgen.testing.oracles.Ground` and to world.json (for drawin
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Optional
@@ -76,24 +75,10 @@ def _checked_task(world_id: str, task: dict) -> dict:
 
 def _task_of_world(world) -> dict:
     """world.json's ``tasks[0]`` of an in-memory World, without rendering any file."""
-    from worldgen.export.metadata import time_limit
-    from worldgen.params import COMMON_PARAMS
-    from worldgen.scene.doors import door_joints, leaves_in_the_way
+    from worldgen.export.tasks import task_entry
 
-    task = world.tasks[0]
     path = world.feasibility.paths[0] if world.feasibility.paths else None
-    out = {"id": task.id, "spawn": task.spawn.as_list(), "goal": task.goal.as_list(),
-           "goal_tolerance": float(task.goal_tolerance), "path": None, "time_limit": None,
-           "straight_line_distance": math.hypot(task.goal.x - task.spawn.x, task.goal.y - task.spawn.y)}
-    if path is not None:
-        leaves = []
-        if door_joints(world.scene):
-            leaves = leaves_in_the_way(world.scene, path.waypoints, world.robot.radius, world.robot.height)
-        speed = world.params.get("robot_speed", next(p.default for p in COMMON_PARAMS if p.name == "robot_speed"))
-        out["path"] = {"waypoints": [[float(x), float(y)] for x, y in path.waypoints], "length": float(path.length),
-                       "min_clearance": float(path.min_clearance)}
-        out["time_limit"] = time_limit(float(path.length), speed, len(leaves))
-    return _checked_task(world.world_id, out)
+    return _checked_task(world.world_id, task_entry(world, world.tasks[0], path))
 
 
 def episode_world(world) -> EpisodeWorld:
@@ -103,7 +88,7 @@ def episode_world(world) -> EpisodeWorld:
     from worldgen.testing.figures import Ground
 
     task = _task_of_world(world)
-    movers = [mover_entry(m) for m in world.scene.movers]
+    movers = [mover_entry(m, world.params) for m in world.scene.movers]
     robot = world.robot
     light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": movers,
              "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance}}

@@ -1,19 +1,59 @@
-"""The files a world is written as: the formats, their file names, the SDF versions."""
+"""The one table of the formats a world is written in: each format's file, writer, and what it carries.
+
+Everything that needs to know the formats reads :data:`TABLE`: :class:`~worldgen.world.World` renders
+through :func:`render`, world.json's notes on movers come from :func:`movers_note`, scenario.yaml names
+the first written file, the command line and recipes check names with :func:`normalise_formats`.
+A writer is named by ``module:function`` and imported on first use, so the writers can read this
+table (the SDF versions) without an import cycle and a program that writes only MJCF never imports
+the SDF writer.
+"""
 
 from __future__ import annotations
 
-from typing import Iterable
+import importlib
+from dataclasses import dataclass
+from typing import Any, Iterable, Mapping, Optional
 
 from worldgen.errors import ParameterError
 
-__all__ = ["FORMATS", "FILE_NAMES", "METADATA_NAME", "SDF_VERSIONS", "normalise_formats"]
+__all__ = ["Format", "TABLE", "FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats", "render",
+           "movers_note", "uses_meshes"]
 
-#: Every format a world can be written in, in the order they are written.
-FORMATS = ("sdf", "mjcf", "urdf")
-FILE_NAMES = {"sdf": "world.sdf", "mjcf": "world.mjcf.xml", "urdf": "world.urdf"}
-METADATA_NAME = "world.json"
 #: Versions the SDF exporter writes: 1.9 for Gazebo Fortress-Harmonic, 1.6 for Gazebo classic.
 SDF_VERSIONS = ("1.9", "1.6")
+
+
+@dataclass(frozen=True)
+class Format:
+    """One output format.
+
+    ``writer`` is ``module:function`` taking ``(scene, name=...)`` (and ``version=`` where
+    ``versions`` lists some) and returning the file's bytes. ``movers_as`` says how the format
+    carries a mover (None: it cannot); ``movers_switch`` names a boolean parameter that, set false,
+    leaves the movers out of this format. ``meshes``: the file refers to mesh files beside it.
+    """
+
+    name: str
+    file_name: str
+    writer: str
+    movers_as: Optional[str]
+    movers_switch: Optional[str] = None
+    versions: tuple[str, ...] = ()
+    meshes: bool = False
+
+    def carries_movers(self, params: Mapping[str, Any]) -> bool:
+        return self.movers_as is not None and (self.movers_switch is None or bool(params.get(self.movers_switch, True)))
+
+
+#: Every format, in the order they are written. SDF movers are <actor>s, which Drake rejects: the
+#: ``sdf_actors`` parameter leaves them out for Drake users (docs/formats.md).
+TABLE: dict[str, Format] = {f.name: f for f in (
+    Format("sdf", "world.sdf", "worldgen.export.sdf:to_sdf", "actor", "sdf_actors", SDF_VERSIONS, meshes=True),
+    Format("mjcf", "world.mjcf.xml", "worldgen.export.mjcf:to_mjcf", "mocap_body"),
+    Format("urdf", "world.urdf", "worldgen.export.urdf:to_urdf", None, meshes=True),
+)}
+FORMATS = tuple(TABLE)
+FILE_NAMES = {f.name: f.file_name for f in TABLE.values()}
 
 
 def normalise_formats(formats: Iterable[str]) -> tuple[str, ...]:
@@ -22,8 +62,29 @@ def normalise_formats(formats: Iterable[str]) -> tuple[str, ...]:
         formats = [f for f in formats.split(",") if f.strip()]
     chosen = [f.strip().lower() for f in formats]
     for f in chosen:
-        if f not in FORMATS:
+        if f not in TABLE:
             raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {f!r}")
     if not chosen:
         raise ParameterError(f"parameter 'formats' must name at least one of {', '.join(FORMATS)}, got nothing")
     return tuple(f for f in FORMATS if f in chosen)
+
+
+def render(fmt: str, scene, name: str, params: Mapping[str, Any], sdf_version: str = "1.9") -> bytes:
+    """The bytes of ``scene`` written as ``fmt`` under the world name ``name``."""
+    (chosen,) = normalise_formats([fmt])
+    spec = TABLE[chosen]
+    if scene.movers and not spec.carries_movers(params):
+        scene = scene.with_movers(())
+    module, function = spec.writer.split(":")
+    writer = getattr(importlib.import_module(module), function)
+    return writer(scene, name=name, **({"version": sdf_version} if spec.versions else {}))
+
+
+def movers_note(params: Mapping[str, Any]) -> dict[str, Optional[str]]:
+    """How each format carries a mover of a world with ``params``: world.json's ``dynamic_obstacles[].formats``."""
+    return {f.name: (f.movers_as if f.carries_movers(params) else None) for f in TABLE.values()}
+
+
+def uses_meshes(formats: Iterable[str]) -> bool:
+    """Whether any of ``formats`` refers to mesh files beside it."""
+    return any(TABLE[f].meshes for f in formats)

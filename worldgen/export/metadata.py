@@ -1,4 +1,4 @@
-"""world.json: the ground truth a test asserts against (../shared/design/METADATA.md).
+"""world.json: the ground truth a test asserts against (the contract: docs/world-json.md).
 
 ``build(world, files)`` turns a checked :class:`~worldgen.world.World` into a
 plain dict whose field names are the public contract; ``dumps`` writes it in
@@ -11,7 +11,6 @@ shipped beside this package; ``validate()`` checks a dict against it.
 from __future__ import annotations
 
 import json
-import math
 from functools import lru_cache
 from importlib import resources
 from typing import Any, Mapping
@@ -19,24 +18,17 @@ from typing import Any, Mapping
 import numpy as np
 import shapely
 
-from worldgen.floats import round_float
+from worldgen.export.formats import movers_note
+from worldgen.export.tasks import task_entry
+from worldgen.floats import finite_or_none, round_float
 from worldgen.groundtruth import truth
-from worldgen.params import COMMON_PARAMS
-from worldgen.scene.doors import door_records, leaves_in_the_way
+from worldgen.scene.doors import door_records
 from worldgen.scene.footprint import scene_footprints
 
-__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "time_limit", "free_area_ratio", "mover_entry",
-           "FORMATS_NOTE"]
+__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "free_area_ratio", "mover_entry"]
 
 #: The value of world.json's ``schema`` field; a breaking change bumps the number.
 SCHEMA_ID = "worldgen.world/1"
-
-#: time_limit = TIME_FACTOR x path length / robot_speed + TIME_MARGIN: twice the time an
-#: ideal run needs, plus a fixed allowance for start-up and turning on the spot.
-TIME_FACTOR = 2.0
-TIME_MARGIN = 10.0
-#: Added to time_limit for each door leaf the path needs moved (pushing or pulling it open).
-DOOR_TIME = 10.0
 
 #: Segments per quarter circle when a disc footprint becomes a polygon for area sums:
 #: the polygon's area is within 0.1 % of the disc's.
@@ -51,9 +43,8 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
     """
     scene, report, robot = world.scene, world.feasibility, world.robot
     (x0, y0), (x1, y1) = scene.bounds
-    narrowest = _finite_or_none(report.narrowest_passage)
+    narrowest = finite_or_none(report.narrowest_passage)
     paths = list(report.paths) + [None] * max(0, len(world.tasks) - len(report.paths))
-    speed = world.params.get("robot_speed", _default("robot_speed"))
     meta = {
         "schema": SCHEMA_ID,
         "worldgen_version": _version(),
@@ -66,21 +57,20 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
         "entities": [_entity(scene, node) for node in scene.nodes],
         "doors": door_records(scene),
-        "dynamic_obstacles": [mover_entry(m) for m in scene.movers],
-        "tasks": [_task(task, path, speed, _in_the_way(world, path)) for task, path in zip(world.tasks, paths)],
+        "dynamic_obstacles": [mover_entry(m, world.params) for m in scene.movers],
+        "tasks": [task_entry(world, task, path) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
             "allow_infeasible": world.allow_infeasible,
             "checker": report.checker,
             "checks": [
-                {"name": c.name, "ok": bool(c.ok), "value": _finite_or_none(c.value), "detail": c.detail}
+                {"name": c.name, "ok": bool(c.ok), "value": finite_or_none(c.value), "detail": c.detail}
                 for c in report.checks
             ],
             "narrowest_passage": narrowest,
-            "resolution": _finite_or_none(report.resolution),
             "attempts": int(world.attempts),
             "informational": [
-                {"name": c.name, "ok": bool(c.ok), "value": _finite_or_none(c.value), "detail": c.detail}
+                {"name": c.name, "ok": bool(c.ok), "value": finite_or_none(c.value), "detail": c.detail}
                 for c in getattr(report, "informational", ())
             ],
         },
@@ -110,32 +100,17 @@ def dumps(meta: Mapping[str, Any]) -> str:
     return _emit(meta, "") + "\n"
 
 
-#: How each exported format carries a mover; URDF cannot express a scripted motion.
-FORMATS_NOTE = {"sdf": "actor", "mjcf": "mocap_body", "urdf": None}
-
-
-def mover_entry(mover) -> dict:
-    """The mover's ``dynamic_obstacles[]`` entry of world.json."""
+def mover_entry(mover, params: Mapping[str, Any]) -> dict:
+    """The mover's ``dynamic_obstacles[]`` entry of world.json, for a world of ``params`` (which say
+    whether the SDF carries movers)."""
     return {
         "name": mover.name,
         "radius": mover.radius,
         "height": mover.height,
         "trajectory": [list(row) for row in mover.trajectory],
         "loop": mover.loop,
-        "formats": dict(FORMATS_NOTE),
+        "formats": movers_note(params),
     }
-
-
-def time_limit(length: float, robot_speed: float, doors: int = 0) -> float:
-    """A generous time bound (s) for a path of ``length`` m at ``robot_speed`` m/s that must open ``doors`` leaves."""
-    return TIME_FACTOR * length / robot_speed + TIME_MARGIN + DOOR_TIME * doors
-
-
-def _in_the_way(world, path) -> list[str]:
-    """The door leaves, as they start, that the robot's footprint meets along ``path``."""
-    if path is None:
-        return []
-    return leaves_in_the_way(world.scene, path.waypoints, world.robot.radius, world.robot.height)
 
 
 def free_area_ratio(scene, height: float) -> float:
@@ -212,40 +187,6 @@ def _entity(scene, node) -> dict:
         "shape": None if node.shape is None else node.shape.describe(),
         "aabb": scene.aabb(node.name).tolist(),
     }
-
-
-def _task(task, path, speed: float, leaves: list) -> dict:
-    spawn, goal = task.spawn, task.goal
-    out = {
-        "id": task.id,
-        "spawn": spawn.as_list(),
-        "goal": goal.as_list(),
-        "goal_tolerance": task.goal_tolerance,
-        "straight_line_distance": math.hypot(goal.x - spawn.x, goal.y - spawn.y),
-        "path": None,
-        "time_limit": None,
-        "requires_door_open": bool(leaves),
-    }
-    if path is not None:
-        out["path"] = {
-            "waypoints": np.asarray(path.waypoints, dtype=float).reshape(-1, 2).tolist(),
-            "length": path.length,
-            "min_clearance": _finite_or_none(path.min_clearance),
-        }
-        out["time_limit"] = time_limit(path.length, speed, len(leaves))
-    return out
-
-
-def _finite_or_none(x):
-    """None for a missing or unbounded figure (e.g. no obstacle in reach): JSON has no inf."""
-    if x is None:
-        return None
-    x = float(x)
-    return x if math.isfinite(x) else None
-
-
-def _default(name: str):
-    return next(p.default for p in COMMON_PARAMS if p.name == name)
 
 
 def _version() -> str:

@@ -13,10 +13,9 @@ from PIL import Image, ImageDraw, ImageFont
 
 from worldgen.errors import ParameterError
 
-__all__ = ["PREVIEW_NAME", "DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA", "SUPERSAMPLE",
+__all__ = ["DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA", "SUPERSAMPLE",
            "HIDDEN_ROLES", "Layout", "layout", "text_font", "title", "footer"]
 
-PREVIEW_NAME = "preview.png"
 DEFAULT_WIDTH = 800
 MIN_WIDTH, MAX_WIDTH = 400, 4000
 
@@ -25,6 +24,7 @@ COLOURS = {
     "background": (255, 255, 255),
     "slab": (214, 214, 210),        # floor slab outside the usable bounds
     "floor": (248, 247, 242),       # the usable bounds
+    "unreachable": (232, 231, 226), # floor inside the bounds that no footprint from a spawn can reach
     "grid": (228, 227, 220),
     "nogo": (232, 72, 64),          # blended at NOGO_ALPHA over what lies beneath
     "wall": (45, 45, 55),
@@ -94,7 +94,7 @@ def layout(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Layout:
     room = width - 2 * _MARGIN
     scale = min(room / span[0], room / span[1])
     map_w, map_h = span[0] * scale, span[1] * scale
-    rows = 1 if _LEGEND_START + _legend_width() + _MARGIN <= width else 2
+    rows = 1 if _LEGEND_START + _legend_width(legend(meta, unreachable=True)) + _MARGIN <= width else 2
     height = int(math.ceil(_TITLE_H + map_h + _FOOTER_H * rows - 1e-6))  # 768.0000001 px is 768
     return Layout(width, height, float(scale), float(lo[0]), float(hi[1]),
                   float((width - map_w) / 2), float(_TITLE_H), rows)
@@ -162,19 +162,36 @@ def _fit(text: str, font, room: float) -> str:
     return text + "..."
 
 
+#: Every legend entry (text, colour, glyph), in order; a picture lists those its world has (:func:`legend`).
 _LEGEND = (("obstacle", "obstacle", "box"), ("wall", "wall", "box"), ("no-go zone", "nogo", "zone"),
-           ("path", "path", "line"), ("spawn", "spawn", "disc"), ("goal", "goal", "disc"),
+           ("unreachable", "unreachable", "box"), ("path", "path", "line"),
+           ("path (opens a door)", "path", "line"), ("spawn", "spawn", "disc"), ("goal", "goal", "disc"),
            ("door", "door", "box"), ("mover", "mover", "dash"))
 _LEGEND_START = _MARGIN + _SCALE_BAR_MAX + 28 + 40  # right of the longest scale bar and the axes
 _LEGEND_GAP = 12  # px between one entry's text and the next glyph
 
 
-def _legend_width() -> float:
+def legend(meta: Mapping[str, Any], unreachable: bool) -> tuple[tuple[str, str, str], ...]:
+    """The legend entries of what ``meta``'s picture shows: no door or mover entry in a world without one."""
+    roles = {e["role"] for e in meta.get("entities", [])}
+    tasks = meta.get("tasks", [])
+    through_door = any(t.get("path") and t.get("requires_door_open") for t in tasks)
+    shown = {
+        "obstacle": "obstacle" in roles, "wall": "wall" in roles or "door_frame" in roles,
+        "no-go zone": bool(roles - {"floor", "marker"}), "unreachable": unreachable,
+        "path": any(t.get("path") and not t.get("requires_door_open") for t in tasks),
+        "path (opens a door)": through_door, "spawn": bool(tasks), "goal": bool(tasks),
+        "door": bool(meta.get("doors")) or "door" in roles, "mover": bool(meta.get("dynamic_obstacles")),
+    }
+    return tuple(entry for entry in _LEGEND if shown[entry[0]])
+
+
+def _legend_width(entries=_LEGEND) -> float:
     font = text_font(12)
-    return sum(19 + font.getlength(text) + _LEGEND_GAP for text, _, _ in _LEGEND)
+    return sum(19 + font.getlength(text) + _LEGEND_GAP for text, _, _ in entries)
 
 
-def footer(image: Image.Image, lay: Layout) -> None:
+def footer(image: Image.Image, lay: Layout, entries=_LEGEND) -> None:
     d = ImageDraw.Draw(image)
     font = text_font(12)
     top = lay.height - _FOOTER_H * lay.legend_rows
@@ -192,20 +209,23 @@ def footer(image: Image.Image, lay: Layout) -> None:
     d.text((ax + 20, ay), "x", fill=COLOURS["text"], font=font, anchor="lm")
     d.text((ax, ay - 20), "y", fill=COLOURS["text"], font=font, anchor="mb")
     # Legend, wrapped onto the rows the layout reserved.
-    per_row = math.ceil(len(_LEGEND) / lay.legend_rows)
-    gx = start = max(ax + 40, lay.width - _MARGIN - _legend_width() / lay.legend_rows)
-    for i, (text, colour, glyph) in enumerate(_LEGEND):
-        if i and i % per_row == 0:
-            gx = start
+    # Each row right-aligned on its own width, so no entry runs off the picture.
+    per_row = max(1, math.ceil(len(entries) / lay.legend_rows))
+    rows = [entries[k:k + per_row] for k in range(0, len(entries), per_row)]
+    for i, (text, colour, glyph) in enumerate(entries):
+        if i % per_row == 0:
+            gx = max(ax + 40, lay.width - _MARGIN - _legend_width(rows[i // per_row]) + _LEGEND_GAP)
         gy = top + 12 + (i // per_row) * _FOOTER_H
         c = COLOURS[colour]
         if glyph == "box":
-            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=c)
+            d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=c, outline=COLOURS["grid"] if colour == "unreachable" else None)
         elif glyph == "zone":
             blend = tuple(round(f + (n - f) * NOGO_ALPHA) for f, n in zip(COLOURS["floor"], c))
             d.rectangle([gx, gy - 5, gx + 14, gy + 5], fill=blend, outline=c)
         elif glyph == "line":
             d.line([(gx, gy), (gx + 14, gy)], fill=c, width=3)
+            if text != "path":  # through a door it opens: dashed in the leaf's colour, as on the map
+                d.line([(gx + 5, gy), (gx + 9, gy)], fill=COLOURS["door"], width=3)
         elif glyph == "disc":
             d.ellipse([gx + 1, gy - 6, gx + 13, gy + 6], fill=COLOURS[colour + "_fill"], outline=c, width=2)
         else:

@@ -31,25 +31,26 @@ rounded by :mod:`worldgen.floats`.
 
 from __future__ import annotations
 
-from typing import Any, Optional
+from typing import Any, Iterable, Optional
 
-__all__ = ["SCENARIO_NAME", "scenario", "dumps", "files", "read"]
+from worldgen.export.formats import FILE_NAMES, FORMATS, normalise_formats
+from worldgen.export.tasks import leaves_on_path, task_entry
+from worldgen.files import SCENARIO_NAME
 
-SCENARIO_NAME = "scenario.yaml"
+__all__ = ["scenario", "dumps", "files", "read"]
 
 
-def scenario(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, Any]:
+
+def scenario(world, formats: Iterable[str] = FORMATS) -> dict[str, Any]:
     """The scenario spec of ``world`` as a plain dict; ``world`` names the first written of SDF, MJCF, URDF."""
-    from worldgen.export.formats import FILE_NAMES, FORMATS
-    from worldgen.export.metadata import _default, _in_the_way, time_limit
     from worldgen.floats import round_float
 
-    speed = world.params.get("robot_speed", _default("robot_speed"))
     paths = list(world.feasibility.paths) + [None] * len(world.tasks)
     tasks = []
     for task, path in zip(world.tasks, paths):
-        leaves = _in_the_way(world, path)
-        limit: Optional[float] = None if path is None else round_float(time_limit(path.length, speed, len(leaves)))
+        leaves = leaves_on_path(world, path)
+        seconds = task_entry(world, task, path, leaves)["time_limit"]
+        limit: Optional[float] = None if seconds is None else round_float(seconds)
         success = [{"type": "robot_reaches_waypoint", "waypoint": [round_float(task.goal.x), round_float(task.goal.y)],
                     "tolerance": round_float(task.goal_tolerance)}]
         failure: list[dict[str, Any]] = [{"type": "collision"}]
@@ -69,7 +70,7 @@ def scenario(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, Any]:
         "name": world.world_id,
         "description": f"worldgen '{world.generator}' world, seed {world.seed}: drive the footprint from spawn to goal "
                        f"without touching any collider",
-        "world": FILE_NAMES[[f for f in FORMATS if f in formats][0]],
+        "world": FILE_NAMES[normalise_formats(formats)[0]],
         "robot": {"radius": world.robot.radius, "height": world.robot.height, "spawn": first["spawn"]},
         "success_criteria": first["success_criteria"],
         "failure_conditions": first["failure_conditions"],
@@ -99,7 +100,7 @@ def _plain_dumper():
     return _DUMPER
 
 
-def files(world, formats=("sdf", "mjcf", "urdf")) -> dict[str, tuple[str, bytes]]:
+def files(world, formats: Iterable[str] = FORMATS) -> dict[str, tuple[str, bytes]]:
     """``{"scenario": ("scenario.yaml", bytes)}`` for :meth:`World.rendered_files`."""
     return {"scenario": (SCENARIO_NAME, dumps(scenario(world, formats)).encode())}
 

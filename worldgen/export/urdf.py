@@ -47,7 +47,7 @@ from __future__ import annotations
 import numpy as np
 
 from worldgen.errors import SceneError
-from worldgen.export.mjcf import RESERVED_NAME, joints_by_child, mass_properties
+from worldgen.export.bodies import RESERVED_NAME, joints_by_child, mass_properties
 from worldgen.export.xml import XmlText, escape_attr, fill, load_template, sub
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose

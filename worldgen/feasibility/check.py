@@ -10,7 +10,7 @@ along its whole length, proven by FCL on the volume the footprint sweeps
 check passes only if it passes for every task, its value is the worst figure,
 and its detail names the task that set it.
 
-The planner keeps a small safety margin :data:`SAFETY` on top of the inflation
+The planner keeps a small safety margin :data:`~worldgen.scene.footprint.SAFETY` on top of the inflation
 radius: FCL counts touching as collision, and the written waypoints are rounded
 to 6 decimals. Half of it pays for the polygons written round arcs.
 """
@@ -26,21 +26,15 @@ from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.passage import narrowest_passage
 from worldgen.feasibility.planner import Planner
-from worldgen.feasibility.report import Check, FeasibilityReport, TaskPath
+from worldgen.feasibility.report import CHECKER, Check, FeasibilityReport, TaskPath
 from worldgen.feasibility.route import waypoints
 from worldgen.feasibility.verify import verify_path
 from worldgen.floats import DECIMALS
 from worldgen.scene import Robot, Scene, Task
 from worldgen.scene.doors import door_joints, fixed_scene, open_scene
-from worldgen.scene.footprint import robot_footprints
+from worldgen.scene.footprint import SAFETY, robot_footprints
 
-__all__ = ["check", "SAFETY"]
-
-#: Extra margin (m) the planner keeps on top of the inflation radius: far above the
-#: 6-decimal rounding of waypoints and FCL's solver tolerance, far below any length
-#: that matters (it lengthens a path by well under 0.1 %). A passage is refused only
-#: when it is narrower than 2 x (inflation + SAFETY).
-SAFETY = 1e-4
+__all__ = ["check"]
 
 
 def _bounds_margin(bounds, xy: np.ndarray) -> np.ndarray:
@@ -147,7 +141,7 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     informational = ()
     if door_joints(initial):
         informational = (_reachable_initial(initial, tasks, robot),)
-    return FeasibilityReport(checks, tuple(paths), narrowest, "fcl", None, informational)
+    return FeasibilityReport(checks, tuple(paths), narrowest, CHECKER, informational)
 
 
 def _reachable_initial(initial: Scene, tasks, robot: Robot) -> Check:

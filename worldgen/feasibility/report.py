@@ -7,9 +7,13 @@ from typing import Optional
 
 import numpy as np
 
-__all__ = ["Check", "TaskPath", "FeasibilityReport", "REQUIRED_CHECKS"]
+__all__ = ["Check", "TaskPath", "FeasibilityReport", "REQUIRED_CHECKS", "CHECKER"]
 
-#: Checks every report carries, in this order (METADATA.md names them).
+#: The method behind every report: paths planned exactly on the tangent graph of the configuration
+#: space, then proven with FCL along their swept volume (docs/feasibility.md).
+CHECKER = "exact_tangent_graph+fcl"
+
+#: Checks every report carries, in this order (docs/world-json.md names them).
 REQUIRED_CHECKS = ("inside_bounds", "spawn_free", "goal_free", "path_exists", "path_clearance")
 
 
@@ -44,15 +48,14 @@ class FeasibilityReport:
 
     ``paths`` has one entry per task (None where no path was found);
     ``narrowest_passage`` is the widest disc diameter that still gets from
-    spawn to goal of the hardest task (m); ``checker`` names the tool that
-    proved the path.
+    spawn to goal of the hardest task (m); ``checker`` names the method that
+    proved the paths (:data:`CHECKER`).
     """
 
     checks: tuple[Check, ...]
     paths: tuple[Optional[TaskPath], ...]
     narrowest_passage: Optional[float]
-    checker: str = "fcl"
-    resolution: Optional[float] = None
+    checker: str
     #: Checks that inform but never decide ``feasible`` (e.g. ``reachable_initial_state``
     #: for doors: the reference path assumes them open).
     informational: tuple[Check, ...] = ()

@@ -17,7 +17,7 @@ spawn and goal), so every gap on the way is at least ``min_passage`` wide.
 Width: a corridor narrower than 2 x (robot_radius + clearance) cannot be driven,
 and :func:`check` says so with the numbers (:class:`~worldgen.errors.InfeasibleError`).
 The checker plans exactly in the continuous plane with a safety margin of
-:data:`~worldgen.feasibility.check.SAFETY` (0.1 mm) on each side, so every
+:data:`~worldgen.scene.footprint.SAFETY` (0.1 mm) on each side, so every
 corridor from :func:`proven_width` = 2 x (robot_radius + clearance + SAFETY)
 (plus the walls' rounding to 6 decimals) on is proven passable: 1 mm more than
 the footprint needs is enough. ``generate(..., allow_infeasible=True)`` still
@@ -32,14 +32,15 @@ from typing import Any, Mapping
 import numpy as np
 
 from worldgen.errors import InfeasibleError, ParameterError
-from worldgen.feasibility.check import SAFETY
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
+from worldgen.generators.corridor_layout import Layout, layout
 from worldgen.generators.room import FLOOR_RGBA, FLOOR_THICKNESS, WALL_RGBA
 from worldgen.params import Param
 from worldgen.scene import Box, Material, Node, Physics, Pose, Scene, Task
+from worldgen.scene.footprint import SAFETY
 
-__all__ = ["SPEC", "build", "check", "layout", "proven_width", "Layout"]
+__all__ = ["SPEC", "build", "check", "proven_width"]
 
 #: Room (m) on top of the checker's margin for the walls' coordinates, rounded to 6 decimals.
 WALL_ROUNDING = 1e-5
@@ -48,13 +49,9 @@ PLACEMENT_TRIES = 60
 #: Density (kg/m^3) for the obstacles' nominal mass: static, but inertia must be valid.
 OBSTACLE_DENSITY = 300.0
 OBSTACLE_RGBA = (0.80, 0.52, 0.25, 1.0)
-#: Unit vectors of the four headings (+x, +y, -x, -y): exact, so coordinates stay exact sums.
-_HEADINGS = ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))
-_SEGMENT_COUNT = {"straight": 1, "L": 2, "U": 3}
-#: Default number of segments of a zigzag given neither segments nor turns.
-ZIGZAG_SEGMENTS = 4
-
 PARAMS = (
+    # One task, from one end of the corridor to the other: a request for more is refused, not dropped.
+    Param("n_tasks", "int", 1, "spawn/goal pairs per world: one here, from one end to the other", 1, 1),
     Param("shape", "choice", "straight", "layout of the centreline", choices=("straight", "L", "U", "zigzag")),
     Param("width", "float", 1.5, "free width between the side walls", 0.05, 50.0, unit="m"),
     Param("length", "float", 10.0, "centreline length of every segment (unless 'segments' is given)",
@@ -74,92 +71,6 @@ PARAMS = (
     Param("side_openings", "int", 0, "gaps in the side walls, on random sides and legs", 0, 100),
     Param("opening_width", "float", 1.0, "width of each side opening", 0.05, 50.0, unit="m"),
 )
-
-
-class Layout:
-    """The corridor's centreline and derived frame, all exact for axis-aligned headings.
-
-    ``points`` (k+1, 2) centreline vertices, ``heads`` (k,) heading index of each
-    segment (0 +x, 1 +y, 2 -x, 3 -y), ``lengths`` (k,), ``turns`` (k-1,) +1 left / -1 right.
-    """
-
-    def __init__(self, lengths, turns, width: float):
-        self.lengths = [float(v) for v in lengths]
-        self.turns = list(turns)
-        self.width = width
-        heads, points = [0], [np.zeros(2)]
-        for i, length in enumerate(self.lengths):
-            points.append(points[-1] + length * np.array(_HEADINGS[heads[-1]]))
-            if i < len(self.turns):
-                heads.append((heads[-1] + self.turns[i]) % 4)
-        self.heads = heads
-        self.points = np.array(points)
-
-    def u(self, i: int) -> np.ndarray:
-        return np.array(_HEADINGS[self.heads[i]])
-
-    def n(self, i: int) -> np.ndarray:
-        """The left normal of segment i."""
-        return np.array(_HEADINGS[(self.heads[i] + 1) % 4])
-
-    def rects(self, extra: float = 0.0) -> list[tuple[float, float, float, float]]:
-        """(minx, miny, maxx, maxy) of each leg's floor (corner squares included), widened by ``extra``."""
-        out = []
-        half = self.width / 2 + extra
-        k = len(self.lengths)
-        for i in range(k):
-            u = self.u(i)
-            start = self.points[i] - (self.width / 2 + extra if i > 0 else extra) * u
-            end = self.points[i + 1] + (self.width / 2 + extra if i < k - 1 else extra) * u
-            n = self.n(i)
-            pts = np.array([start + half * n, start - half * n, end + half * n, end - half * n])
-            out.append((*pts.min(axis=0), *pts.max(axis=0)))
-        return out
-
-    def bounds(self):
-        r = np.array(self.rects())
-        return ((float(r[:, 0].min()), float(r[:, 1].min())), (float(r[:, 2].max()), float(r[:, 3].max())))
-
-    def straight_part(self, i: int) -> tuple[float, float]:
-        """Along-segment interval of leg i outside the corner squares (0 = its start vertex)."""
-        lo = self.width / 2 if i > 0 else 0.0
-        hi = self.lengths[i] - (self.width / 2 if i < len(self.lengths) - 1 else 0.0)
-        return lo, hi
-
-
-def _lengths_and_turns(params: Mapping[str, Any]) -> tuple[list[float], list[int]]:
-    shape = params["shape"]
-    segments, turns = params["segments"], params["turns"]
-    words = turns.split(",") if turns is not None else None
-    if shape == "zigzag":
-        count = len(segments) if segments is not None else (len(words) + 1 if words else ZIGZAG_SEGMENTS)
-        if count < 2:
-            raise ParameterError(f"parameter 'segments' must hold at least 2 lengths for a zigzag, got {segments!r}")
-        if words is None:
-            words = ["left" if i % 2 == 0 else "right" for i in range(count - 1)]
-        if len(words) != count - 1:
-            raise ParameterError(f"parameter 'turns' must name {count - 1} turns for {count} zigzag segments, got {turns!r}")
-    else:
-        count = _SEGMENT_COUNT[shape]
-        if segments is not None and len(segments) != count:
-            raise ParameterError(f"parameter 'segments' must hold {count} length(s) for a {shape} corridor, got {segments!r}")
-        if shape == "straight":
-            if words is not None:
-                raise ParameterError(f"parameter 'turns' does not apply to a straight corridor; leave it unset, got {turns!r}")
-            words = []
-        elif words is None:
-            words = ["left"] * (count - 1)
-        elif len(words) != count - 1 or len(set(words)) != 1:
-            need = "one turn" if shape == "L" else "two turns the same way (e.g. left,left)"
-            raise ParameterError(f"parameter 'turns' must be {need} for a {shape} corridor, got {turns!r}")
-    lengths = list(segments) if segments is not None else [params["length"]] * count
-    return lengths, [1 if w == "left" else -1 for w in words]
-
-
-def layout(params: Mapping[str, Any]) -> Layout:
-    """The centreline of validated ``params`` (raises :class:`ParameterError` for impossible ones)."""
-    lengths, turns = _lengths_and_turns(params)
-    return Layout(lengths, turns, params["width"])
 
 
 def proven_width(params: Mapping[str, Any]) -> float:
@@ -221,6 +132,15 @@ def check(params: Mapping[str, Any]) -> None:
             raise ParameterError(
                 f"parameter 'n_obstacles' must be 0 in a corridor {w:g} m wide: obstacles need width >= passage + "
                 f"0.05 = {g + 0.05:.3f} m (or set 'min_passage' as low as {proven:.5f}), got {params['n_obstacles']!r}")
+    if params["n_obstacles"]:
+        shortest = params["obstacle_length"][0] + 2 * g
+        longest = max(hi - lo for lo, hi in _usable(lay, params))
+        if longest < shortest:
+            raise ParameterError(
+                f"parameter 'n_obstacles' must be 0 in this corridor: an obstacle needs {shortest:.3g} m of a leg "
+                f"({params['obstacle_length'][0]:g} m long and {g:g} m of passage on each side), and the longest leg "
+                f"has {max(longest, 0.0):.3g} m left after the spawn's and goal's room; lengthen the corridor, "
+                f"got {params['n_obstacles']!r}")
     if params["side_openings"] and params["opening_width"] > max(b - a for a, b in
                                                                  (lay.straight_part(i) for i in range(k))):
         raise ParameterError(f"parameter 'opening_width' must fit in a leg's straight part, got {params['opening_width']!r}")
@@ -235,6 +155,22 @@ def check(params: Mapping[str, Any]) -> None:
             f"from {proven:.5f} m wide")
 
 
+def _usable(lay, params: Mapping[str, Any]) -> list[tuple[float, float]]:
+    """Per leg, the along-leg interval where openings and obstacles may go: the straight part, less the
+    spawn's and the goal's room on the first and last legs."""
+    e, inflation = _end_offset(params), params["robot_radius"] + params["clearance"]
+    k = len(lay.lengths)
+    usable = []
+    for i in range(k):
+        lo, hi = lay.straight_part(i)
+        if i == 0:
+            lo = e + inflation
+        if i == k - 1:
+            hi = lay.lengths[i] - e - inflation
+        usable.append((lo, hi))
+    return usable
+
+
 def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     opening_rng, obstacle_rng = rng.spawn(2)
     lay = layout(params)
@@ -244,16 +180,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     k = len(lay.lengths)
     e = _end_offset(params)
     g = _passage(params, proven_width(params))
-    inflation = params["robot_radius"] + params["clearance"]
-    # Per leg: the along-leg intervals already taken (openings, obstacles) and where things may go.
-    usable = []
-    for i in range(k):
-        lo, hi = lay.straight_part(i)
-        if i == 0:
-            lo = e + inflation
-        if i == k - 1:
-            hi = lay.lengths[i] - e - inflation
-        usable.append((lo, hi))
+    usable = _usable(lay, params)
     taken: list[list[tuple[float, float]]] = [[] for _ in range(k)]
 
     openings: list[list[tuple[float, float]]] = [[] for _ in range(2 * k)]  # per (leg, side)
@@ -261,8 +188,9 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     for _ in range(params["side_openings"]):
         spot = _place(opening_rng, usable, taken, lambda: ow, 0.2)
         if spot is None:
+            n = params["side_openings"]
             return Draft(None, rejected="opening_placement",
-                         detail=f"could not fit {params['side_openings']} openings of {ow:g} m in the side walls")
+                         detail=f"could not fit {n} side opening{'s' if n != 1 else ''} of {ow:g} m in the side walls")
         leg, a, b = spot
         side = int(opening_rng.integers(2))
         openings[2 * leg + side].append((a, b))
@@ -275,8 +203,12 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     for j in range(params["n_obstacles"]):
         spot = _place(obstacle_rng, usable, taken, lambda: obstacle_rng.uniform(lo_len, hi_len), g)
         if spot is None:
+            n = params["n_obstacles"]
+            room = sum(max(hi - lo, 0.0) for lo, hi in usable)
             return Draft(None, rejected="obstacle_placement",
-                         detail=f"could not fit {params['n_obstacles']} obstacles {g:g} m apart along the corridor")
+                         detail=f"placed {j} of {n} obstacle{'s' if n != 1 else ''} {lo_len:g}-{hi_len:g} m long, each "
+                                f"{g:g} m from the others and from the corridor's ends, in {room:.3g} m of usable "
+                                f"corridor (the rest is kept free at the spawn and goal)")
         leg, a, b = spot
         side = 1.0 if obstacle_rng.random() < 0.5 else -1.0
         depth = round_float(obstacle_rng.uniform(min(0.1, w - g), w - g))

@@ -58,6 +58,8 @@ TARGET_DENSITY = 300.0
 TARGET_RGBA = (0.85, 0.30, 0.25, 1.0)
 
 PARAMS = (
+    # One task: the robot at its spawn facing the target; a request for more is refused, not dropped.
+    Param("n_tasks", "int", 1, "spawn/goal pairs per world: one here, the spawn facing the target", 1, 1),
     Param("size", "pair", [10.0, 10.0], "extents (x, y) of the floor, centred on the origin", 1.0, 500.0, unit="m"),
     Param("walls", "bool", False, "surround the floor with walls (they are seen by sensors too)"),
     Param("wall_height", "float", 1.0, "height of the surrounding walls", 0.05, 50.0, unit="m"),

@@ -30,13 +30,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
 from worldgen.floats import fmt, round_float
 from worldgen.scene import Scene
 
-__all__ = ["OccupancyMap", "build", "extent", "MAX_CELLS", "OCCUPIED", "FREE", "IMAGE_NAME", "YAML_NAME"]
+__all__ = ["OccupancyMap", "build", "extent", "MAX_CELLS", "OCCUPIED", "FREE"]
 
-IMAGE_NAME = "map.pgm"
-YAML_NAME = "map.yaml"
 OCCUPIED = 0
 FREE = 254
 #: The largest map written (cells); 20 x 20 m at 0.05 m is 160 000.
@@ -63,7 +62,7 @@ class OccupancyMap:
         rows, cols = self.occupied.shape
         return b"P5\n%d %d\n255\n" % (cols, rows) + self.image().tobytes()
 
-    def yaml(self, image: str = IMAGE_NAME) -> bytes:
+    def yaml(self, image: str = MAP_IMAGE_NAME) -> bytes:
         ox, oy = self.origin
         return (
             f"image: {image}\n"
@@ -75,7 +74,7 @@ class OccupancyMap:
             f"free_thresh: 0.25\n"
         ).encode()
 
-    def describe(self, image: str = IMAGE_NAME, yaml: str = YAML_NAME) -> dict:
+    def describe(self, image: str = MAP_IMAGE_NAME, yaml: str = MAP_YAML_NAME) -> dict:
         """world.json's ``occupancy`` block."""
         return {"image": image, "yaml": yaml, "resolution": self.resolution,
                 "origin": [self.origin[0], self.origin[1], 0.0]}

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import weakref
 
+from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
 from worldgen.groundtruth import barn as barn_grid
 from worldgen.groundtruth import lidar, metrics, occupancy
 from worldgen.params import COMMON_PARAMS
@@ -66,14 +67,14 @@ def occupancy_map(world) -> occupancy.OccupancyMap:
 
 def occupancy_block(world) -> dict:
     """world.json's ``occupancy`` block."""
-    return occupancy_map(world).describe(occupancy.IMAGE_NAME, occupancy.YAML_NAME)
+    return occupancy_map(world).describe(MAP_IMAGE_NAME, MAP_YAML_NAME)
 
 
 def map_files(world) -> dict[str, tuple[str, bytes]]:
     """``{key: (relative path, bytes)}`` of the map's PGM and YAML files."""
     grid = occupancy_map(world)
-    return {"map_pgm": (occupancy.IMAGE_NAME, grid.pgm()),
-            "map_yaml": (occupancy.YAML_NAME, grid.yaml(occupancy.IMAGE_NAME))}
+    return {"map_pgm": (MAP_IMAGE_NAME, grid.pgm()),
+            "map_yaml": (MAP_YAML_NAME, grid.yaml(MAP_IMAGE_NAME))}
 
 
 def difficulty(world) -> dict:

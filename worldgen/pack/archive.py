@@ -17,7 +17,8 @@ from pathlib import Path, PurePosixPath
 from typing import Optional
 
 from worldgen.errors import OutputError, ParameterError
-from worldgen.pack.manifest import MANIFEST_NAME, WORLDS_DIR, world_folder, write_atomically
+from worldgen.files import MANIFEST_NAME, WORLDS_DIR, write_atomically
+from worldgen.pack.manifest import world_folder
 
 __all__ = ["write_archive", "ArchiveReader", "is_archive", "SUFFIX"]
 

@@ -27,16 +27,8 @@ from pathlib import Path
 from typing import Optional, TextIO
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError
-from worldgen.pack.manifest import (
-    INDEX_NAME,
-    MANIFEST_NAME,
-    WORLDS_DIR,
-    build_manifest,
-    index_bytes,
-    manifest_bytes,
-    world_folder,
-    write_atomically,
-)
+from worldgen.files import INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, write_atomically, write_folder_atomically
+from worldgen.pack.manifest import build_manifest, index_bytes, manifest_bytes, world_folder
 from worldgen.pack.recipe import Recipe
 from worldgen.pack.render import build_job
 
@@ -81,7 +73,6 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
     at ``scheduler``; see :mod:`worldgen.pack.dask`).
     """
     import worldgen
-    from worldgen.world import write_folder_atomically
 
     if not 1 <= jobs <= MAX_JOBS:
         raise ParameterError(f"parameter 'jobs' must be in [1, {MAX_JOBS}], got {jobs}")

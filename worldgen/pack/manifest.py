@@ -10,19 +10,13 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
-import tempfile
-from pathlib import Path
 from typing import Any, Iterable, Mapping
 
-from worldgen.world import creation_mode
+from worldgen.files import METADATA_NAME, WORLDS_DIR
 
-__all__ = ["MANIFEST_NAME", "INDEX_NAME", "WORLDS_DIR", "SCHEMA_ID", "METRICS", "build_manifest",
-           "manifest_bytes", "index_bytes", "write_atomically"]
+__all__ = ["SCHEMA_ID", "METRICS", "build_manifest",
+           "manifest_bytes", "index_bytes"]
 
-MANIFEST_NAME = "manifest.json"
-INDEX_NAME = "index.csv"
-WORLDS_DIR = "worlds"
 SCHEMA_ID = "worldgen.pack/1"
 #: The key metrics copied from each world.json into the manifest and index.csv.
 METRICS = ("obstacle_count", "free_area_ratio", "narrowest_passage", "path_length",
@@ -62,7 +56,7 @@ def world_folder(world: Mapping[str, Any]) -> str:
     (``worlds/<preset>--<world_id>`` for a preset's world, else ``worlds/<world_id>``)."""
     for rel in world["files"]:
         parts = rel.split("/")
-        if len(parts) == 3 and parts[0] == WORLDS_DIR and parts[1] not in ("", ".", "..") and parts[2] == "world.json":
+        if len(parts) == 3 and parts[0] == WORLDS_DIR and parts[1] not in ("", ".", "..") and parts[2] == METADATA_NAME:
             return f"{WORLDS_DIR}/{parts[1]}"
     return f"{WORLDS_DIR}/{world['world_id']}"
 
@@ -77,25 +71,6 @@ def index_bytes(manifest: Mapping[str, Any]) -> bytes:
         w.writerow([i, world["world_id"], world["generator"], world["seed"], world_folder(world),
                     *("" if m.get(k) is None else repr(m[k]) for k in METRICS)])
     return buf.getvalue().encode()
-
-
-def write_atomically(path: Path, data: bytes) -> None:
-    """Write ``path`` whole or not at all: a temporary file beside it, fsync, rename."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, creation_mode(0o666))
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def key_metrics(meta: Mapping[str, Any]) -> dict[str, Any]:

@@ -1,9 +1,11 @@
 """``worldgen.Pack``: a built pack (folder or archive), read through its manifest.
 
-    >>> pack = worldgen.Pack.open("packs/small")          # or "packs/small.tar.gz"
-    >>> len(pack), pack[0].world_id, pack["cluttered-s3-1f3a9c0b"].seed
-    >>> hard = pack.filter("narrowest_passage < 1.0 and obstacle_count >= 5")
-    >>> meta = hard[0].metadata                            # its world.json as a dict
+Usage, on a pack built with ``worldgen pack build`` (docs/packs.md)::
+
+    pack = worldgen.Pack.open("packs/small")          # or "packs/small.tar.gz"
+    len(pack), pack[0].world_id, pack["cluttered-s3-1f3a9c0b"].seed
+    hard = pack.filter("narrowest_passage < 1.0 and obstacle_count >= 5")
+    meta = hard[0].metadata                            # its world.json as a dict
 """
 
 from __future__ import annotations
@@ -15,8 +17,9 @@ from pathlib import Path, PurePosixPath
 from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from worldgen.errors import ParameterError
+from worldgen.files import MANIFEST_NAME, METADATA_NAME
 from worldgen.pack.archive import ArchiveReader, is_archive
-from worldgen.pack.manifest import MANIFEST_NAME, METRICS, SCHEMA_ID, world_folder
+from worldgen.pack.manifest import METRICS, SCHEMA_ID, world_folder
 from worldgen.pack.where import parse_where
 
 __all__ = ["Pack", "PackWorld", "open_source"]
@@ -91,7 +94,7 @@ class PackWorld:
     @cached_property
     def metadata(self) -> dict:
         """world.json as a dict."""
-        return json.loads(self.read("world.json"))
+        return json.loads(self.read(METADATA_NAME))
 
 
 class Pack:

@@ -12,7 +12,8 @@ from pathlib import Path
 from typing import Any
 
 from worldgen.errors import InfeasibleError
-from worldgen.pack.manifest import WORLDS_DIR, key_metrics
+from worldgen.files import METADATA_NAME, WORLDS_DIR, write_folder_atomically
+from worldgen.pack.manifest import key_metrics
 from worldgen.pack.recipe import Job
 
 __all__ = ["render_job", "build_job"]
@@ -36,7 +37,7 @@ def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict
     if job.preset:
         rec["preset"] = job.preset
     blobs = world.folder_blobs(formats, sdf_version, preview)
-    meta = json.loads(blobs["world.json"])
+    meta = json.loads(blobs[METADATA_NAME])
     folder = f"{WORLDS_DIR}/{world.folder_name}"
     rec.update(world_id=world.world_id, folder=world.folder_name, params=meta["params"], metrics=key_metrics(meta),
                attempts=world.attempts,
@@ -46,7 +47,6 @@ def render_job(job: Job, formats, sdf_version: str, preview: bool) -> tuple[dict
 
 def build_job(job: Job, worlds_dir: str, formats, sdf_version: str, preview: bool) -> dict:
     """Build and write one world; return its record (runs in a local worker process)."""
-    from worldgen.world import write_folder_atomically
 
     rec, blobs = render_job(job, formats, sdf_version, preview)
     if blobs:

@@ -16,7 +16,8 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from worldgen.pack.manifest import INDEX_NAME, WORLDS_DIR, index_bytes
+from worldgen.files import INDEX_NAME, WORLDS_DIR
+from worldgen.pack.manifest import index_bytes
 from worldgen.pack.pack import Pack
 
 __all__ = ["verify_pack"]

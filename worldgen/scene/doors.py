@@ -118,7 +118,7 @@ def _passage(scene: Scene, joint: Joint) -> Optional[dict]:
 
 
 def door_records(scene: Scene) -> list[dict]:
-    """world.json's ``doors[]``: one record per door joint (METADATA.md's fields, plus ``joint``).
+    """world.json's ``doors[]``: one record per door joint (docs/world-json.md's fields, plus ``joint``).
 
     ``hinge`` is where the hinge axis meets the floor (z = 0), ``axis`` the unit
     axis in the world frame (positive angles open the door), ``angle`` the

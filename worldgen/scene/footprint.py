@@ -18,7 +18,13 @@ import shapely
 
 from worldgen.scene.graph import Scene
 
-__all__ = ["Footprint", "FootprintIndex", "scene_footprints", "robot_footprints"]
+__all__ = ["Footprint", "FootprintIndex", "scene_footprints", "robot_footprints", "SAFETY"]
+
+#: Extra margin (m) the feasibility planner keeps on top of the robot's inflation radius: far above
+#: the 6-decimal rounding of waypoints and FCL's solver tolerance, far below any length that matters
+#: (it lengthens a path by well under 0.1 %). A passage is refused only when it is narrower than
+#: 2 x (inflation + SAFETY); generators that build passages to a width (corridor) read it here.
+SAFETY = 1e-4
 
 _VERTICAL = 1e-9
 

@@ -1,17 +1,24 @@
 """Judge many runs in many worlds against acceptance criteria read from YAML.
 
-    >>> report = evaluate([(trajectory, world), ...], "criteria.yaml")
-    >>> print(report)                 # a table: criterion, required, measured, verdict, by how much
-    >>> report.passed, report.failures
-    >>> report.write_csv("report.csv"); report.write_json("report.json")
+Usage (an example that runs is in :mod:`worldgen.testing.oracles`)::
 
-Criteria come in three sections; every key is optional, an unknown section or
-key is a one-line :class:`~worldgen.errors.ParameterError`:
+    report = evaluate([(trajectory, world), ...], "criteria.yaml")
+    print(report)                 # a table: criterion, required, measured, verdict, by how much
+    report.passed, report.failures
+    report.write_csv("report.csv"); report.write_json("report.json")
 
-    navigation:  success_rate (>=, 0..1), path_efficiency (<=, mean recorded/reference length)
-    safety:      obstacle_clearance (>=, m, smallest over all runs), min_obstacle_distance (>=, m,
-                 from movers), collision_tolerance (<=, total contacts), max_velocity (<=, m/s)
-    performance: max_time (<=, s, slowest successful run), avg_time_to_goal (<=, s, mean over successes)
+The criteria file's sections and keys are in :mod:`worldgen.testing.criteria`.
+What is averaged over what, so that a crash cannot flatter a figure:
+
+- success rate: every run; in its confidence form (``success_rate: {min: 0.95, confidence: 0.95}``)
+  the one-sided Clopper-Pearson lower bound must reach ``min``, and the report says how many more
+  clean runs would get it there (:mod:`worldgen.testing.stats`);
+- path efficiency and time to goal: successful runs only, as BARN and Arena average them (a run
+  that crashed at 65 % of the path is short, not efficient);
+- BARN score: every run, failures scoring 0; clearance, contacts, speed: every run.
+
+``summary["per_world"]`` breaks every figure down by world: the runs in one world are repeats, the
+worlds a sample.
 
 A run succeeds when it meets its world's scenario (scenario.yaml, read from the
 folder or built from the World): it reaches the goal waypoint within tolerance,
@@ -23,67 +30,25 @@ from __future__ import annotations
 import csv
 import io
 import json
-import math
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any, Iterable, Mapping, Optional
+from typing import Any, Iterable, Mapping, Optional, Union
 
 from worldgen.errors import ParameterError
-from worldgen.testing.figures import Run, load
+from worldgen.files import SCENARIO_NAME
+from worldgen.testing.criteria import CRITERIA, SCORING, load_criteria
+from worldgen.testing.figures import Run, barn_score, load
 from worldgen.testing.figures import run as run_figures
 
-__all__ = ["CRITERIA", "Criterion", "Report", "load_criteria", "evaluate", "scenario_of"]
+__all__ = ["CRITERIA", "AVERAGED_OVER", "Criterion", "Report", "load_criteria", "evaluate", "scenario_of"]
 
-#: section -> key -> (comparison, what is measured)
-CRITERIA: dict[str, dict[str, tuple[str, str]]] = {
-    "navigation": {"success_rate": (">=", "share of runs meeting their scenario"),
-                   "path_efficiency": ("<=", "mean recorded length / reference length")},
-    "safety": {"obstacle_clearance": (">=", "smallest footprint-to-collider distance (m)"),
-               "min_obstacle_distance": (">=", "smallest footprint-to-mover gap (m)"),
-               "collision_tolerance": ("<=", "total contacts"),
-               "max_velocity": ("<=", "highest speed between samples (m/s)")},
-    "performance": {"max_time": ("<=", "slowest time to goal of a successful run (s)"),
-                    "avg_time_to_goal": ("<=", "mean time to goal of successful runs (s)")},
+#: Which runs each summary figure is taken over (written into every report's summary).
+AVERAGED_OVER = {
+    "success_rate": "all runs", "path_efficiency": "successful runs", "time_to_goal": "successful runs",
+    "barn_score": "all runs (failed runs score 0; runs without a reference path are left out)",
+    "min_clearance": "all runs (smallest)", "collision_count": "all runs (total)",
+    "max_velocity": "all runs (largest)", "min_separation": "all runs (smallest)",
 }
-
-
-def load_criteria(criteria) -> dict[str, dict[str, float]]:
-    """Criteria from a YAML file path, a YAML text or a mapping, checked key by key."""
-    import yaml
-
-    where = "criteria"
-    is_file_name = isinstance(criteria, str) and "\n" not in criteria and criteria.endswith((".yaml", ".yml"))
-    if isinstance(criteria, Path) or is_file_name:
-        where = str(criteria)
-        try:
-            criteria = Path(criteria).read_text()
-        except OSError as exc:
-            raise ParameterError(f"parameter 'criteria': cannot read '{where}': {exc.strerror}") from None
-    if isinstance(criteria, str):
-        try:
-            criteria = yaml.safe_load(criteria) or {}
-        except yaml.YAMLError as exc:
-            raise ParameterError(f"parameter 'criteria': {where} is not valid YAML ({str(exc).splitlines()[0]})") from None
-    if not isinstance(criteria, Mapping):
-        raise ParameterError(f"parameter 'criteria' must be a mapping of sections {', '.join(CRITERIA)}, "
-                             f"got {type(criteria).__name__}")
-    out: dict[str, dict[str, float]] = {}
-    for section, keys in criteria.items():
-        if section not in CRITERIA:
-            raise ParameterError(f"{where}: unknown section {section!r}; allowed: {', '.join(CRITERIA)}")
-        if not isinstance(keys, Mapping):
-            raise ParameterError(f"{where}: section {section!r} must be a mapping of criteria, got {type(keys).__name__}")
-        out[section] = {}
-        for key, value in keys.items():
-            if key not in CRITERIA[section]:
-                raise ParameterError(f"{where}: unknown key {section}.{key}; "
-                                     f"allowed in {section}: {', '.join(CRITERIA[section])}")
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-                raise ParameterError(f"{where}: {section}.{key} must be a finite number >= 0, got {value!r}")
-            if key == "success_rate" and value > 1:
-                raise ParameterError(f"{where}: navigation.success_rate must be in [0, 1], got {value!r}")
-            out[section][key] = float(value)
-    return out
 
 
 def scenario_of(world) -> dict:
@@ -92,7 +57,7 @@ def scenario_of(world) -> dict:
 
     if isinstance(world, (str, Path)):
         return scenario.read(world)
-    if getattr(world, "path", None) is not None and (Path(world.path) / scenario.SCENARIO_NAME).is_file():
+    if getattr(world, "path", None) is not None and (Path(world.path) / SCENARIO_NAME).is_file():
         return scenario.read(world.path)
     return scenario.scenario(world)
 
@@ -124,7 +89,13 @@ def _succeeded(r: Run, task_spec: dict) -> tuple[bool, str]:
 
 @dataclass(frozen=True)
 class Criterion:
-    """One criterion's verdict. ``margin`` is how far the measurement is on the good side (negative = failed by)."""
+    """One criterion's verdict. ``margin`` is how far the measurement is on the good side (negative = failed by).
+
+    For ``success_rate`` in its confidence form, ``measured`` is the one-sided Clopper-Pearson lower
+    bound at ``confidence``, ``successes``/``runs`` the counts it comes from, and ``more_clean_runs``
+    how many more successful runs would make the bound reach ``required`` (0 when it does; "never"
+    when no run count can, a required rate of 1).
+    """
 
     section: str
     key: str
@@ -133,6 +104,29 @@ class Criterion:
     measured: Optional[float]
     passed: bool
     margin: Optional[float]
+    confidence: Optional[float] = None
+    successes: Optional[int] = None
+    runs: Optional[int] = None
+    more_clean_runs: Union[int, str, None] = None
+
+    @property
+    def more_text(self) -> str:
+        """What more runs would do, for the confidence form ('' when it passes or is another criterion)."""
+        more = self.more_clean_runs
+        if self.confidence is None or not more:
+            return ""
+        if more == "never":
+            return "no number of further runs would make it pass"
+        return f"{more} more clean run{'s' if more != 1 else ''} would make it pass"
+
+    @property
+    def bound_text(self) -> str:
+        """How the confidence form reads (empty for every other criterion)."""
+        if self.confidence is None:
+            return ""
+        head = (f"one-sided {self.confidence:.0%} Clopper-Pearson lower bound of {self.successes}/{self.runs} "
+                f"= {self.measured:.4f}")
+        return f"{head}; {self.more_text}" if self.more_text else head
 
 
 class Report:
@@ -154,15 +148,31 @@ class Report:
         for c in self.criteria:
             if not c.passed:
                 got = "nothing to measure" if c.measured is None else f"{c.measured:.6g}"
+                if c.confidence is not None:
+                    got = f"lower bound {got} ({c.successes}/{c.runs} at {c.confidence:.0%} confidence)"
                 by = "" if c.margin is None else f", failed by {-c.margin:.6g}"
-                out.append(f"{c.section}.{c.key}: required {c.op} {c.required:.6g}, measured {got}{by}")
+                more = f"; {c.more_text}" if c.more_text else ""
+                out.append(f"{c.section}.{c.key}: required {c.op} {c.required:.6g}, measured {got}{by}{more}")
         return out
 
     def rows(self) -> list[dict[str, Any]]:
-        return [{"criterion": f"{c.section}.{c.key}", "required": f"{c.op} {c.required:.6g}",
-                 "measured": "n/a" if c.measured is None else f"{c.measured:.6g}",
-                 "verdict": "PASS" if c.passed else "FAIL",
-                 "margin": "" if c.margin is None else f"{c.margin:+.6g}"} for c in self.criteria]
+        out = []
+        for c in self.criteria:
+            measured = "n/a" if c.measured is None else f"{c.measured:.6g}"
+            required = f"{c.op} {c.required:.6g}"
+            if c.confidence is not None:  # the bound, and the counts it is a bound of
+                required += f" ({c.confidence:.0%} conf.)"
+                measured += f" ({c.successes}/{c.runs})"
+            out.append({"criterion": f"{c.section}.{c.key}", "required": required, "measured": measured,
+                        "verdict": "PASS" if c.passed else "FAIL",
+                        "margin": "" if c.margin is None else f"{c.margin:+.6g}"})
+        return out
+
+    def notes(self) -> list[str]:
+        """What the table's figures are taken over, and the confidence bound in words."""
+        out = [f"{c.section}.{c.key}: {c.bound_text}" for c in self.criteria if c.confidence is not None]
+        out.append("path efficiency and time to goal: means over successful runs only")
+        return out
 
     def __str__(self) -> str:
         rows = self.rows()
@@ -173,6 +183,7 @@ class Report:
             return "  ".join(c.ljust(w) for c, w in zip(cells, widths)).rstrip()
 
         out = [line(head), line(["-" * w for w in widths])] + [line([r[h] for h in head]) for r in rows]
+        out += self.notes()
         s = self.summary
         out.append(f"{s['runs']} runs, {s['successes']} succeeded: {'PASS' if self.passed else 'FAIL'}")
         return "\n".join(out)
@@ -206,43 +217,71 @@ def _runs(runs: Iterable) -> Iterable[tuple[Any, Any, Optional[str]]]:
             raise ParameterError(f"parameter 'runs' item {i} must be (trajectory, world[, task]) or a dict with those keys")
 
 
-def evaluate(runs: Iterable, criteria) -> Report:
-    """Figures of every run (each a ``(trajectory, world[, task])`` or a dict), judged against ``criteria``."""
+def _mean(xs: list[float]) -> Optional[float]:
+    return sum(xs) / len(xs) if xs else None
+
+
+def _figures(judged: list[tuple[Run, bool, Optional[float]]]) -> dict[str, Any]:
+    """The summary figures of some judged runs (run, success, BARN score), each over the runs AVERAGED_OVER says."""
+    good = [r for r, ok, _ in judged if ok]
+    times = [r.time_to_goal for r in good if r.time_to_goal is not None]
+    scores = [s for _, _, s in judged if s is not None]
+    return {
+        "runs": len(judged), "successes": len(good), "success_rate": len(good) / len(judged),
+        "mean_time_to_goal": _mean(times), "max_time_to_goal": max(times) if times else None,
+        "mean_path_efficiency": _mean([r.path_efficiency for r in good if r.path_efficiency is not None]),
+        "mean_barn_score": _mean(scores),
+        "min_clearance": min(r.min_clearance for r, _, _ in judged),
+    }
+
+
+def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
+             reference_speed: Optional[float] = None) -> Report:
+    """Figures of every run (each a ``(trajectory, world[, task])`` or a dict), judged against ``criteria``.
+
+    ``barn_k`` and ``reference_speed`` set the BARN score (the criteria file's ``scoring`` section
+    otherwise, else BARN's current 2 optimal times and 2 m/s).
+    """
     crit = load_criteria(criteria)
-    rows, figures = [], []
+    scoring = {key: default for key, (default, _) in SCORING.items()} | crit.pop("scoring", {})
+    k = scoring["barn_k"] if barn_k is None else barn_k
+    speed = scoring["reference_speed"] if reference_speed is None else reference_speed
+    rows, judged = [], []
     for trajectory, world, task in _runs(runs):
         ground = load(world)
         r = run_figures(trajectory, ground, task)
         ok, why = _succeeded(r, _task_spec(scenario_of(world), r.task))
-        figures.append((r, ok))
-        rows.append(r.as_dict() | {"success": ok, "reason": why})
-    if not figures:
+        score = barn_score(ok, r.time_to_goal, r.reference_length, k, speed)
+        judged.append((r, ok, score))
+        rows.append(r.as_dict() | {"success": ok, "reason": why, "barn_score": score})
+    if not judged:
         raise ParameterError("parameter 'runs' must hold at least one run, got none")
-    good = [r for r, ok in figures if ok]
-    times = [r.time_to_goal for r in good if r.time_to_goal is not None]
-    eff = [r.path_efficiency for r, _ in figures if r.path_efficiency is not None]
-    seps = [r.min_separation for r, _ in figures if r.min_separation is not None]
-    summary = {
-        "runs": len(figures), "successes": len(good),
-        "success_rate": len(good) / len(figures),
-        "mean_time_to_goal": sum(times) / len(times) if times else None,
-        "max_time_to_goal": max(times) if times else None,
-        "min_clearance": min(r.min_clearance for r, _ in figures),
-        "mean_path_efficiency": sum(eff) / len(eff) if eff else None,
-        "collision_count": sum(len(r.collisions) for r, _ in figures),
+    seps = [r.min_separation for r, _, _ in judged if r.min_separation is not None]
+    by_world: dict[str, list] = {}
+    for item in judged:
+        by_world.setdefault(item[0].world_id, []).append(item)
+    summary = _figures(judged) | {
+        "collision_count": sum(len(r.collisions) for r, _, _ in judged),
         "min_separation": min(seps) if seps else None,
-        "max_velocity": max(r.max_velocity for r, _ in figures),
+        "max_velocity": max(r.max_velocity for r, _, _ in judged),
+        "worlds": len(by_world),
+        "per_world": {w: _figures(items) for w, items in sorted(by_world.items())},
+        "averaged_over": AVERAGED_OVER, "barn": {"k": k, "reference_speed": speed},
     }
     measured = {"success_rate": summary["success_rate"], "path_efficiency": summary["mean_path_efficiency"],
                 "obstacle_clearance": summary["min_clearance"], "min_obstacle_distance": summary["min_separation"],
                 "collision_tolerance": float(summary["collision_count"]), "max_velocity": summary["max_velocity"],
-                "max_time": summary["max_time_to_goal"], "avg_time_to_goal": summary["mean_time_to_goal"]}
+                "max_time": summary["max_time_to_goal"], "avg_time_to_goal": summary["mean_time_to_goal"],
+                "barn_score": summary["mean_barn_score"]}
     verdicts = []
     for section in CRITERIA:  # a fixed order, whatever order the YAML had
         for key, (op, _) in CRITERIA[section].items():
             if key not in crit.get(section, {}):
                 continue
             need, got = crit[section][key], measured[key]
+            if isinstance(need, dict):  # success_rate: {min, confidence}
+                verdicts.append(_bound_verdict(section, key, op, need, summary["successes"], summary["runs"]))
+                continue
             if got is None:
                 # No movers means nothing can come near: that criterion holds; no success means no time: it fails.
                 passed = key == "min_obstacle_distance"
@@ -251,3 +290,11 @@ def evaluate(runs: Iterable, criteria) -> Report:
             margin = got - need if op == ">=" else need - got
             verdicts.append(Criterion(section, key, op, need, got, margin >= 0, margin))
     return Report(verdicts, rows, summary)
+
+
+def _bound_verdict(section: str, key: str, op: str, need: dict, k: int, n: int) -> Criterion:
+    from worldgen.testing.stats import success_bound
+
+    b = success_bound(k, n, need["min"], need["confidence"])
+    return Criterion(section, key, op, need["min"], b["lower_bound"], b["passed"], b["lower_bound"] - need["min"],
+                     confidence=need["confidence"], successes=k, runs=n, more_clean_runs=b["more_clean_runs"])

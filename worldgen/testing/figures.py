@@ -26,11 +26,12 @@ from typing import Any, Callable, Optional
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.files import METADATA_NAME
 
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "min_separation", "run",
+    "collisions", "min_separation", "run", "BARN_K", "BARN_REFERENCE_SPEED", "barn_score",
 ]
 
 
@@ -85,7 +86,7 @@ def load(world) -> Ground:
         return Ground(world.metadata, read=world.read)
     if isinstance(world, (str, Path)):
         folder = Path(world)
-        path = folder / "world.json" if folder.is_dir() else folder
+        path = folder / METADATA_NAME if folder.is_dir() else folder
         try:
             meta = json.loads(path.read_text())
         except (OSError, ValueError) as exc:
@@ -250,6 +251,8 @@ class Run:
     collisions: tuple[Contact, ...]
     min_separation: Optional[float]
     max_velocity: float
+    #: The task's exact reference path length (m); None where the world has no proven path.
+    reference_length: Optional[float] = None
 
     def as_dict(self) -> dict[str, Any]:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
@@ -275,7 +278,41 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
         path_efficiency=(length / float(ref)) if ref else None,
         min_clearance=min_clearance(traj, ground), collisions=tuple(collisions(traj, ground)),
         min_separation=min_separation(traj, ground), max_velocity=vmax,
+        reference_length=float(ref) if ref else None,
     )
+
+
+# -- the BARN Challenge's score --------------------------------------------------------
+
+#: The lower clip of the BARN score, in optimal times. The ICRA 2022 runner (Daffan/the-barn-challenge,
+#: run.py) clipped at 4; its ROS 2 runner, used for the dynamic worlds 300-359, clips at 2, so a
+#: perfect run scores 0.5. 2 is the default: scores comparable with today's challenge.
+BARN_K = 2.0
+#: m/s. BARN's optimal time is the reference path length / 2 m/s (the Jackal's top speed), in every runner.
+BARN_REFERENCE_SPEED = 2.0
+#: The upper clip (optimal times), the same in every BARN runner: slower runs all score 1/8.
+_BARN_CEILING = 8.0
+
+
+def barn_score(success: bool, time: Optional[float], reference_length: Optional[float],
+               k: float = BARN_K, reference_speed: float = BARN_REFERENCE_SPEED) -> Optional[float]:
+    """The BARN Challenge score of one run: success x OT / clip(time, k OT, 8 OT), OT = length / speed.
+
+    ``reference_length`` is the task's exact reference path length (m); without one (a world with no
+    proven path) there is no optimal time and the score is None. A failed run scores 0.
+    """
+    if not (isinstance(k, (int, float)) and 0 < k <= _BARN_CEILING):
+        raise ParameterError(f"parameter 'barn_k' must be in (0, {_BARN_CEILING:g}] (BARN used 4, then 2), got {k!r}")
+    if not (isinstance(reference_speed, (int, float)) and 0 < reference_speed < float("inf")):
+        raise ParameterError(f"parameter 'reference_speed' must be a number > 0 (m/s), got {reference_speed!r}")
+    if reference_length is None or reference_length <= 0:
+        return None
+    if not success:
+        return 0.0
+    if time is None:
+        raise ParameterError("a successful run needs its time to goal for a BARN score, got None")
+    optimal = float(reference_length) / float(reference_speed)
+    return optimal / min(max(float(time), k * optimal), _BARN_CEILING * optimal)
 
 
 # -- colliders from world.json (a folder has no Scene) ------------------------------

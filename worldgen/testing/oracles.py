@@ -1,9 +1,18 @@
 """Test oracles: a recorded run plus a world's ground truth in, navigation figures out.
 
+    >>> import worldgen
     >>> from worldgen import oracles
-    >>> oracles.path_efficiency(trajectory, world)      # recorded length / task path length
-    >>> oracles.collisions(trajectory, "worlds/cluttered-s7-1f3a9c0b")
-    >>> oracles.evaluate([(trajectory, world), ...], "criteria.yaml")   # many runs against criteria
+    >>> world = worldgen.generate("cluttered", seed=7, size=[8, 8], n_obstacles=6)
+    >>> path = world.metadata["tasks"][0]["path"]["waypoints"]
+    >>> trajectory = [(2.0 * i, x, y) for i, (x, y) in enumerate(path)]      # rows t, x, y
+    >>> round(oracles.path_efficiency(trajectory, world), 3)     # recorded length / task path length
+    1.0
+    >>> oracles.reached_goal(trajectory, world), oracles.collisions(trajectory, world)
+    (True, [])
+    >>> folder = world.write("worlds")                 # a world folder serves as well as the World
+    >>> report = oracles.evaluate([(trajectory, folder)], {"navigation": {"success_rate": 1.0}})
+    >>> report.passed
+    True
 
 The public face of two modules: :mod:`worldgen.testing.figures` (each figure of
 one run: trajectories, worlds and tasks as accepted there) and
@@ -18,6 +27,7 @@ from worldgen.testing.figures import (
     Ground,
     Run,
     as_trajectory,
+    barn_score,
     collisions,
     load,
     min_clearance,
@@ -32,5 +42,5 @@ from worldgen.testing.figures import (
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "min_separation", "run", "evaluate",
+    "collisions", "min_separation", "run", "evaluate", "barn_score",
 ]

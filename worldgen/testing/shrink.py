@@ -1,7 +1,9 @@
 """Shrink a failing world: drop obstacles and movers while the user's test still fails.
 
-    >>> result = worldgen.shrink(world, lambda w: not my_planner_reaches_goal(w), "shrunk/")
-    >>> result.world.path, result.removed        # the smallest failing world, written
+Usage, with the planner under test in ``my_planner_reaches_goal``::
+
+    result = worldgen.shrink(world, lambda w: not my_planner_reaches_goal(w), "shrunk/")
+    result.world.path, result.removed        # the smallest failing world, written
 
 The search is a greedy delta debugging over the world's obstacle nodes: try
 to drop half of what is left, then quarters, and so on down to single
