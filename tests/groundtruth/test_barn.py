@@ -133,3 +133,17 @@ def test_world_json_records_barns_metrics_of_the_written_map(tmp_path, generator
 def test_without_a_path_every_barn_metric_is_null():
     world = worldgen.generate("cluttered", seed=0, infeasible=True)
     assert world.metadata["metrics"]["barn"] == dict.fromkeys(barn.NAMES)
+
+
+def test_barn_inputs_of_a_world_are_what_metrics_barn_uses():
+    world = worldgen.generate("door", seed=3)
+    grid, cells = truth.barn_inputs(world)
+    assert barn_metrics(grid, cells, barn.DISP_RADIUS) == truth.barn(world)  # one task: no averaging
+    raw, raw_cells = truth.barn_inputs(world, kernel=1)
+    assert (raw == truth.occupancy_map(world).occupied[::-1]).all()
+    half = barn.kernel_cells(world.robot.radius, truth.occupancy_map(world).resolution) // 2
+    assert (cells == raw_cells - half).all()  # this path keeps clear of the map's edge: no cell clipped
+    with pytest.raises(ParameterError, match="task must be in"):
+        truth.barn_inputs(world, task=1)
+    with pytest.raises(worldgen.errors.InfeasibleError, match="no reference path"):
+        truth.barn_inputs(worldgen.generate("cluttered", seed=0, infeasible=True))

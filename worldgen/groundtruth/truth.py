@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import weakref
 
+from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
 from worldgen.groundtruth import barn as barn_grid
 from worldgen.groundtruth import lidar, metrics, occupancy
@@ -17,6 +18,7 @@ from worldgen.scene import Pose
 from worldgen.scene.doors import open_scene
 
 __all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "barn",
+           "barn_inputs",
            "MAP_KEYS"]
 
 #: world.json ``files`` keys of the map's two files.
@@ -88,3 +90,18 @@ def barn(world) -> dict:
     grid = occupancy_map(world)
     paths = [None if p is None else p.waypoints for p in world.feasibility.paths]
     return barn_grid.world_metrics(grid.occupied, grid.origin, grid.resolution, world.robot.radius, paths)
+
+
+def barn_inputs(world, task: int = 0, kernel=None):
+    """(grid, path cells): BARN's inputs for one task's reference path, as ``metrics.barn`` uses
+    them (``kernel=1``: the uninflated map and the chain in map cells), for
+    :func:`worldgen.groundtruth.barn_metrics` with another radius or BARN's other tools."""
+    paths = list(world.feasibility.paths)
+    if not 0 <= task < len(world.tasks):
+        raise ParameterError(f"task must be in [0, {len(world.tasks) - 1}] for this world, got {task!r}")
+    path = paths[task] if task < len(paths) else None
+    if path is None:
+        raise InfeasibleError(f"task {task} of this world has no reference path, so it has no BARN inputs")
+    grid = occupancy_map(world)
+    return barn_grid.world_inputs(grid.occupied, grid.origin, grid.resolution, world.robot.radius, path.waypoints,
+                                  kernel=kernel)
