@@ -105,6 +105,8 @@ def test_rejects_bad_inputs_in_one_line():
         barn_metrics(grid, [(0.5, 1.0)], 3)
     with pytest.raises(ParameterError, match="grid"):
         barn_metrics([1, 0], [(0, 0)], 3)
+    with pytest.raises(ParameterError, match="grid"):
+        barn_metrics([[0, 1], [0]], [(0, 0)], 3)
     with pytest.raises(ParameterError, match="disp_radius"):
         barn_metrics(grid, [(0, 0)], math.inf)
 

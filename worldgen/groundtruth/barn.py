@@ -78,7 +78,10 @@ def barn_metrics(grid, path_cells, disp_radius) -> dict[str, Optional[float]]:
     radius in BARN's steps. ``tortuosity`` is None when the path starts and ends
     in the same cell (BARN's code divides by zero there).
     """
-    occ = np.asarray(grid) == 1
+    try:
+        occ = np.asarray(grid) == 1
+    except ValueError:  # ragged rows
+        occ = np.zeros(0, dtype=bool)
     if occ.ndim != 2 or occ.size == 0:
         raise ParameterError(f"grid must be a non-empty 2-D array of rows of 0/1, got shape {np.shape(grid)}")
     cells = np.asarray(path_cells)
@@ -119,7 +122,7 @@ def cspace(occupied, kernel: int) -> np.ndarray:
 
 def kernel_cells(robot_radius: float, resolution: float) -> int:
     """BARN's robot kernel for a disc robot: the odd square of cells that holds the disc, 2h + 1
-    with h = ceil(radius / resolution) (BARN's Jackal is a 3 x 3 square of its 0.15 m cells)."""
+    with h = ceil(radius / resolution) (BARN's generator defaults to 3 cells, ``def_kernel_size``)."""
     return 2 * max(0, math.ceil(robot_radius / resolution - 1e-9)) + 1
 
 
