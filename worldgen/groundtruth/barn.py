@@ -83,7 +83,8 @@ def barn_metrics(grid, path_cells, disp_radius) -> dict[str, Optional[float]]:
     except ValueError:  # ragged rows
         occ = np.zeros(0, dtype=bool)
     if occ.ndim != 2 or occ.size == 0:
-        raise ParameterError(f"grid must be a non-empty 2-D array of rows of 0/1, got shape {np.shape(grid)}")
+        raise ParameterError(f"grid must be a non-empty 2-D array of rows of 0/1 of one length, got {occ.ndim} "
+                             f"dimension(s) and {occ.size} cells")
     cells = np.asarray(path_cells)
     if cells.ndim != 2 or cells.shape[1:] != (2,) or len(cells) == 0 or not np.issubdtype(cells.dtype, np.integer):
         raise ParameterError(f"path_cells must be a non-empty list of integer (row, col) pairs, got shape {cells.shape}")
