@@ -35,8 +35,9 @@ CLOSEST_TOL = 0.05
 #: follows (octile against Euclidean length), and its end cells move each end by up to half a cell;
 #: measured 1.000 to 1.090.
 TORTUOSITY_RATIO = (0.98, 1.10)
-#: Average visibility, BARN / worldgen: 8 grid directions against 16 exact ones (BARN's are the
-#: longest along a corridor's axis); measured 0.888 to 1.420, highest in narrow straight corridors.
+#: Average visibility, BARN / worldgen: 8 grid directions against 16 exact ones (in an axis-aligned
+#: corridor the two long rays along it weigh 2 of 8 in BARN's mean, 2 of 16 in worldgen's); measured
+#: 0.888 to 1.420, highest in narrow corridors.
 VISIBILITY_RATIO = (0.85, 1.45)
 #: Characteristic dimension, BARN / worldgen: the shortest of 4 grid axes against 8 exact lines
 #: (fewer lines miss narrower chords); measured 0.915 to 1.370.
