@@ -79,6 +79,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
             "free_area_ratio": free_area_ratio(scene, robot.height + robot.clearance),
             "narrowest_passage": narrowest,
             **truth.difficulty(world),
+            "barn": truth.barn(world),
         },
         "sensors": truth.sensors(world),
         "occupancy": truth.occupancy_block(world),

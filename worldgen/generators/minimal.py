@@ -209,7 +209,9 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     size, friction = params["size"], params["friction"]
     (sx, sy, yaw), direction, u = target_layout(params)
     spawn_xy = np.array([sx, sy])
-    nodes = [floor_node(size, params["wall_thickness"] if params["walls"] else 0.5, friction)]
+    # The floor is `size` (the bounds) and, with walls, reaches under them: the bounds, the floor
+    # and the map then end together, so rays and distances stop where the floor does.
+    nodes = [floor_node(size, params["wall_thickness"] if params["walls"] else 0.0, friction)]
     if params["walls"]:
         nodes += wall_nodes(size, params["wall_height"], params["wall_thickness"], friction)
     nodes.append(_target_node(params, spawn_xy, direction, u, friction))

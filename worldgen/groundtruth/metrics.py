@@ -1,7 +1,8 @@
-"""BARN-style difficulty metrics, computed exactly along the reference paths.
+"""Difficulty metrics after BARN's, computed exactly along the reference paths.
 
-Definitions (docs/metrics.md gives them with formulas and says where they
-differ from BARN, Perille et al. 2020): the obstacles are the floor shadows of
+These are not BARN's numbers (those are :mod:`worldgen.groundtruth.barn`'s):
+docs/metrics.md gives the definitions with formulas and says, metric by metric,
+how and by how much they differ from BARN's (Perille et al. 2020). The obstacles are the floor shadows of
 everything a robot can hit (:func:`worldgen.scene.footprint.robot_footprints`, walls
 included) and the edge of the floor area (``scene.bounds``) counts as a wall.
 Each task's path is sampled at :data:`SAMPLES` points evenly spaced by arc
@@ -41,7 +42,7 @@ def path_samples(waypoints: np.ndarray, count: int = SAMPLES) -> np.ndarray:
 
 
 def difficulty(scene, robot, tasks: Sequence, paths: Sequence) -> dict[str, Optional[float]]:
-    """The five BARN-style figures (None each when no task has a path)."""
+    """worldgen's five exact figures after BARN's (None each when no task has a path)."""
     found = [(t, p) for t, p in zip(tasks, paths) if p is not None]
     if not found:
         return {name: None for name in NAMES}

@@ -9,13 +9,17 @@ from __future__ import annotations
 
 import weakref
 
+from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
+from worldgen.groundtruth import barn as barn_grid
 from worldgen.groundtruth import lidar, metrics, occupancy
 from worldgen.params import COMMON_PARAMS
 from worldgen.scene import Pose
 from worldgen.scene.doors import open_scene
 
-__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "MAP_KEYS"]
+__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "barn",
+           "barn_inputs",
+           "MAP_KEYS"]
 
 #: world.json ``files`` keys of the map's two files.
 MAP_KEYS = ("map_pgm", "map_yaml")
@@ -76,5 +80,28 @@ def map_files(world) -> dict[str, tuple[str, bytes]]:
 
 
 def difficulty(world) -> dict:
-    """The five BARN-style figures of world.json's ``metrics``."""
+    """worldgen's five exact figures of world.json's ``metrics`` (after BARN's; not BARN's numbers)."""
     return metrics.difficulty(planning_scene(world), world.robot, world.tasks, world.feasibility.paths)
+
+
+def barn(world) -> dict:
+    """world.json's ``metrics.barn``: BARN's own five metrics (its code's definitions, in cells)
+    on BARN's inputs made from this world's map and reference paths (docs/metrics.md)."""
+    grid = occupancy_map(world)
+    paths = [None if p is None else p.waypoints for p in world.feasibility.paths]
+    return barn_grid.world_metrics(grid.occupied, grid.origin, grid.resolution, world.robot.radius, paths)
+
+
+def barn_inputs(world, task: int = 0, kernel=None):
+    """(grid, path cells): BARN's inputs for one task's reference path, as ``metrics.barn`` uses
+    them (``kernel=1``: the uninflated map and the chain in map cells), for
+    :func:`worldgen.groundtruth.barn_metrics` with another radius or BARN's other tools."""
+    paths = list(world.feasibility.paths)
+    if not 0 <= task < len(world.tasks):
+        raise ParameterError(f"task must be in [0, {len(world.tasks) - 1}] for this world, got {task!r}")
+    path = paths[task] if task < len(paths) else None
+    if path is None:
+        raise InfeasibleError(f"task {task} of this world has no reference path, so it has no BARN inputs")
+    grid = occupancy_map(world)
+    return barn_grid.world_inputs(grid.occupied, grid.origin, grid.resolution, world.robot.radius, path.waypoints,
+                                  kernel=kernel)
