@@ -30,7 +30,7 @@ from functools import partial
 from pathlib import Path
 from typing import Iterator, Optional, TextIO
 
-from worldgen.errors import InfeasibleError, OutputError, ParameterError
+from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError
 from worldgen.files import INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, write_atomically
 from worldgen.pack.manifest import build_manifest, index_bytes, manifest_bytes, world_folder
 from worldgen.pack.recipe import Recipe
@@ -86,22 +86,28 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
 
     _check_options(jobs, executor, scheduler)
     version = version or worldgen.__version__
-    run = _Run(recipe, Path(out), progress)
+    out = Path(out)
+    created = _first_missing(out)
     try:
-        if executor == "dask":
-            run.on_dask(scheduler, version)
-        elif jobs == 1 or len(run.todo) <= 1:
-            run.in_process()
-        else:
-            run.in_pool(jobs)
-    except KeyboardInterrupt as exc:
-        run.bar.done()
-        run.summary.seconds = time.monotonic() - run.start
-        raise BuildInterrupted(run.summary) from exc
-    run.bar.done()
-    run.summary.seconds = time.monotonic() - run.start
-    _write_manifest(recipe, run.out, run.records, run.summary, version)
+        run = _Run(recipe, out, progress)
+        run.execute(jobs, executor, scheduler, version)
+        _write_manifest(recipe, out, run.records, run.summary, version)
+    except WorldgenError:
+        # No pack (no world made, two jobs making one world, a scheduler out of reach): a folder
+        # this build created goes again, so nothing half-written is left. One that was there
+        # before keeps what earlier runs recorded. Ctrl-C is no WorldgenError: its progress stays.
+        if created is not None:
+            shutil.rmtree(created, ignore_errors=True)
+        raise
     return run.summary
+
+
+def _first_missing(path: Path) -> Optional[Path]:
+    """The outermost folder on the way to ``path`` that does not exist yet (None: ``path`` exists)."""
+    missing = None
+    while not path.exists() and path.parent != path:
+        missing, path = path, path.parent
+    return missing
 
 
 class BuildInterrupted(KeyboardInterrupt):
@@ -145,6 +151,24 @@ class _Run:
         self.bar = _Progress(progress, len(self.todo))
         self.render_args = (recipe.formats, recipe.sdf_version, recipe.preview, recipe.ros)
         self.job_args = (str(self.worlds_dir), str(self.state), *self.render_args)
+
+    def execute(self, jobs: int, executor: str, scheduler: Optional[str], version: str) -> None:
+        """Run the jobs still to do; Ctrl-C becomes BuildInterrupted with the counts so far."""
+        try:
+            if executor == "dask":
+                self.on_dask(scheduler, version)
+            elif jobs == 1 or len(self.todo) <= 1:
+                self.in_process()
+            else:
+                self.in_pool(jobs)
+        except KeyboardInterrupt as exc:
+            raise BuildInterrupted(self.stop()) from exc
+        self.stop()
+
+    def stop(self) -> BuildSummary:
+        self.bar.done()
+        self.summary.seconds = time.monotonic() - self.start
+        return self.summary
 
     def finished(self, rec: Optional[dict]) -> None:
         """Count a job whose record is on disk (None: a job the cancel kept from starting)."""
