@@ -10,8 +10,10 @@ from __future__ import annotations
 import json
 import os
 import re
+import shutil
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from support.cli import QUICK, WORLDGEN, run, world_dirs
@@ -331,3 +333,28 @@ def test_an_unknown_name_is_one_line_with_did_you_mean(args, line, tmp_path):
     [got] = r.stderr.splitlines()
     assert got.startswith(line), got
     assert not list(tmp_path.iterdir())  # nothing written
+
+
+# -- make demo ---------------------------------------------------------------------
+
+def test_make_demo_ends_with_what_to_try_next_and_each_suggestion_works(tmp_path):
+    if shutil.which("make") is None:
+        pytest.skip("make is not installed here")
+    root = Path(__file__).resolve().parents[1]
+    venv = Path(sys.executable).parent.parent
+    # The installed venv as it is (-o: never reinstall it), worlds into tmp.
+    r = subprocess.run(["make", "-s", "-C", str(root), "-o", str(venv / ".installed"), "demo", f"VENV={venv}",
+                        f"DEMO_OUT={tmp_path / 'demo'}"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    tips = [line.split("#")[0].split() for line in lines[lines.index("Try next:") + 1:]]
+    assert len(tips) == 4
+    viewer, listing, example, pack = tips
+    assert viewer[:3] == [str(venv / "bin/python"), "-m", "mujoco.viewer"]
+    mjcf = Path(viewer[3].split("=", 1)[1])
+    assert mjcf.is_file() and mjcf.parent.name.startswith("cluttered-s0-")  # the world just written
+    assert listing[1:] == ["list", "cluttered"]
+    shown = subprocess.run(listing, capture_output=True, text=True, timeout=120)
+    assert shown.returncode == 0 and shown.stdout.startswith("cluttered: "), shown.stderr
+    assert (root / example[1]).is_file()
+    assert pack[1:4] == ["pack", "build", "examples/recipes/ci_smoke.yaml"] and (root / pack[3]).is_file()
