@@ -22,10 +22,17 @@ $(RL_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[rl]'
 	touch $@
 
-## demo: install, then generate worlds from the cluttered generator's defaults and say where they are
+## demo: install, then generate worlds from the cluttered generator's defaults, say where they are
+## and what to try next
 demo: $(STAMP)
 	$(VENV)/bin/worldgen generate cluttered --seed 0 --count 3 --out $(DEMO_OUT)
 	@echo "worlds written under $(abspath $(DEMO_OUT))/: each folder holds world.sdf, world.mjcf.xml, world.urdf, world.json, scenario.yaml, map.pgm + map.yaml and preview.png"
+	@echo ""
+	@echo "Try next:"
+	@echo "  $(VENV)/bin/python -m mujoco.viewer --mjcf=$$(ls -d $(DEMO_OUT)/cluttered-s0-* | head -n 1)/world.mjcf.xml   # look at a world (needs a display)"
+	@echo "  $(VENV)/bin/worldgen list cluttered   # every parameter you can --set, with its range"
+	@echo "  $(VENV)/bin/python examples/lidar_unit_test.py   # a sensor unit test; as pytest tests: README step 3, docs/testing.md"
+	@echo "  $(VENV)/bin/worldgen pack build examples/recipes/ci_smoke.yaml --out packs/ci_smoke --jobs 2   # many worlds, one manifest"
 
 ## test: install with the test extras, lint (ruff: pyflakes, pycodestyle, import order), check the
 ## public API's types (mypy), then run the whole suite

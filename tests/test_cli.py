@@ -8,8 +8,12 @@ nothing written.
 from __future__ import annotations
 
 import json
+import os
 import re
+import shutil
+import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 from support.cli import QUICK, WORLDGEN, run, world_dirs
@@ -41,22 +45,36 @@ def test_help_shows_commands_and_examples():
     assert bare.returncode == 0 and "Usage:" in bare.stdout
 
 
+def parameter_blocks(text: str) -> dict[str, str]:
+    """``worldgen list GENERATOR``'s text: each parameter's wrapped lines joined into one string, by name."""
+    blocks: dict[str, list[str]] = {}
+    name = None
+    for line in text.splitlines():
+        m = re.match(r"^  ([a-z_0-9]+)  +(.*)$", line)
+        if m:
+            name = m.group(1)
+            blocks[name] = [m.group(2)]
+        elif name is not None and line.startswith("    ") and line.strip():
+            blocks[name].append(line.strip())
+        else:
+            name = None
+    return {k: " ".join(v) for k, v in blocks.items()}
+
+
 def test_list_shows_every_parameter_with_default_range_and_unit():
-    r = run("list")
+    r = run("list", "cluttered")
     assert r.returncode == 0, r.stderr
-    lines = r.stdout.splitlines()
     spec = get("cluttered")
-    assert lines[0] == f"cluttered: {spec.summary}"
+    assert r.stdout.splitlines()[0] == f"cluttered: {spec.summary}"
+    blocks = parameter_blocks(r.stdout)
+    assert set(blocks) == {p.name for p in spec.all_params}
     for p in spec.all_params:
-        row = next((line for line in lines if line.split()[:1] == [p.name]), None)
-        assert row is not None, p.name
-        assert p.kind in row.split()
-        assert describe_range(p) in row, (p.name, row)
-        if p.unit:
-            assert f"  {p.unit}  " in row
-        assert p.doc in row
-    assert re.search(r"^  n_obstacles\s+int\s+20\s+integer in \[0, 5000\]\s+-\s+number of obstacles", r.stdout, re.M)
-    assert re.search(r"^  size\s+pair\s+10,10\s+each in \[1, 500\]\s+m\s", r.stdout, re.M)
+        block = blocks[p.name]
+        assert block.startswith(p.doc), (p.name, block)
+        assert f" {p.kind}{f' ({p.unit})' if p.unit else ''}; default " in block, (p.name, block)
+        assert describe_range(p) in block, (p.name, block)
+    assert blocks["n_obstacles"].endswith("int; default 20; integer in [0, 5000]")
+    assert blocks["size"].endswith("pair (m); default 10,10; each in [1, 500]")
 
 
 def test_list_markdown_has_a_table_per_generator_and_every_parameter_once_per_generator():
@@ -257,3 +275,86 @@ def test_failure_on_world_3_of_5_leaves_worlds_1_2_complete(tmp_path):
         # preview.png is a picture of world.json, deliberately not listed in its files (worldgen.export.preview).
         listed = {e["path"] for e in meta["files"].values()}
         assert {p.name for p in folder.iterdir()} == listed | {"world.json", "preview.png"}
+
+
+# -- list: an overview, one generator, "did you mean" ------------------------------
+
+def list_output(*args, columns: int) -> subprocess.CompletedProcess:
+    env = {**os.environ, "COLUMNS": str(columns)}
+    return subprocess.run(WORLDGEN + ["list", *args], capture_output=True, text=True, env=env, timeout=120)
+
+
+def test_list_is_one_line_per_generator():
+    r = list_output(columns=200)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    specs = all_specs()
+    assert [line.split()[0] for line in lines[:len(specs)]] == [s.name for s in specs]
+    assert len(lines) == len(specs) + 2 and "worldgen list GENERATOR" in lines[-1]
+    assert max(map(len, lines)) <= 100  # at most 100 columns however wide the terminal
+
+
+@pytest.mark.parametrize("columns", [60, 100, 300])
+def test_list_one_generator_wraps_to_the_terminal(columns):
+    for spec in all_specs():
+        r = list_output(spec.name, columns=columns)
+        assert r.returncode == 0, r.stderr
+        assert max(map(len, r.stdout.splitlines())) <= min(columns, 100), spec.name
+        assert set(parameter_blocks(r.stdout)) == {p.name for p in spec.all_params}
+        for ex in spec.examples:  # wrapped, never cut
+            assert ex in " ".join(line.strip() for line in r.stdout.splitlines())
+
+
+def test_list_some_parameters_of_one_generator_and_its_json():
+    r = run("list", "door", "state", "robot_radius")
+    assert r.returncode == 0, r.stderr
+    assert set(parameter_blocks(r.stdout)) == {"state", "robot_radius"} and "Examples:" not in r.stdout
+    r = run("list", "door", "--json")
+    assert [g["name"] for g in json.loads(r.stdout)["generators"]] == ["door"]
+
+
+@pytest.mark.parametrize("args, line", [
+    (["list", "clutterd"],
+     "error: unknown generator 'clutterd' (did you mean 'cluttered'?); available: cluttered, corridor, door, minimal"),
+    (["generate", "coridor", "--out", "x"],
+     "error: unknown generator 'coridor' (did you mean 'corridor'?); available: cluttered, corridor, door, minimal"),
+    (["list", "cluttered", "n_obstacle"],
+     "error: unknown parameter 'n_obstacle' for generator 'cluttered' (did you mean 'n_obstacles'?); known parameters: "
+     "box_size, clearance, "),
+    (["generate", "cluttered", "--set", "n_obstacle=3", "--out", "x"],
+     "error: unknown parameter 'n_obstacle' for generator 'cluttered' (did you mean 'n_obstacles'?); known parameters: "
+     "box_size, clearance, "),
+    (["generate", "door", "--set", "door_widht=1", "--out", "x"],
+     "error: unknown parameter 'door_widht' for generator 'door' (did you mean 'door_width'?); known parameters: "),
+])
+def test_an_unknown_name_is_one_line_with_did_you_mean(args, line, tmp_path):
+    r = run(*args, cwd=tmp_path)
+    assert r.returncode == 2 and r.stdout == ""
+    [got] = r.stderr.splitlines()
+    assert got.startswith(line), got
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+# -- make demo ---------------------------------------------------------------------
+
+def test_make_demo_ends_with_what_to_try_next_and_each_suggestion_works(tmp_path):
+    if shutil.which("make") is None:
+        pytest.skip("make is not installed here")
+    root = Path(__file__).resolve().parents[1]
+    venv = Path(sys.executable).parent.parent
+    # The installed venv as it is (-o: never reinstall it), worlds into tmp.
+    r = subprocess.run(["make", "-s", "-C", str(root), "-o", str(venv / ".installed"), "demo", f"VENV={venv}",
+                        f"DEMO_OUT={tmp_path / 'demo'}"], capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    tips = [line.split("#")[0].split() for line in lines[lines.index("Try next:") + 1:]]
+    assert len(tips) == 4
+    viewer, listing, example, pack = tips
+    assert viewer[:3] == [str(venv / "bin/python"), "-m", "mujoco.viewer"]
+    mjcf = Path(viewer[3].split("=", 1)[1])
+    assert mjcf.is_file() and mjcf.parent.name.startswith("cluttered-s0-")  # the world just written
+    assert listing[1:] == ["list", "cluttered"]
+    shown = subprocess.run(listing, capture_output=True, text=True, timeout=120)
+    assert shown.returncode == 0 and shown.stdout.startswith("cluttered: "), shown.stderr
+    assert (root / example[1]).is_file()
+    assert pack[1:4] == ["pack", "build", "examples/recipes/ci_smoke.yaml"] and (root / pack[3]).is_file()

@@ -13,14 +13,16 @@ from __future__ import annotations
 import errno
 import json
 import os
+import shutil
 import sys
+import textwrap
 from pathlib import Path
 from typing import Any, Optional, Sequence
 
 import click
 
 import worldgen
-from worldgen.errors import EXIT_USAGE, InfeasibleError, OutputError, ParameterError, WorldgenError
+from worldgen.errors import EXIT_USAGE, InfeasibleError, OutputError, ParameterError, WorldgenError, did_you_mean
 from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.export.ros2 import DEFAULT_GZ_RELEASE, GZ_RELEASES
 from worldgen.generators import all_specs, get
@@ -40,7 +42,8 @@ def _examples() -> str:
     return "\b\nExamples:\n" + "\n".join(f"  {ex}" for ex in lines) if lines else ""
 
 
-@click.group(context_settings=_CONTEXT, epilog="Run 'worldgen list' for every generator and its parameters.")
+@click.group(context_settings=_CONTEXT,
+             epilog="Run 'worldgen list' for the generators, 'worldgen list GENERATOR' for its parameters.")
 @click.version_option(worldgen.__version__, "--version", prog_name="worldgen", message="%(prog)s %(version)s")
 def cli() -> None:
     """Seeded, feasibility-checked test worlds for robot simulation.
@@ -51,13 +54,23 @@ def cli() -> None:
 
 
 @cli.command("list", context_settings=_CONTEXT)
-@click.option("--json", "as_json", is_flag=True, help="Print the same as JSON (stable key order).")
+@click.argument("name", required=False, metavar="[GENERATOR]")
+@click.argument("param_names", nargs=-1, metavar="[PARAMETER]...")
+@click.option("--json", "as_json", is_flag=True, help="Print every generator (or GENERATOR) in full as JSON (stable key order).")
 @click.option("--markdown", "as_markdown", is_flag=True,
-              help="Print Markdown tables: each generator's own parameters, then the common ones "
+              help="Print Markdown tables: each generator's (or GENERATOR's) own parameters, then the common ones "
                    "(the reference in docs/generators.md is this output).")
-def list_command(as_json: bool, as_markdown: bool) -> None:
-    """List generators and every parameter: kind, default, allowed range, unit."""
-    specs = all_specs()
+def list_command(name: Optional[str], param_names: Sequence[str], as_json: bool, as_markdown: bool) -> None:
+    """The generators, one line each; with GENERATOR, its parameters: kind, default, allowed range, unit.
+
+    \b
+    worldgen list                          every generator, one line each
+    worldgen list cluttered                every parameter of cluttered
+    worldgen list cluttered size density   just those
+    """
+    specs = [get(name)] if name is not None else all_specs()
+    if param_names and name is not None:
+        _check_param_names(specs[0], param_names)
     if as_markdown:
         click.echo(parameter_tables(specs), nl=False)
         return
@@ -66,24 +79,57 @@ def list_command(as_json: bool, as_markdown: bool) -> None:
             "worldgen_version": worldgen.__version__,
             "generators": [
                 {"name": s.name, "summary": s.summary, "examples": list(s.examples),
-                 "params": [describe_param(p) for p in s.all_params]}
+                 "params": [describe_param(p) for p in s.all_params if not param_names or p.name in param_names]}
                 for s in specs
             ],
         }
         click.echo(json.dumps(doc, indent=2, sort_keys=True))
         return
-    for i, spec in enumerate(specs):
-        if i:
-            click.echo("")
-        click.echo(f"{spec.name}: {spec.summary}")
-        rows = [("parameter", "kind", "default", "allowed", "unit", "meaning")]
-        rows += [(d["name"], d["kind"], d["default_text"], d["allowed"], d["unit"] or "-", d["doc"])
-                 for d in (describe_param(p) for p in spec.all_params)]
-        widths = [max(len(r[c]) for r in rows) for c in range(5)]
-        for row in rows:
-            click.echo("  " + "  ".join(cell.ljust(w) for cell, w in zip(row, widths)) + "  " + row[5])
-        for ex in spec.examples:
-            click.echo(f"  e.g. {ex}")
+    width = max(40, min(100, shutil.get_terminal_size((100, 24)).columns))
+    if name is None:
+        column = max(len(s.name) for s in specs) + 2
+        for spec in specs:  # one line each; 'worldgen list GENERATOR' has the whole summary
+            click.echo(spec.name.ljust(column) + textwrap.shorten(spec.summary, width - column, placeholder=" ..."))
+        click.echo("\n" + textwrap.fill("'worldgen list GENERATOR' shows its parameters; --markdown and --json "
+                                         "print every generator in full.", width))
+        return
+    click.echo("\n".join(_parameter_text(specs[0], param_names, width)))
+
+
+def _check_param_names(spec, names: Sequence[str]) -> None:
+    known = sorted(p.name for p in spec.all_params)
+    for n in names:
+        if n not in known:
+            raise ParameterError(f"unknown parameter '{n}' for generator '{spec.name}'{did_you_mean(n, known)}; "
+                                 f"known parameters: {', '.join(known)}")
+
+
+def _parameter_text(spec, names: Sequence[str], width: int) -> list[str]:
+    """A generator's parameters for a terminal of ``width`` columns: its own, then those every
+    generator takes; each as its name and meaning, then kind, default and allowed values."""
+    from worldgen.params import COMMON_PARAMS
+
+    common = {p.name for p in COMMON_PARAMS}
+    chosen = [p for p in spec.all_params if not names or p.name in names]
+    column = max(len(p.name) for p in chosen) + 4
+    indent = " " * column
+    lines = textwrap.wrap(f"{spec.name}: {spec.summary}", width)
+    for title, group in ((f"Parameters of {spec.name} (--set NAME=VALUE):", [p for p in chosen if p.name not in common]),
+                         ("Parameters every generator takes:", [p for p in chosen if p.name in common])):
+        if not group:
+            continue
+        lines += ["", title]
+        for d in (describe_param(p) for p in sorted(group, key=lambda p: p.name)):
+            unit = f" ({d['unit']})" if d["unit"] else ""
+            lines += textwrap.wrap(d["doc"], width, initial_indent=f"  {d['name']}".ljust(column),
+                                   subsequent_indent=indent, break_on_hyphens=False)
+            lines += textwrap.wrap(f"{d['kind']}{unit}; default {d['default_text']}; {d['allowed']}", width,
+                                   initial_indent=indent, subsequent_indent=indent, break_on_hyphens=False)
+    if not names and spec.examples:
+        lines += ["", "Examples:"]
+        for ex in spec.examples:  # a long command goes on over indented lines, never cut
+            lines += textwrap.wrap(ex, width, initial_indent="  ", subsequent_indent="      ", break_on_hyphens=False)
+    return lines
 
 
 def parameter_tables(specs) -> str:
@@ -255,7 +301,7 @@ def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: 
         if key not in by_name:
             hint = " (the seed is set with --seed)" if key == "seed" else ""
             raise ParameterError(
-                f"unknown parameter '{key}' for generator '{generator}'{hint}; "
+                f"unknown parameter '{key}' for generator '{generator}'{hint or did_you_mean(key, by_name)}; "
                 f"known parameters: {', '.join(sorted(by_name))}"
             )
         out[key] = parse_value(by_name[key], text)

@@ -16,6 +16,7 @@ __all__ = [
     "OutputError",
     "MissingDependencyError",
     "quoted",
+    "did_you_mean",
     "read_user_text",
     "QUOTE_LIMIT",
 ]
@@ -80,6 +81,17 @@ def quoted(value, limit: int = QUOTE_LIMIT) -> str:
     if len(text) <= limit:
         return text
     return f"{text[:limit - 3]}... ({len(text)} characters)"
+
+
+def did_you_mean(name, allowed) -> str:
+    """`` (did you mean 'x'?)`` when ``name`` is a likely typo of one of ``allowed`` (difflib), else ``""``.
+
+    Goes right after the unknown name in a message, before the list of what is allowed.
+    """
+    from difflib import get_close_matches
+
+    close = get_close_matches(str(name), [str(a) for a in allowed], n=1)
+    return f" (did you mean '{close[0]}'?)" if close else ""
 
 
 def read_user_text(path, what: str) -> str:

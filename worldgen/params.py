@@ -11,7 +11,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, Mapping, Optional, Sequence
 
-from worldgen.errors import ParameterError, quoted
+from worldgen.errors import ParameterError, did_you_mean, quoted
 from worldgen.floats import round_float
 
 __all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "describe_range"]
@@ -144,7 +144,8 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
     unknown = sorted(set(given) - set(by_name))
     if unknown:
         raise ParameterError(
-            f"unknown parameter '{unknown[0]}'; known parameters: {', '.join(sorted(by_name))}"
+            f"unknown parameter '{unknown[0]}'{did_you_mean(unknown[0], by_name)}; "
+            f"known parameters: {', '.join(sorted(by_name))}"
         )
     resolved = {}
     for name in sorted(by_name):

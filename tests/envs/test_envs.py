@@ -300,7 +300,7 @@ def test_a_pack_is_a_fixed_benchmark_set_in_order(tmp_path):
     ({"lidar_noise": -0.1}, "parameter 'lidar_noise' must be in [0, 10], got -0.1"),
     ({"lidar_range_min": 5.0, "lidar_range_max": 2.0}, "parameter 'lidar_range_min' must be below lidar_range_max = 2.0, got 5.0"),
     ({"reward_fn": 3}, "parameter 'reward_fn' must be a callable (StepOutcome -> float) or None, got 3"),
-    ({"lidar_beam": 10}, "unknown parameter 'lidar_beam'; known parameters:"),
+    ({"lidar_beam": 10}, "unknown parameter 'lidar_beam' (did you mean 'lidar_beams'?); known parameters:"),
     ({"generator": "cluttered", "params": {"n_obstacles": -1}}, "parameter 'n_obstacles' must be in [0, 5000], got -1"),
     ({"generator": "cluttered", "preset": "drl_arena"}, "parameters 'generator' and 'preset' exclude each other"),
     ({"preset": "no_such_preset"}, "unknown preset 'no_such_preset'; available:"),

@@ -3,10 +3,23 @@
 import subprocess
 import sys
 
+from support.cli import run
+
 # In a subprocess each: in-process runs restore sys.modules afterwards, and numpy cannot be imported twice.
 pytest_plugins = ["pytester"]
 
 QUICK = "size=[6, 6], n_obstacles=3"
+TINY = "name: tiny\nseeds: 2\nworlds:\n  - generator: cluttered\n    params:\n      size: [6, 6]\n      n_obstacles: 3\n"
+
+
+def build_tiny(out):
+    """A two-world pack, built by the command (in-process, the generators would be imported inside
+    a pytester test, whose end unloads them while the registry keeps their specs)."""
+    recipe = out.parent / "tiny.yaml"
+    out.parent.mkdir(parents=True, exist_ok=True)
+    recipe.write_text(TINY)
+    done = run("pack", "build", recipe, "--out", out)
+    assert done.returncode == 0, done.stderr
 
 
 def test_registered_through_the_entry_point_and_light():
@@ -63,24 +76,116 @@ def test_factory_fixture_writes_into_tmp(pytester):
     pytester.runpytest_subprocess().assert_outcomes(passed=1)
 
 
-def test_marker_mistakes_are_usage_errors(pytester):
-    pytester.makepyfile("""
+def error_sections(result) -> dict[str, list[str]]:
+    """The lines of each ``ERROR at setup of TEST`` section of a pytest report, by TEST."""
+    sections: dict[str, list[str]] = {}
+    current = None
+    for line in result.stdout.lines:
+        if line.startswith("_") and " ERROR at setup of " in line:
+            current = line.split(" ERROR at setup of ", 1)[1].strip(" _")
+            sections[current] = []
+        elif line.startswith("=") or (line.startswith("_") and line.endswith("_")):
+            current = None
+        elif current is not None and line.strip():
+            sections[current].append(line)
+    return sections
+
+
+def test_a_mistake_in_a_marker_fails_that_test_with_one_line_and_the_run_goes_on(pytester):
+    pytester.makepyfile(f"""
         import pytest
 
+        @pytest.mark.worldgen("cluttered", seeds=range(2), size=[6, 6], n_obstacle=3)
+        def test_typo_in_a_parameter(world):
+            pass
+
+        @pytest.mark.worldgen("clutterd", seeds=range(2))
+        def test_typo_in_the_generator(world):
+            pass
+
+        @pytest.mark.worldgen("cluttered", seed=4, {QUICK})
+        def test_seed_for_seeds(world):
+            pass
+
+        @pytest.mark.worldgen("cluttered", seeds=range(2), size=[6, 6], n_obstacles=-3)
+        def test_value_out_of_range(world):
+            pass
+
         @pytest.mark.worldgen(seeds=range(2))
-        def test_nav(world):
+        def test_no_generator(world):
+            pass
+
+        @pytest.mark.worldgen("cluttered", seeds=[0], {QUICK})
+        def test_fine(world):
             pass
     """)
     result = pytester.runpytest_subprocess()
-    assert result.ret != 0
-    result.stdout.fnmatch_lines(["*UsageError: @pytest.mark.worldgen takes one generator name*"])
+    result.assert_outcomes(passed=1, errors=5)  # one per marked test, not one per seed
+    sections = error_sections(result)
+    assert sorted(sections) == sorted(f"{t}[marker-error]" for t in (
+        "test_typo_in_a_parameter", "test_typo_in_the_generator", "test_seed_for_seeds", "test_value_out_of_range",
+        "test_no_generator"))
+    assert all(len(lines) == 1 for lines in sections.values()), sections  # no traceback
+    one = {name.split("[")[0]: lines[0] for name, lines in sections.items()}
+    assert "unknown argument 'n_obstacle' (did you mean 'n_obstacles'?); allowed: seeds, allow_infeasible, pack, " \
+           "or a parameter of 'cluttered': box_size" in one["test_typo_in_a_parameter"]
+    assert "unknown generator 'clutterd' (did you mean 'cluttered'?); available: cluttered, corridor" \
+           in one["test_typo_in_the_generator"]
+    assert "unknown argument 'seed' (did you mean 'seeds'?)" in one["test_seed_for_seeds"]
+    assert "parameter 'n_obstacles' must be" in one["test_value_out_of_range"]
+    assert "takes one generator name or pack=PATH" in one["test_no_generator"]
+    assert all(line.startswith("@pytest.mark.worldgen(") for line in one.values())
+
+
+def test_a_relative_pack_path_is_read_from_the_test_files_folder(pytester):
+    suite = pytester.mkdir("suite")
+    build_tiny(suite / "packs" / "tiny")
+    (suite / "test_over_pack.py").write_text(
+        "import pytest\n\n"
+        "@pytest.mark.worldgen(pack='packs/tiny')\n"
+        "def test_pack(world):\n"
+        "    assert world.metadata['world_id'] == world.world_id\n")
+    # Started from the folder above the suite and from a folder beside it: the same two worlds.
+    pytester.runpytest_subprocess("suite").assert_outcomes(passed=2)
+    elsewhere = pytester.mkdir("elsewhere")
+    result = pytester.run(sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "--rootdir", str(elsewhere),
+                          str(suite / "test_over_pack.py"))
+    result.assert_outcomes(passed=2)
+
+
+def test_a_missing_or_unfinished_pack_is_said_plainly(pytester):
+    pytester.mkdir("not_a_pack")
+    (pytester.mkdir("stopped") / ".build").mkdir()  # a build stopped before its manifest
+    pytester.makepyfile("""
+        import pytest
+
+        @pytest.mark.worldgen(pack="packs/nowhere")
+        def test_missing(world):
+            pass
+
+        @pytest.mark.worldgen(pack="not_a_pack")
+        def test_not_a_pack(world):
+            pass
+
+        @pytest.mark.worldgen(pack="stopped")
+        def test_unfinished(world):
+            pass
+    """)
+    result = pytester.runpytest_subprocess()
+    result.assert_outcomes(errors=3)
+    one = {name.split("[")[0]: lines for name, lines in error_sections(result).items()}
+    assert all(len(lines) == 1 for lines in one.values()), one
+    here = pytester.path
+    assert one["test_missing"][0].endswith(f"no pack at '{here / 'packs/nowhere'}' "
+                                           "(a relative pack path is read from the test file's folder)")
+    assert one["test_not_a_pack"][0].endswith(f"'{here / 'not_a_pack'}' is not a pack: it has no manifest.json "
+                                              f"(build one with 'worldgen pack build RECIPE --out {here / 'not_a_pack'}')")
+    assert f"'{here / 'stopped'}' is a pack whose build has not finished" in one["test_unfinished"][0]
+    assert not any("has not finished" in line for line in one["test_missing"] + one["test_not_a_pack"])
 
 
 def test_pack_parametrisation(pytester, tmp_path):
-    from worldgen.pack import build_pack, parse_recipe
-
-    recipe = "name: tiny\nseeds: 2\nworlds:\n  - generator: cluttered\n    params:\n      size: [6, 6]\n      n_obstacles: 3\n"
-    build_pack(parse_recipe(recipe, "tiny.yaml", "tiny"), tmp_path / "pack", jobs=1)
+    build_tiny(tmp_path / "pack")
     pytester.makepyfile(f"""
         import pytest
 

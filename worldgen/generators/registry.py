@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from importlib.metadata import entry_points
 
-from worldgen.errors import UnknownGeneratorError, WorldgenError
+from worldgen.errors import UnknownGeneratorError, WorldgenError, did_you_mean
 from worldgen.generators.base import GeneratorSpec
 
 __all__ = ["ENTRY_POINT_GROUP", "register", "get", "names", "all_specs"]
@@ -72,5 +72,5 @@ def get(name: str) -> GeneratorSpec:
         return _REGISTRY[name]
     except KeyError:
         raise UnknownGeneratorError(
-            f"unknown generator '{name}'; available: {', '.join(names())}"
+            f"unknown generator '{name}'{did_you_mean(name, names())}; available: {', '.join(names())}"
         ) from None

@@ -33,14 +33,19 @@ def pack_group() -> None:
 def build_command(recipe: Path, out: Path, jobs: int, executor: str, scheduler: Optional[str]) -> None:
     """Build every world of RECIPE into PACK; rerun the same command to finish a killed build.
 
-    A progress line (count, rate, ETA) is drawn on stderr when it is a terminal.
+    A progress line (count, rate, ETA) is drawn on stderr when it is a terminal. Ctrl-C stops
+    within about a second, keeping every finished world; the rerun builds the rest.
     """
-    from worldgen.pack.build import build_pack
+    from worldgen.pack.build import BuildInterrupted, build_pack
     from worldgen.pack.recipe import load_recipe
 
     parsed = load_recipe(recipe)
     stream = sys.stderr if sys.stderr.isatty() else None
-    summary = build_pack(parsed, out, jobs=jobs, progress=stream, executor=executor, scheduler=scheduler)
+    try:
+        summary = build_pack(parsed, out, jobs=jobs, progress=stream, executor=executor, scheduler=scheduler)
+    except BuildInterrupted as exc:  # Ctrl-C: one line saying what is kept, status 130 (docs/cli.md)
+        click.echo(f"error: {exc.line()}", err=True)
+        raise click.exceptions.Exit(130) from None
     for line in summary.lines():
         click.echo(line)
     click.echo(f"pack: {out}")

@@ -37,7 +37,7 @@ from typing import Any, Optional
 
 import yaml
 
-from worldgen.errors import InfeasibleError, ParameterError, WorldgenError, quoted, read_user_text
+from worldgen.errors import InfeasibleError, ParameterError, WorldgenError, did_you_mean, quoted, read_user_text
 from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.floats import round_float
 from worldgen.seeding import MAX_SEED, recipe_rng
@@ -189,7 +189,7 @@ class _Reader:
             if not isinstance(key, str):
                 raise RecipeError(f"{self.source}:{k.start_mark.line + 1}: key {quoted(key)} in {what} is not a name")
             if allowed is not None and key not in allowed:
-                self.fail(k, key, f"unknown key in {what}; allowed: {', '.join(allowed)}")
+                self.fail(k, key, f"unknown key in {what}{did_you_mean(key, allowed)}; allowed: {', '.join(allowed)}")
             if key in out:
                 self.fail(k, key, f"given twice in {what}")
             out[key] = v
@@ -245,7 +245,8 @@ class _Reader:
             allowed = PHYSICS_PARAMS if group == "physics" else None
             for key, vnode in self.mapping(m[group], f"{where}.{group}", allowed).items():
                 if key not in kinds:
-                    self.fail(vnode, key, f"unknown parameter of generator '{spec.name}'; known: {', '.join(sorted(kinds))}")
+                    self.fail(vnode, key, f"unknown parameter of generator '{spec.name}'{did_you_mean(key, kinds)}; "
+                                          f"known: {', '.join(sorted(kinds))}")
                 if key == "seed":
                     self.fail(vnode, key, "the seed is set with 'seeds'")
                 if key in lines:
