@@ -17,7 +17,7 @@ from typing import Mapping
 from worldgen.errors import OutputError
 
 __all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "MAP_YAML_NAME", "MANIFEST_NAME",
-           "INDEX_NAME", "WORLDS_DIR", "creation_mode", "safe_relative", "write_atomically",
+           "INDEX_NAME", "WORLDS_DIR", "BUILD_STATE_DIR", "creation_mode", "safe_relative", "write_atomically",
            "write_folder_atomically", "refuse_other_world", "recorded_content_hash"]
 
 #: A world folder: its ground truth, scenario, picture and nav2 map (the formats' files are named in
@@ -31,6 +31,8 @@ MAP_YAML_NAME = "map.yaml"
 MANIFEST_NAME = "manifest.json"
 INDEX_NAME = "index.csv"
 WORLDS_DIR = "worlds"
+#: A pack build's records of finished jobs, kept until the manifest is written (a resume reads them).
+BUILD_STATE_DIR = ".build"
 
 
 def creation_mode(full: int) -> int:

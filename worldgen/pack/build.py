@@ -31,14 +31,12 @@ from pathlib import Path
 from typing import Iterator, Optional, TextIO
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError
-from worldgen.files import INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, write_atomically
+from worldgen.files import BUILD_STATE_DIR, INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, write_atomically
 from worldgen.pack.manifest import build_manifest, index_bytes, manifest_bytes, world_folder
 from worldgen.pack.recipe import Recipe
 from worldgen.pack.render import build_job, init_worker, save_job
 
-__all__ = ["build_pack", "BuildSummary", "BuildInterrupted", "STATE_DIR", "GRACE_SECONDS"]
-
-STATE_DIR = ".build"
+__all__ = ["build_pack", "BuildSummary", "BuildInterrupted", "GRACE_SECONDS"]
 MAX_JOBS = 256
 #: After Ctrl-C, how long the jobs already running may take to finish before their workers are stopped.
 GRACE_SECONDS = 1.0
@@ -137,7 +135,7 @@ class _Run:
 
     def __init__(self, recipe: Recipe, out: Path, progress: Optional[TextIO]):
         self.recipe, self.out = recipe, out
-        self.state, self.worlds_dir = out / STATE_DIR, out / WORLDS_DIR
+        self.state, self.worlds_dir = out / BUILD_STATE_DIR, out / WORLDS_DIR
         try:
             self.state.mkdir(parents=True, exist_ok=True)
             self.worlds_dir.mkdir(exist_ok=True)
@@ -275,7 +273,7 @@ def _remove_stale(out: Path, folders: set[str], keys: set[str]) -> int:
     stale = [p for p in (out / WORLDS_DIR).iterdir() if not p.name.startswith(".") and p.name not in folders]
     for p in stale:
         shutil.rmtree(p) if p.is_dir() and not p.is_symlink() else p.unlink()
-    for p in (out / STATE_DIR).glob("*.json"):
+    for p in (out / BUILD_STATE_DIR).glob("*.json"):
         if p.stem not in keys:
             p.unlink()
     return len(stale)

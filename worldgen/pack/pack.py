@@ -17,9 +17,8 @@ from pathlib import Path, PurePosixPath
 from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from worldgen.errors import ParameterError
-from worldgen.files import MANIFEST_NAME, METADATA_NAME
+from worldgen.files import BUILD_STATE_DIR, MANIFEST_NAME, METADATA_NAME
 from worldgen.pack.archive import ArchiveReader, is_archive
-from worldgen.pack.build import STATE_DIR
 from worldgen.pack.manifest import METRICS, SCHEMA_ID, world_folder
 from worldgen.pack.where import parse_where
 
@@ -61,7 +60,7 @@ def open_source(path):
     if not path.is_dir():
         raise ParameterError(f"'{path}' is not a pack: a pack is a folder or a .tar.gz archive")
     if not (path / MANIFEST_NAME).is_file():
-        if (path / STATE_DIR).is_dir():  # a build's records, no manifest: it was stopped before the end
+        if (path / BUILD_STATE_DIR).is_dir():  # a build's records, no manifest: it was stopped before the end
             raise ParameterError(f"'{path}' is a pack whose build has not finished (no {MANIFEST_NAME} yet); "
                                  "rerun its 'worldgen pack build' command to finish it")
         raise ParameterError(f"'{path}' is not a pack: it has no {MANIFEST_NAME} "
