@@ -386,3 +386,10 @@ def test_pack_folders_of_preset_entries(tmp_path):
     assert [line.split(",")[4] for line in index[1:]] == folders
     verified = run("pack", "verify", tmp_path / "pack")
     assert verified.returncode == 0, verified.stdout + verified.stderr
+
+
+def test_a_mistyped_preset_name_gets_a_suggestion():
+    from worldgen.presets import load
+
+    with pytest.raises(ParameterError, match=r"^unknown preset 'empty_rom' \(did you mean 'empty_room'\?\); available: "):
+        load("empty_rom")

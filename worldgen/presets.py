@@ -23,7 +23,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, Mapping, Optional
 
-from worldgen.errors import ParameterError, WorldgenError, quoted, read_user_text
+from worldgen.errors import ParameterError, WorldgenError, did_you_mean, quoted, read_user_text
 
 __all__ = ["Preset", "PRESET_KEYS", "names", "all_presets", "load", "generate_preset"]
 
@@ -73,7 +73,8 @@ def load(name_or_path: str) -> Preset:
         return _parse(read_user_text(path, "preset file"), str(path), path.stem)
     available = names()
     if text_name not in available:
-        raise ParameterError(f"unknown preset '{text_name}'; available: {', '.join(available)}")
+        raise ParameterError(f"unknown preset '{text_name}'{did_you_mean(text_name, available)}; "
+                             f"available: {', '.join(available)}")
     entry = _shipped().joinpath(f"{text_name}.yaml")
     return _parse(entry.read_text(encoding="utf-8"), f"templates/{_FOLDER}/{text_name}.yaml", text_name)
 
