@@ -223,6 +223,11 @@ from worldgen.pack.commands import pack_group  # noqa: E402
 
 cli.add_command(pack_group)
 
+# `worldgen judge` lives in worldgen/testing/commands.py; only wired in here.
+from worldgen.testing.commands import judge_command  # noqa: E402
+
+cli.add_command(judge_command)
+
 
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
     """``["key=value", ...]`` -> ``{key: value}``, each value parsed for its parameter's kind.

@@ -45,7 +45,7 @@ import numpy as np
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.testing.rosdeps import require_rosbags
 
-__all__ = ["BagRun", "read_run", "bag_metadata", "START_RULES", "GOAL_TOPICS", "MOTION_START"]
+__all__ = ["BagRun", "read_run", "bag_metadata", "peek_metadata", "START_RULES", "GOAL_TOPICS", "MOTION_START"]
 
 START_RULES = ("command", "goal", "motion", "bag")
 #: Where a goal shows: RViz's and nav2's goal topic, and the navigate_to_pose action's topics as recorded.
@@ -115,6 +115,22 @@ def bag_metadata(reader) -> dict[str, Any]:
             out["custom"].update(getattr(meta, "custom", None) or {})
             out["ros_distro"] = out["ros_distro"] or getattr(meta, "ros_distro", None)
     return out
+
+
+def peek_metadata(bag) -> dict[str, str]:
+    """The bag's ``worldgen.*`` custom data (world_id, task, run) without reading its messages."""
+    require_rosbags()
+    from rosbags.highlevel import AnyReader
+
+    path = Path(bag)
+    if not path.exists():
+        raise _fail(path, "does not exist")
+    try:
+        with AnyReader([path], default_typestore=_typestore(None)) as reader:
+            custom = bag_metadata(reader)["custom"]
+    except Exception as exc:  # a truncated or foreign file
+        raise _fail(path, f"cannot be read as a ROS bag ({type(exc).__name__}: {(str(exc).splitlines() or [''])[0][:160]})") from None
+    return {str(k): str(v) for k, v in custom.items() if str(k).startswith("worldgen.")}
 
 
 def _interp(series: np.ndarray, t: np.ndarray) -> np.ndarray:
