@@ -26,7 +26,8 @@ Examples:
 @click.argument("bags", nargs=-1, type=click.Path(path_type=Path), metavar="[BAG]...")
 @click.option("--world", type=click.Path(path_type=Path), metavar="DIR", help="The world folder every BAG ran in.")
 @click.option("--pack", type=click.Path(path_type=Path), metavar="DIR",
-              help="A built pack: worlds by the id a --runs row or a bag's metadata (worldgen.world_id) names.")
+              help="A built pack, or a folder of world folders: worlds by the id a --runs row or a bag's "
+                   "metadata (worldgen.world_id) names.")
 @click.option("--runs", "runs_table", type=click.Path(path_type=Path), metavar="TABLE",
               help="CSV with columns bag, world (id in --pack, or a world folder), optional task, run.")
 @click.option("--criteria", type=click.Path(path_type=Path), metavar="FILE", help="Acceptance criteria (YAML, docs/testing.md).")

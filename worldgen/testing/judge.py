@@ -96,22 +96,46 @@ def plan(bags: Sequence, *, world=None, pack=None, runs=None) -> list[Item]:
     return [Item(Path(b), folder, None, None) for b in bags]
 
 
-def _pack_world(pack, world_id: str) -> Path:
-    from worldgen.pack import Pack
+def _index(pack) -> dict[str, Path]:
+    """world id -> world folder of a built pack, or of a folder of world folders (``worldgen generate --out``)."""
+    import json
 
-    opened = Pack.open(pack)
-    try:
-        if world_id not in opened:
-            raise ParameterError(f"world {world_id!r} is not in pack '{pack}'")
-        path = opened[world_id].path
-    finally:
-        opened.close()
-    if path is None:
-        raise ParameterError(f"pack '{pack}' is an archive: extract it first (worldgen judge reads world folders)")
-    return Path(path)
+    root = Path(pack)
+    if not root.is_dir() and not root.is_file():
+        raise ParameterError(f"--pack '{root}' does not exist")
+    if (root / "manifest.json").is_file() or root.is_file():
+        from worldgen.pack import Pack
+
+        opened = Pack.open(root)
+        try:
+            if opened.archive:
+                raise ParameterError(f"pack '{root}' is an archive: extract it first (worldgen judge reads world folders)")
+            return {w.world_id: Path(w.path) for w in opened if w.path is not None}
+        finally:
+            opened.close()
+    found = {}
+    for meta in sorted(root.glob("*/world.json")):
+        try:
+            found[str(json.loads(meta.read_text())["world_id"])] = meta.parent
+        except (OSError, ValueError, KeyError, TypeError):
+            continue  # not a world folder: the lookup reports the id as missing
+    if not found:
+        raise ParameterError(f"--pack '{root}' is neither a pack (no manifest.json) nor a folder of world folders")
+    return found
+
+
+def _pack_world(pack, world_id: str, cache: Optional[dict] = None) -> Path:
+    cache = {} if cache is None else cache
+    key = str(pack)
+    if key not in cache:
+        cache[key] = _index(pack)
+    if world_id not in cache[key]:
+        raise ParameterError(f"world {world_id!r} is not in '{pack}'")
+    return cache[key][world_id]
 
 
 def _table(table: Path, pack) -> list[Item]:
+    packs: dict[str, dict[str, Path]] = {}
     text = read_user_text(table, "runs table")
     rows = list(csv.DictReader(text.splitlines()))
     if not rows or "bag" not in rows[0] or "world" not in rows[0]:
@@ -126,7 +150,7 @@ def _table(table: Path, pack) -> list[Item]:
         if (candidate / "world.json").is_file():
             folder = candidate
         elif pack is not None:
-            folder = _pack_world(pack, world)
+            folder = _pack_world(pack, world, packs)
         else:
             raise ParameterError(f"runs table '{table}' line {i}: world {world!r} is no world folder; "
                                  "give --pack DIR to look world ids up in a pack")
@@ -165,6 +189,7 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     extra: list[dict] = []        # per bag: the judge's columns (readable ones also get evaluate's)
     plots: list[Optional[dict]] = []
     names: set[str] = set()
+    packs: dict[str, dict[str, Path]] = {}
 
     def ground(folder: Path) -> _WorldGround:
         key = folder.resolve()
@@ -193,7 +218,7 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
                     if not wid:
                         raise ParameterError(f"bag '{item.bag}': names no world in its metadata (worldgen.world_id); "
                                              "give --world DIR or --runs TABLE")
-                    folder = _pack_world(pack, wid)
+                    folder = _pack_world(pack, wid, packs)
                 g = ground(folder)
                 got = read_run(item.bag, g, task=item.task, start=start, **options)
                 named = got.metadata.get("worldgen.world_id")
