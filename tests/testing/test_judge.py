@@ -164,3 +164,32 @@ def test_decimated_picture_keeps_the_ends():
     traj = np.column_stack([t, np.cos(t / 10), np.sin(t / 10), t * 0])
     d = _decimate(traj, 100)
     assert len(d) <= 102 and (d[0] == traj[0, :3]).all() and (d[-1] == traj[-1, :3]).all()
+
+
+def test_the_mujoco_example_loop_is_judged_end_to_end(tmp_path):
+    """examples/diffdrive_mujoco.py records real bags; `worldgen judge` on them gives the example's own report,
+    and the official mcap reader decodes them."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[2] / "examples" / "diffdrive_mujoco.py"
+    ex = subprocess.run([sys.executable, str(script), str(tmp_path / "ex"), "3"], capture_output=True, text=True,
+                        timeout=300)
+    assert ex.returncode == 0, ex.stdout + ex.stderr
+    bags = sorted((tmp_path / "ex" / "bags").iterdir())
+    (tmp_path / "c.yaml").write_text(CRITERIA)
+    r = run("judge", *bags, "--pack", tmp_path / "ex" / "worlds", "--criteria", tmp_path / "c.yaml", "--out", tmp_path / "r")
+    assert r.returncode == 0, r.stdout + r.stderr
+    mine, theirs = _report(tmp_path / "r"), _report(tmp_path / "ex" / "report")
+    drop = {"bag", "world_folder", "picture"}
+    assert [{k: v for k, v in row.items() if k not in drop} for row in mine["runs"]] == \
+           [{k: v for k, v in row.items() if k not in drop} for row in theirs["runs"]]
+    assert all(row["success"] and row["source"] == "tf" and row["start"] == "command" for row in mine["runs"])
+    mcap_reader = pytest.importorskip("mcap.reader")
+    decoder = pytest.importorskip("mcap_ros2.decoder")
+    with next(bags[0].glob("*.mcap")).open("rb") as f:
+        reader = mcap_reader.make_reader(f, decoder_factories=[decoder.DecoderFactory()])
+        odom = [m for _, ch, _, m in reader.iter_decoded_messages(topics=["/odom"])]
+    assert odom[0].pose.pose.position.x == 0.0 and odom[0].pose.pose.position.y == 0.0  # zeroed at the spawn
+    assert odom[0].header.frame_id == "odom" and odom[0].child_frame_id == "base_footprint"

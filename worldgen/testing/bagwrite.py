@@ -28,6 +28,7 @@ version 6 and later; ``worldgen.world_id``, ``worldgen.task``, ``worldgen.run``)
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import Callable, Optional, Sequence
@@ -51,6 +52,14 @@ DEFAULT_TOPICS = ("clock", "odom", "tf", "cmd_vel")
 #: What a message takes from its stamp to the recorder.
 RECEIVE_LATENCY_NS = 2_000_000
 _ALL_TOPICS = ("clock", "odom", "tf", "cmd_vel", "scan", "ground_truth")
+
+
+@functools.lru_cache(maxsize=None)
+def _store(distro: str):
+    """The release's typestore, built once per process (its serialisers are generated code)."""
+    from rosbags.typesys import Stores, get_typestore
+
+    return get_typestore(Stores.ROS2_HUMBLE if distro == "humble" else Stores.ROS2_JAZZY)
 
 
 def _quat(yaw: float) -> tuple[float, float, float, float]:
@@ -113,12 +122,11 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
     """
     require_rosbags()
     from rosbags.rosbag2 import StoragePlugin, Writer
-    from rosbags.typesys import Stores, get_typestore
 
     traj = _check(trajectory, topics, storage, distro)
     spawn3 = tuple(float(v) for v in (spawn if spawn is not None else traj[0, 1:4]))
     cmds = _commands(traj) if commands is None else np.asarray(commands, dtype=float).reshape(-1, 3)
-    ts = get_typestore(Stores.ROS2_HUMBLE if distro == "humble" else Stores.ROS2_JAZZY)
+    ts = _store(distro)
     T = ts.types
     Header, Time = T["std_msgs/msg/Header"], T["builtin_interfaces/msg/Time"]
     Vector3, Quaternion = T["geometry_msgs/msg/Vector3"], T["geometry_msgs/msg/Quaternion"]
