@@ -8,8 +8,8 @@ import math
 
 import numpy as np
 import pytest
-
 from support.runs import along, idle_then, small_world, spawn_of, toward, write_bag
+
 from worldgen import oracles
 from worldgen.errors import ParameterError
 from worldgen.ros import read_run

@@ -6,9 +6,9 @@ import json
 import numpy as np
 import pytest
 from PIL import Image
-
 from support.cli import run
 from support.runs import along, idle_then, small_world, toward, write_bag
+
 from worldgen import oracles
 
 pytest.importorskip("rosbags")

@@ -34,11 +34,14 @@ sample per ``min_dt`` seconds; message objects are dropped as they are read.
 
 from __future__ import annotations
 
+import functools
 import math
+import struct
 from array import array
+from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Optional, Sequence
+from typing import Any, Callable, Optional, Sequence
 
 import numpy as np
 
@@ -74,6 +77,11 @@ class BagRun:
 
 def _fail(bag: Path, why: str) -> ParameterError:
     return ParameterError(f"bag '{bag}': {why}")
+
+
+def _unreadable(bag: Path, exc: Exception) -> ParameterError:
+    why = (str(exc).splitlines() or [""])[0][:160]
+    return _fail(bag, f"cannot be read as a ROS bag ({type(exc).__name__}: {why})")
 
 
 def _yaw(q) -> float:
@@ -126,10 +134,14 @@ def peek_metadata(bag) -> dict[str, str]:
     if not path.exists():
         raise _fail(path, "does not exist")
     try:
-        with AnyReader([path], default_typestore=_typestore(None)) as reader:
-            custom = bag_metadata(reader)["custom"]
+        source, meta = _storage(path)
+        if meta:
+            custom = meta["custom"]
+        else:
+            with AnyReader([source], default_typestore=_typestore(None)) as reader:
+                custom = bag_metadata(reader)["custom"]
     except Exception as exc:  # a truncated or foreign file
-        raise _fail(path, f"cannot be read as a ROS bag ({type(exc).__name__}: {(str(exc).splitlines() or [''])[0][:160]})") from None
+        raise _unreadable(path, exc) from None
     return {str(k): str(v) for k, v in custom.items() if str(k).startswith("worldgen.")}
 
 
@@ -146,11 +158,61 @@ def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a[:, 0] + c * b[:, 0] - s * b[:, 1], a[:, 1] + s * b[:, 0] + c * b[:, 1], a[:, 2] + b[:, 2]], axis=1)
 
 
+@functools.lru_cache(maxsize=None)
 def _typestore(distro: Optional[str]):
     from rosbags.typesys import Stores, get_typestore
 
     stores = {"humble": Stores.ROS2_HUMBLE, "jazzy": Stores.ROS2_JAZZY}
     return get_typestore(stores.get(distro or "jazzy", Stores.ROS2_JAZZY))
+
+
+#: Typestores built from bags' own definitions, by those definitions: rosbags generates each type's
+#: deserialiser on first use, which costs more than reading a one-minute bag; a batch reuses them.
+_STORES: OrderedDict[tuple, Any] = OrderedDict()
+
+
+def _deserializer(reader, conns, distro: Optional[str]) -> Callable[[bytes, str], Any]:
+    key = (distro, reader.is2) + tuple(sorted((c.msgtype, c.msgdef.format.name, c.msgdef.data) for c in conns))
+    if key not in _STORES:
+        _STORES[key] = reader.typestore
+        if len(_STORES) > 16:
+            _STORES.popitem(last=False)
+    _STORES.move_to_end(key)
+    store = _STORES[key]
+    if reader.is2:
+        return store.deserialize_cdr
+    return store.deserialize_ros1
+
+
+def _clock(raw: bytes) -> Optional[float]:
+    """rosgraph_msgs/Clock from its CDR bytes (4-byte encapsulation header, then int32 sec, uint32 nanosec);
+    None where the encoding is not plain CDR."""
+    if len(raw) < 12 or raw[0] != 0 or raw[1] not in (0, 1):
+        return None
+    sec, nsec = struct.unpack_from("<iI" if raw[1] == 1 else ">iI", raw, 4)
+    return sec + nsec * 1e-9
+
+
+def _storage(path: Path) -> tuple[Path, dict[str, Any]]:
+    """The file to open and the bag's metadata: an uncompressed one-file rosbag2 folder is read through its
+    storage file, its metadata.yaml parsed here (rosbags' own parser costs a fifth of reading a minute's bag)."""
+    meta_file = path / "metadata.yaml"
+    if not (path.is_dir() and meta_file.is_file()):
+        return path, {}
+    import yaml
+
+    try:
+        info = yaml.load(meta_file.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+        info = info["rosbag2_bagfile_information"]
+        files = info.get("relative_file_paths") or []
+        single = path / Path(files[0]).name if len(files) == 1 else None
+        plain = not info.get("compression_mode") and not info.get("compression_format")
+    except (yaml.YAMLError, KeyError, TypeError, IndexError, AttributeError):
+        return path, {}  # rosbags reads it and says what is wrong
+    meta = {"custom": info.get("custom_data") or {}, "ros_distro": info.get("ros_distro")}
+    if single is not None and plain and single.suffix in (".mcap", ".db3") and single.is_file():
+        return single, meta
+    return path, meta
 
 
 def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "command",
@@ -173,16 +235,16 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
         from worldgen.testing.figures import load
         spawn = np.asarray(load(world).task(task)["spawn"], dtype=float)[[0, 1, 5]]
     try:
-        with AnyReader([path], default_typestore=_typestore(distro)) as reader:
-            meta = bag_metadata(reader)
+        source, meta = _storage(path)
+        with AnyReader([source], default_typestore=_typestore(distro)) as reader:
+            meta = meta or bag_metadata(reader)
             topics = {c.topic: c.msgtype for c in reader.connections}
             st = _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topics, map_frame, odom_frame,
-                         tuple(base_frames), start, min_dt, spawn is not None)
+                         tuple(base_frames), start, min_dt, distro)
     except WorldgenError as exc:
         raise _fail(path, str(exc)) from None
     except Exception as exc:  # rosbags' and the storage libraries' errors: a truncated or foreign file
-        why = (str(exc).splitlines() or [""])[0][:160]
-        raise _fail(path, f"cannot be read as a ROS bag ({type(exc).__name__}: {why})") from None
+        raise _unreadable(path, exc) from None
     found = ", ".join(f"{t} ({ty})" for t, ty in sorted(topics.items())) or "none"
     source, detail, traj = _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames)
     if traj is None:
@@ -204,7 +266,7 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
 
 
 def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topics, map_frame, odom_frame, base_frames,
-            start, min_dt, have_spawn) -> dict:
+            start, min_dt, distro) -> dict:
     """One pass over the topics that matter; returns the pose series and the start events."""
     gt = pose_topic in topics and topics[pose_topic] in _POSE_TYPES
     wanted = {cmd_topic}
@@ -220,19 +282,26 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
     if not gt and odom_topic in topics:
         st["odom"] = _Series(min_dt)
     ref = None  # (receive ns, simulation s) of the latest stamped message: clocks unstamped ones
+    deserialize = _deserializer(reader, conns, distro)
     for conn, recv, raw in reader.messages(connections=conns):
         topic = conn.topic
+        if topic == "/clock" and reader.is2:
+            now = _clock(raw)
+            if now is not None:
+                ref = (recv, now)
+                continue
         if topic in goal_topics and conn.msgtype != "geometry_msgs/msg/PoseStamped":
             if st["first_goal"] is None and ref is not None:
                 st["first_goal"] = ref[1] + (recv - ref[0]) * 1e-9
             continue
-        msg = reader.deserialize(raw, conn.msgtype)
+        msg = deserialize(raw, conn.msgtype)
         if topic == "/clock":
             ref = (recv, _t(msg.clock))
         elif topic == cmd_topic:
             st["cmd_seen"] = True
             twist = getattr(msg, "twist", msg)
-            if st["first_cmd"] is None and (abs(twist.linear.x) > 1e-9 or abs(twist.linear.y) > 1e-9 or abs(twist.angular.z) > 1e-9):
+            moving = abs(twist.linear.x) > 1e-9 or abs(twist.linear.y) > 1e-9 or abs(twist.angular.z) > 1e-9
+            if st["first_cmd"] is None and moving:
                 if hasattr(msg, "header"):
                     st["first_cmd"] = _t(msg.header.stamp)
                 elif ref is not None:
