@@ -24,6 +24,7 @@ import json
 import math
 import os
 import resource
+import shutil
 import statistics
 import subprocess
 import sys
@@ -73,7 +74,7 @@ def make_bag(root: Path) -> tuple[Path, Path]:
 def time_one(bag: Path, world: Path, repeats: int) -> dict:
     from worldgen.ros import judge, write_report
 
-    out = Path(tempfile.mkdtemp(prefix="bench-judge-")) / "report"
+    out = bag.parent / "timing" / "report"
 
     def once() -> tuple[float, float]:
         t0 = time.perf_counter()
@@ -118,6 +119,13 @@ def main() -> int:
         batch_child(args.child[0], args.child[1], int(args.child[2]), args.child[3])
         return 0
     root = Path(tempfile.mkdtemp(prefix="bench-judge-"))
+    try:
+        return run(root, args)
+    finally:
+        shutil.rmtree(root, ignore_errors=True)
+
+
+def run(root: Path, args) -> int:
     bag, world = make_bag(root)
     size = sum(p.stat().st_size for p in bag.iterdir())
     timing = time_one(bag, world, args.repeats)

@@ -193,3 +193,10 @@ def test_the_mujoco_example_loop_is_judged_end_to_end(tmp_path):
         odom = [m for _, ch, _, m in reader.iter_decoded_messages(topics=["/odom"])]
     assert odom[0].pose.pose.position.x == 0.0 and odom[0].pose.pose.position.y == 0.0  # zeroed at the spawn
     assert odom[0].header.frame_id == "odom" and odom[0].child_frame_id == "base_footprint"
+
+
+def test_the_progress_bar_goes_to_stderr_when_asked(setup, tmp_path):
+    r = run("judge", setup["clean"], setup["idle"], "--world", setup["world"], "--out", tmp_path / "r", "--progress")
+    assert r.returncode == 0 and r.stderr.splitlines() == ["judging: 1 of 2 bags (50%)", "judging: 2 of 2 bags (100%)"]
+    quiet = run("judge", setup["clean"], "--world", setup["world"], "--out", tmp_path / "q")
+    assert quiet.returncode == 0 and quiet.stderr == ""  # not a terminal: no bar

@@ -42,7 +42,9 @@ Examples:
               help="Robot base frame(s) in /tf, in order of preference [default: base_footprint, base_link].")
 @click.option("--spawn-tolerance", type=click.FloatRange(0, None), default=0.25, show_default=True,
               help="m a run may start from its task's spawn before the bag is refused as being in the wrong world.")
-@click.option("--progress/--no-progress", default=None, help="A progress bar on stderr [default: when stderr is a terminal].")
+@click.option("--progress/--no-progress", default=None,
+              help="Progress on stderr: a bar on a terminal, a line per tenth of the batch elsewhere "
+                   "[default: on a terminal only].")
 def judge_command(bags: Sequence[Path], world: Optional[Path], pack: Optional[Path], runs_table: Optional[Path],
                   criteria: Optional[Path], out: Path, start: str, pose_topic: str, odom_topic: str, cmd_topic: str,
                   base_frames: Sequence[str], spawn_tolerance: float, progress: Optional[bool]) -> None:
@@ -63,22 +65,28 @@ def judge_command(bags: Sequence[Path], world: Optional[Path], pack: Optional[Pa
                "spawn_tolerance": spawn_tolerance}
     if base_frames:
         options["base_frames"] = tuple(base_frames)
-    total = None
-    if runs_table is None:
-        total = len(bags)
-    show = sys.stderr.isatty() if progress is None else progress
-    if show:
+    tty = sys.stderr.isatty()
+    if tty if progress is None else progress:
         from worldgen.testing.judge import plan
-        total = len(plan(bags, world=world, pack=pack, runs=runs_table))
-        with click.progressbar(length=total, label="judging", file=sys.stderr) as bar:
-            done = [0]
 
-            def tick(k: int) -> None:
-                bar.update(k - done[0])
-                done[0] = k
+        total = len(plan(bags, world=world, pack=pack, runs=runs_table))
+        if tty:
+            with click.progressbar(length=total, label="judging", file=sys.stderr) as bar:
+                done = [0]
+
+                def tick(k: int) -> None:
+                    bar.update(k - done[0])
+                    done[0] = k
+
+                result = judge(bags, criteria, world=world, pack=pack, runs=runs_table, start=start,
+                               read_options=options, progress=tick)
+        else:  # a log (CI): a line at every tenth of the batch instead of a redrawn bar
+            def line(k: int) -> None:
+                if k == total or k * 10 // total != (k - 1) * 10 // total:
+                    click.echo(f"judging: {k} of {total} bags ({100 * k // total}%)", err=True)
 
             result = judge(bags, criteria, world=world, pack=pack, runs=runs_table, start=start, read_options=options,
-                           progress=tick)
+                           progress=line)
     else:
         result = judge(bags, criteria, world=world, pack=pack, runs=runs_table, start=start, read_options=options)
     folder = write_report(result, out)
