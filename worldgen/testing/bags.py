@@ -34,18 +34,16 @@ sample per ``min_dt`` seconds; message objects are dropped as they are read.
 
 from __future__ import annotations
 
-import functools
 import math
-import struct
 from array import array
-from collections import OrderedDict
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable, Optional, Sequence
+from typing import Any, Optional, Sequence
 
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError
+from worldgen.testing.bagio import bag_metadata, decoder, fail, storage, typestore, unreadable
 from worldgen.testing.rosdeps import require_rosbags
 
 __all__ = ["BagRun", "read_run", "bag_metadata", "peek_metadata", "START_RULES", "GOAL_TOPICS", "MOTION_START"]
@@ -75,23 +73,6 @@ class BagRun:
     metadata: dict[str, str] = field(default_factory=dict)  # worldgen.* custom data, where the bag has it
 
 
-def _fail(bag: Path, why: str) -> ParameterError:
-    return ParameterError(f"bag '{bag}': {why}")
-
-
-def _unreadable(bag: Path, exc: Exception) -> ParameterError:
-    why = (str(exc).splitlines() or [""])[0][:160]
-    return _fail(bag, f"cannot be read as a ROS bag ({type(exc).__name__}: {why})")
-
-
-def _yaw(q) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
-def _t(stamp) -> float:
-    return stamp.sec + stamp.nanosec * 1e-9
-
-
 class _Series:
     """t, x, y, yaw samples in a flat float array, at most one per ``min_dt`` seconds."""
 
@@ -114,34 +95,26 @@ class _Series:
         return a
 
 
-def bag_metadata(reader) -> dict[str, Any]:
-    """The bag's ``custom_data`` (rosbag2 folders) and ``ros_distro``, where it has them."""
-    out: dict[str, Any] = {"custom": {}, "ros_distro": None}
-    for r in getattr(reader, "readers", []):
-        meta = getattr(getattr(r, "storage", None), "metadata", None)
-        if meta is not None:
-            out["custom"].update(getattr(meta, "custom", None) or {})
-            out["ros_distro"] = out["ros_distro"] or getattr(meta, "ros_distro", None)
-    return out
-
-
 def peek_metadata(bag) -> dict[str, str]:
-    """The bag's ``worldgen.*`` custom data (world_id, task, run) without reading its messages."""
+    """The bag's ``worldgen.*`` custom data (world_id, task, run) without reading its messages; a bare storage
+    file or a ROS 1 bag has none (it lives in a rosbag2 folder's metadata.yaml)."""
     require_rosbags()
     from rosbags.highlevel import AnyReader
 
     path = Path(bag)
     if not path.exists():
-        raise _fail(path, "does not exist")
+        raise fail(path, "does not exist")
+    if not path.is_dir():
+        return {}
     try:
-        source, meta = _storage(path)
+        source, meta = storage(path)
         if meta:
             custom = meta["custom"]
         else:
-            with AnyReader([source], default_typestore=_typestore(None)) as reader:
+            with AnyReader([source], default_typestore=typestore(None)) as reader:
                 custom = bag_metadata(reader)["custom"]
     except Exception as exc:  # a truncated or foreign file
-        raise _unreadable(path, exc) from None
+        raise unreadable(path, exc) from None
     return {str(k): str(v) for k, v in custom.items() if str(k).startswith("worldgen.")}
 
 
@@ -158,63 +131,6 @@ def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a[:, 0] + c * b[:, 0] - s * b[:, 1], a[:, 1] + s * b[:, 0] + c * b[:, 1], a[:, 2] + b[:, 2]], axis=1)
 
 
-@functools.lru_cache(maxsize=None)
-def _typestore(distro: Optional[str]):
-    from rosbags.typesys import Stores, get_typestore
-
-    stores = {"humble": Stores.ROS2_HUMBLE, "jazzy": Stores.ROS2_JAZZY}
-    return get_typestore(stores.get(distro or "jazzy", Stores.ROS2_JAZZY))
-
-
-#: Typestores built from bags' own definitions, by those definitions: rosbags generates each type's
-#: deserialiser on first use, which costs more than reading a one-minute bag; a batch reuses them.
-_STORES: OrderedDict[tuple, Any] = OrderedDict()
-
-
-def _deserializer(reader, conns, distro: Optional[str]) -> Callable[[bytes, str], Any]:
-    key = (distro, reader.is2) + tuple(sorted((c.msgtype, c.msgdef.format.name, c.msgdef.data) for c in conns))
-    if key not in _STORES:
-        _STORES[key] = reader.typestore
-        if len(_STORES) > 16:
-            _STORES.popitem(last=False)
-    _STORES.move_to_end(key)
-    store = _STORES[key]
-    if reader.is2:
-        return store.deserialize_cdr
-    return store.deserialize_ros1
-
-
-def _clock(raw: bytes) -> Optional[float]:
-    """rosgraph_msgs/Clock from its CDR bytes (4-byte encapsulation header, then int32 sec, uint32 nanosec);
-    None where the encoding is not plain CDR."""
-    if len(raw) < 12 or raw[0] != 0 or raw[1] not in (0, 1):
-        return None
-    sec, nsec = struct.unpack_from("<iI" if raw[1] == 1 else ">iI", raw, 4)
-    return sec + nsec * 1e-9
-
-
-def _storage(path: Path) -> tuple[Path, dict[str, Any]]:
-    """The file to open and the bag's metadata: an uncompressed one-file rosbag2 folder is read through its
-    storage file, its metadata.yaml parsed here (rosbags' own parser costs a fifth of reading a minute's bag)."""
-    meta_file = path / "metadata.yaml"
-    if not (path.is_dir() and meta_file.is_file()):
-        return path, {}
-    import yaml
-
-    try:
-        info = yaml.load(meta_file.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-        info = info["rosbag2_bagfile_information"]
-        files = info.get("relative_file_paths") or []
-        single = path / Path(files[0]).name if len(files) == 1 else None
-        plain = not info.get("compression_mode") and not info.get("compression_format")
-    except (yaml.YAMLError, KeyError, TypeError, IndexError, AttributeError):
-        return path, {}  # rosbags reads it and says what is wrong
-    meta = {"custom": info.get("custom_data") or {}, "ros_distro": info.get("ros_distro")}
-    if single is not None and plain and single.suffix in (".mcap", ".db3") and single.is_file():
-        return single, meta
-    return path, meta
-
-
 def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "command",
              pose_topic: str = "/ground_truth", model: Optional[str] = None,
              odom_topic: str = "/odom", cmd_topic: str = "/cmd_vel", goal_topics: Sequence[str] = GOAL_TOPICS,
@@ -229,35 +145,35 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
         raise ParameterError(f"parameter 'start' must be one of {', '.join(START_RULES)}, got {start!r}")
     path = Path(bag)
     if not path.exists():
-        raise _fail(path, "does not exist")
+        raise fail(path, "does not exist")
     spawn = None
     if world is not None:
         from worldgen.testing.figures import load
         spawn = np.asarray(load(world).task(task)["spawn"], dtype=float)[[0, 1, 5]]
     try:
-        source, meta = _storage(path)
-        with AnyReader([source], default_typestore=_typestore(distro)) as reader:
+        source, meta = storage(path)
+        with AnyReader([source], default_typestore=typestore(distro)) as reader:
             meta = meta or bag_metadata(reader)
             topics = {c.topic: c.msgtype for c in reader.connections}
             st = _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topics, map_frame, odom_frame,
                          tuple(base_frames), start, min_dt, distro)
     except WorldgenError as exc:
-        raise _fail(path, str(exc)) from None
+        raise fail(path, str(exc)) from None
     except Exception as exc:  # rosbags' and the storage libraries' errors: a truncated or foreign file
-        raise _unreadable(path, exc) from None
+        raise unreadable(path, exc) from None
     found = ", ".join(f"{t} ({ty})" for t, ty in sorted(topics.items())) or "none"
     source, detail, traj = _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames)
     if traj is None:
         need = f"{pose_topic}, /tf with {map_frame}->{odom_frame}->{'|'.join(base_frames)}, or {odom_topic}"
         if st["odom"] is not None and spawn is None:
             need += " (odometry needs a world for its spawn pose)"
-        raise _fail(path, f"no pose source: need {need}; topics found: {found}")
+        raise fail(path, f"no pose source: need {need}; topics found: {found}")
     t0, rule = _start_time(st, traj, start, cmd_topic, found, path)
     traj = _cut(traj, t0)
     if spawn is not None:
         d = float(math.hypot(traj[0, 1] - spawn[0], traj[0, 2] - spawn[1]))
         if d > spawn_tolerance:
-            raise _fail(path, f"the run starts {d:.2f} m from the task's spawn ({spawn[0]:.2f}, {spawn[1]:.2f}) at "
+            raise fail(path, f"the run starts {d:.2f} m from the task's spawn ({spawn[0]:.2f}, {spawn[1]:.2f}) at "
                               f"({traj[0, 1]:.2f}, {traj[0, 2]:.2f}), more than spawn_tolerance {spawn_tolerance:g} m: "
                               f"is this the right world and task?")
     return BagRun(bag=str(path), trajectory=traj, source=source, source_detail=detail, drift_bounded=source != "odom",
@@ -282,70 +198,46 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
     if not gt and odom_topic in topics:
         st["odom"] = _Series(min_dt)
     ref = None  # (receive ns, simulation s) of the latest stamped message: clocks unstamped ones
-    deserialize = _deserializer(reader, conns, distro)
+    decode = decoder(reader, conns, distro)
     for conn, recv, raw in reader.messages(connections=conns):
         topic = conn.topic
-        if topic == "/clock" and reader.is2:
-            now = _clock(raw)
-            if now is not None:
-                ref = (recv, now)
-                continue
         if topic in goal_topics and conn.msgtype != "geometry_msgs/msg/PoseStamped":
             if st["first_goal"] is None and ref is not None:
                 st["first_goal"] = ref[1] + (recv - ref[0]) * 1e-9
             continue
-        msg = deserialize(raw, conn.msgtype)
+        v = decode(conn, raw)
         if topic == "/clock":
-            ref = (recv, _t(msg.clock))
+            ref = (recv, v)
         elif topic == cmd_topic:
             st["cmd_seen"] = True
-            twist = getattr(msg, "twist", msg)
-            moving = abs(twist.linear.x) > 1e-9 or abs(twist.linear.y) > 1e-9 or abs(twist.angular.z) > 1e-9
-            if st["first_cmd"] is None and moving:
-                if hasattr(msg, "header"):
-                    st["first_cmd"] = _t(msg.header.stamp)
-                elif ref is not None:
-                    st["first_cmd"] = ref[1] + (recv - ref[0]) * 1e-9
-                else:
-                    st["first_cmd"] = recv * 1e-9
+            t, vx, vy, wz = v
+            if st["first_cmd"] is None and (abs(vx) > 1e-9 or abs(vy) > 1e-9 or abs(wz) > 1e-9):
+                if t is None:  # a Twist has no stamp: the simulation time it was received at
+                    t = ref[1] + (recv - ref[0]) * 1e-9 if ref is not None else recv * 1e-9
+                st["first_cmd"] = t
         elif topic in goal_topics:
             if st["first_goal"] is None:
-                st["first_goal"] = _t(msg.header.stamp)
+                st["first_goal"] = v[0]
         elif topic == pose_topic and gt:
-            pose_msg(msg, st["gt"], model)
-            ref = (recv, st["gt"].last)
+            poses = v if isinstance(v, list) else [v]
+            chosen = [p for p in poses if model is None or p[2] == model][:1]
+            for t, _, _, x, y, yaw in chosen:
+                st["gt"].add(t, x, y, yaw)
+                ref = (recv, t)
         elif topic == odom_topic and st["odom"] is not None:
-            p = msg.pose.pose
-            st["odom"].add(_t(msg.header.stamp), p.position.x, p.position.y, _yaw(p.orientation))
-            ref = (recv, _t(msg.header.stamp))
+            st["odom"].add(v[0], v[3], v[4], v[5])
+            ref = (recv, v[0])
         elif topic in ("/tf", "/tf_static"):
-            for tr in msg.transforms:
-                parent, child = tr.header.frame_id.lstrip("/"), tr.child_frame_id.lstrip("/")
+            for t, parent, child, x, y, yaw in v:
+                parent, child = parent.lstrip("/"), child.lstrip("/")
                 if parent == odom_frame and child in st["base"]:
-                    series = st["base"][child]
+                    st["base"][child].add(t, x, y, yaw)
                 elif parent == map_frame and child == odom_frame:
-                    series = st["map_odom"]
+                    st["map_odom"].add(t, x, y, yaw)
                 else:
                     continue
-                t = _t(tr.header.stamp)
-                series.add(t, tr.transform.translation.x, tr.transform.translation.y, _yaw(tr.transform.rotation))
                 ref = (recv, t)
     return st
-
-
-def pose_msg(msg, series: _Series, model: Optional[str]) -> None:
-    """Add the pose a ground-truth message carries (any of the bridged pose types) to ``series``."""
-    if hasattr(msg, "transforms"):  # TFMessage from gz.msgs.Pose_V: one transform per entity
-        chosen = [tr for tr in msg.transforms if model is None or tr.child_frame_id == model][:1]
-        for tr in chosen:
-            series.add(_t(tr.header.stamp), tr.transform.translation.x, tr.transform.translation.y, _yaw(tr.transform.rotation))
-        return
-    if hasattr(msg, "transform"):
-        p, q = msg.transform.translation, msg.transform.rotation
-    else:
-        pose = msg.pose.pose if hasattr(msg.pose, "pose") else msg.pose
-        p, q = pose.position, pose.orientation
-    series.add(_t(msg.header.stamp), p.x, p.y, _yaw(q))
 
 
 def _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames):
@@ -372,13 +264,13 @@ def _start_time(st, traj, start, cmd_topic, found, path) -> tuple[float, str]:
         return float(traj[0, 0]), "bag"
     if start == "command":
         if not st["cmd_seen"] and st["first_cmd"] is None:
-            raise _fail(path, f"start='command' needs {cmd_topic}, which is not in the bag; topics found: {found}")
+            raise fail(path, f"start='command' needs {cmd_topic}, which is not in the bag; topics found: {found}")
         if st["first_cmd"] is None:  # commands, all zero: the robot was never told to move; judge it from the start
             return float(traj[0, 0]), "command (none non-zero: from the first pose)"
         return float(st["first_cmd"]), "command"
     if start == "goal":
         if st["first_goal"] is None:
-            raise _fail(path, f"start='goal' needs a goal topic ({', '.join(GOAL_TOPICS)}); topics found: {found}")
+            raise fail(path, f"start='goal' needs a goal topic ({', '.join(GOAL_TOPICS)}); topics found: {found}")
         return float(st["first_goal"]), "goal"
     moved = np.hypot(traj[:, 1] - traj[0, 1], traj[:, 2] - traj[0, 2]) >= MOTION_START
     k = int(np.argmax(moved)) if moved.any() else 0

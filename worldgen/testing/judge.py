@@ -211,21 +211,23 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
         for k, item in enumerate(items):
             row: dict[str, Any] = {"bag": str(item.bag), "run": None, "readable": True}
             try:
-                folder = item.world
-                if folder is None:
+                folder, task = item.world, item.task
+                named = {}
+                if folder is None or task is None:
                     from worldgen.testing.bags import peek_metadata
-                    wid = peek_metadata(item.bag).get("worldgen.world_id")
-                    if not wid:
+                    named = peek_metadata(item.bag)
+                if folder is None:
+                    if not named.get("worldgen.world_id"):
                         raise ParameterError(f"bag '{item.bag}': names no world in its metadata (worldgen.world_id); "
                                              "give --world DIR or --runs TABLE")
-                    folder = _pack_world(pack, wid, packs)
+                    folder = _pack_world(pack, named["worldgen.world_id"], packs)
                 g = ground(folder)
-                got = read_run(item.bag, g, task=item.task, start=start, **options)
+                task = task or named.get("worldgen.task")
+                got = read_run(item.bag, g, task=task, start=start, **options)
                 named = got.metadata.get("worldgen.world_id")
                 if named and named != g.meta.get("world_id"):
                     raise ParameterError(f"bag '{item.bag}' was recorded in world {named!r}, "
                                          f"not {g.meta.get('world_id')!r}")
-                task = item.task or got.metadata.get("worldgen.task")
                 row["run"] = unique(item.run or got.metadata.get("worldgen.run") or _stem(item.bag))
                 row.update(source=got.source, source_detail=got.source_detail, drift_bounded=got.drift_bounded,
                            start=got.start, start_time=got.start_time, world_folder=str(folder))
