@@ -132,7 +132,7 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
     img, res, ox, oy = found
     scale = max(1, _WIDTH // img.width)
     img = img.resize((img.width * scale, img.height * scale), Image.NEAREST)
-    top = 36
+    top = 54
     canvas = Image.new("RGB", (img.width, img.height + top), (255, 255, 255))
     canvas.paste(img, (0, top))
     pen = ImageDraw.Draw(canvas)
@@ -166,8 +166,8 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
     pen.text((6, 3), f"{row.get('run')}  {row.get('world_id')} / {t['id']}  source: {row.get('source')}", fill=COLOURS["text"],
              font=font)
     pen.text((6, 19), verdict[:60], fill=colour, font=font)
-    legend = "orange: reference path  line: the run  x: contact"
-    pen.text((canvas.width - 6 - pen.textlength(legend, font=font), 19), legend, fill=COLOURS["text"], font=font)
+    pen.text((6, 35), "orange: reference path   blue/red line: the run   green: spawn   blue circle: goal   x: contact",
+             fill=COLOURS["text"], font=text_font(11))
     return canvas
 
 
