@@ -151,7 +151,7 @@ def main(out_dir: str, n_worlds: int = 20) -> int:
     bags = []
     for seed in range(n_worlds):
         world = worldgen.generate("cluttered", seed=seed, size=[10, 10], n_obstacles=15)
-        world.write(out / "worlds")
+        world.write(out / "worlds", preview=False)  # the report draws each run over map.pgm
         trajectory, commands = drive(world)
         task = world.metadata["tasks"][0]
         spawn = task["spawn"]

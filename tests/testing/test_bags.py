@@ -64,6 +64,13 @@ def test_idle_time_before_the_drive_is_not_counted_from_the_first_command(world,
     assert by_motion.start_time == pytest.approx(3.0 + drive[np.argmax(d >= 0.1), 0])
 
 
+def test_the_goal_sent_starts_the_run_when_asked(world, tmp_path):
+    bag = write_bag(tmp_path / "run", world, idle_then(along(world), 2.0), goal=(1.5, 0.0, 0.0, 0.0))
+    run = read_run(bag, world, start="goal")
+    assert run.start == "goal" and run.start_time == pytest.approx(1.5)
+    assert run.trajectory[0, 0] == pytest.approx(1.5) and len(run.trajectory) == len(idle_then(along(world), 2.0)) - 30
+
+
 def test_a_stamped_command_from_jazzy_nav2_starts_the_run_too(world, tmp_path):
     bag = write_bag(tmp_path / "run", world, idle_then(along(world), 2.0), stamped_cmd=True)
     assert read_run(bag, world).start_time == pytest.approx(2.0)

@@ -114,10 +114,12 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
               drift: float = 0.0, scan: Optional[Callable[[float, float, float], np.ndarray]] = None,
               scan_angles: tuple[float, float, float, float] = (-math.pi, math.pi, 0.05, 12.0),
               stamped_cmd: bool = False, base_frame: str = "base_footprint",
-              world_id: Optional[str] = None, task: Optional[str] = None, run: Optional[str] = None) -> Path:
+              world_id: Optional[str] = None, task: Optional[str] = None, run: Optional[str] = None,
+              goal: Optional[Sequence[float]] = None) -> Path:
     """Write ``trajectory`` as a rosbag2 folder at ``path`` (must not exist); returns the folder.
 
-    ``commands`` is an (m, 3) ``t, v, w`` array (default: read off the trajectory);
+    ``commands`` is an (m, 3) ``t, v, w`` array (default: read off the trajectory); ``goal``
+    ``(t, x, y, yaw)`` adds the goal sent at time t on ``/goal_pose`` (PoseStamped in ``map``, as RViz sends it);
     ``scan_angles`` is LaserScan's ``angle_min, angle_max, range_min, range_max``.
     """
     require_rosbags()
@@ -205,10 +207,14 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
             twist = Twist(linear=Vector3(x=float(v), y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=float(w)))
             put(float(t), "/cmd_vel", T["geometry_msgs/msg/TwistStamped"](header=header(float(t), base_frame), twist=twist)
                 if stamped_cmd else twist)
+    if goal is not None:
+        gt_, gx, gy, gyaw = (float(v) for v in goal)
+        put(gt_, "/goal_pose", T["geometry_msgs/msg/PoseStamped"](
+            header=header(gt_, "map"), pose=Pose(position=Point(x=gx, y=gy, z=0.0), orientation=Quaternion(*_quat(gyaw)))))
     static = "tf" in topics and not drift
     types = {"/clock": "rosgraph_msgs/msg/Clock", "/odom": "nav_msgs/msg/Odometry", "/tf": "tf2_msgs/msg/TFMessage",
              "/tf_static": "tf2_msgs/msg/TFMessage", "/scan": "sensor_msgs/msg/LaserScan",
-             "/ground_truth": "nav_msgs/msg/Odometry",
+             "/ground_truth": "nav_msgs/msg/Odometry", "/goal_pose": "geometry_msgs/msg/PoseStamped",
              "/cmd_vel": "geometry_msgs/msg/TwistStamped" if stamped_cmd else "geometry_msgs/msg/Twist"}
     out.sort(key=lambda m: (m[0], m[1]))
     writer = Writer(path, version=8, storage_plugin=plugin)
