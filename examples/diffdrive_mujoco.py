@@ -163,7 +163,8 @@ def main(out_dir: str, n_worlds: int = 20) -> int:
     write_report(result, out / "report")
     report = result.report
     for c in report["criteria"]:
-        print(f"{c['section'] + '.' + c['key']:<30} {c['op']} {c['required']:<8g} {c['measured']:<10.6g} "
+        measured = "n/a" if c["measured"] is None else f"{c['measured']:.6g}"
+        print(f"{c['section'] + '.' + c['key']:<30} {c['op']} {c['required']!s:<8} {measured:<10} "
               f"{'PASS' if c['passed'] else 'FAIL'}")
     for line in report["failures"]:
         print("FAILED", line)

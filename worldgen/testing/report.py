@@ -81,7 +81,8 @@ def _markdown(report: dict) -> str:
     if report.get("criteria"):
         rows = [[f"{c['section']}.{c['key']}", f"{c['op']} {_cell(c['required'])}",
                  "n/a" if c.get("measured") is None else _cell(c["measured"]), "PASS" if c["passed"] else "FAIL",
-                 "" if c.get("margin") is None else f"{c['margin']:+.6g}"] for c in report["criteria"]]
+                 f"{c['margin']:+.6g}" if isinstance(c.get("margin"), (int, float)) else _cell(c.get("margin"))]
+                for c in report["criteria"]]
         out += ["## Criteria", ""] + _table(["criterion", "required", "measured", "verdict", "margin"], rows) + [""]
     out += ["## Summary", ""] + _table(["figure", "value"], [[k, _cell(v)] for k, v in sorted(s.items())
                                                              if not isinstance(v, (dict, list))]) + [""]
