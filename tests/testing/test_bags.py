@@ -107,6 +107,12 @@ def test_drifting_odometry(world, tmp_path, storage, distro):
     expect_y = sy + math.sin(syaw) * ox + math.cos(syaw) * oy
     np.testing.assert_allclose(run.trajectory[:, 1], expect_x, atol=1e-9)
     np.testing.assert_allclose(run.trajectory[:, 2], expect_y, atol=1e-9)
+    # No /odom and no localisation: the odom -> base transform is the odometry, with the same drift.
+    tf_only = write_bag(tmp_path / "tf_only", world, truth, drift=drift, storage=storage, distro=distro,
+                        topics=("clock", "tf", "cmd_vel"), map_odom=False)
+    alone = read_run(tf_only, world)
+    assert alone.source == "odom" and alone.source_detail == "/tf odom->base_footprint + spawn (unbounded drift)"
+    np.testing.assert_allclose(alone.trajectory[:, 1:3], run.trajectory[:, 1:3], atol=1e-12)
     end_error = math.hypot(run.trajectory[-1, 1] - truth[-1, 1], run.trajectory[-1, 2] - truth[-1, 2])
     assert end_error > 0.1  # the drift is visible: 0.05 rad/m over a few metres
 

@@ -165,7 +165,8 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
     source, detail, traj = _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames)
     if traj is None:
         need = f"{pose_topic}, /tf with {map_frame}->{odom_frame}->{'|'.join(base_frames)}, or {odom_topic}"
-        if st["odom"] is not None and spawn is None:
+        has_odometry = (st["odom"] is not None and len(st["odom"].data)) or any(len(b.data) for b in st["base"].values())
+        if has_odometry and spawn is None:
             need += " (odometry needs a world for its spawn pose)"
         raise fail(path, f"no pose source: need {need}; topics found: {found}")
     t0, rule = _start_time(st, traj, start, cmd_topic, found, path)
@@ -251,11 +252,16 @@ def _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames)
         out = rel.copy()
         out[:, 1:] = _compose(correction, rel[:, 1:])
         return "tf", f"{map_frame}->{odom_frame}->{base}", out
-    if st["odom"] is not None and len(st["odom"].data) and spawn is not None:
-        rel = st["odom"].array()
+    # Odometry alone: the /odom topic, else the odom -> base transform it is usually published beside.
+    rel, detail = None, ""
+    if st["odom"] is not None and len(st["odom"].data):
+        rel, detail = st["odom"].array(), odom_topic
+    elif base is not None:
+        rel, detail = st["base"][base].array(), f"/tf {odom_frame}->{base}"
+    if rel is not None and spawn is not None:
         out = rel.copy()
         out[:, 1:] = _compose(np.repeat(spawn[None, :], len(rel), axis=0), rel[:, 1:])
-        return "odom", f"{odom_topic} + spawn (unbounded drift)", out
+        return "odom", f"{detail} + spawn (unbounded drift)", out
     return None, "", None
 
 

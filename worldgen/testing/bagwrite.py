@@ -115,11 +115,12 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
               scan_angles: tuple[float, float, float, float] = (-math.pi, math.pi, 0.05, 12.0),
               stamped_cmd: bool = False, base_frame: str = "base_footprint",
               world_id: Optional[str] = None, task: Optional[str] = None, run: Optional[str] = None,
-              goal: Optional[Sequence[float]] = None) -> Path:
+              goal: Optional[Sequence[float]] = None, map_odom: bool = True) -> Path:
     """Write ``trajectory`` as a rosbag2 folder at ``path`` (must not exist); returns the folder.
 
     ``commands`` is an (m, 3) ``t, v, w`` array (default: read off the trajectory); ``goal``
     ``(t, x, y, yaw)`` adds the goal sent at time t on ``/goal_pose`` (PoseStamped in ``map``, as RViz sends it);
+    ``map_odom=False`` leaves ``map`` -> ``odom`` out (no localisation running: odometry only);
     ``scan_angles`` is LaserScan's ``angle_min, angle_max, range_min, range_max``.
     """
     require_rosbags()
@@ -190,7 +191,7 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
             put(t, "/ground_truth", odometry(t, "map", truth, float(v_of[k]), float(w_of[k])))
         if "tf" in topics:
             transforms = [tf(t, "odom", base_frame, odom)]
-            if drift:
+            if drift and map_odom:
                 # The localisation's map -> odom: truth = map_odom o odom, so map_odom = truth o odom^-1.
                 inv = _relative(odom, (0.0, 0.0, 0.0))
                 transforms.insert(0, tf(t, "map", "odom", _compose(truth, inv)))
@@ -211,7 +212,7 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
         gt_, gx, gy, gyaw = (float(v) for v in goal)
         put(gt_, "/goal_pose", T["geometry_msgs/msg/PoseStamped"](
             header=header(gt_, "map"), pose=Pose(position=Point(x=gx, y=gy, z=0.0), orientation=Quaternion(*_quat(gyaw)))))
-    static = "tf" in topics and not drift
+    static = "tf" in topics and not drift and map_odom
     types = {"/clock": "rosgraph_msgs/msg/Clock", "/odom": "nav_msgs/msg/Odometry", "/tf": "tf2_msgs/msg/TFMessage",
              "/tf_static": "tf2_msgs/msg/TFMessage", "/scan": "sensor_msgs/msg/LaserScan",
              "/ground_truth": "nav_msgs/msg/Odometry", "/goal_pose": "geometry_msgs/msg/PoseStamped",
