@@ -25,8 +25,9 @@ from __future__ import annotations
 
 import csv
 import math
+import tempfile
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Iterator, Optional, Sequence
 
@@ -67,10 +68,20 @@ class _WorldGround(Ground):
 
 @dataclass
 class JudgeResult:
-    """The report (``Report.to_dict()`` with every bag's row) and what its pictures need, per run."""
+    """The report (``Report.to_dict()`` with every bag's row) and what its pictures need, per run.
+
+    The points each picture is drawn from wait in a scratch folder (removed with the result), not in
+    memory: a batch holds its report rows and nothing per bag beside them.
+    """
 
     report: dict
-    plots: list[Optional[dict]]   # per row: world folder, task, decimated (m, 3) t, x, y; None when unreadable
+    plots: list[Optional[dict]]   # per row: world folder, task, the .npy of its (m, 3) t, x, y; None when unreadable
+    scratch: Any = field(default=None, repr=False)  # the TemporaryDirectory holding the .npy files
+
+    def trajectory(self, k: int) -> Optional[np.ndarray]:
+        """The decimated ``t, x, y`` of row k's picture (None for an unreadable bag)."""
+        plot = self.plots[k]
+        return None if plot is None else np.load(plot["points"])
 
     @property
     def passed(self) -> bool:
@@ -188,6 +199,7 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     grounds: OrderedDict[Path, _WorldGround] = OrderedDict()
     extra: list[dict] = []        # per bag: the judge's columns (readable ones also get evaluate's)
     plots: list[Optional[dict]] = []
+    scratch = tempfile.TemporaryDirectory(prefix="worldgen-judge-")
     names: set[str] = set()
     packs: dict[str, dict[str, Path]] = {}
 
@@ -232,7 +244,9 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
                 row.update(source=got.source, source_detail=got.source_detail, drift_bounded=got.drift_bounded,
                            start=got.start, start_time=got.start_time, world_folder=str(folder))
                 extra.append(row)
-                plots.append({"world": folder, "task": task, "trajectory": _decimate(got.trajectory)})
+                points = Path(scratch.name) / f"{len(plots)}.npy"
+                np.save(points, _decimate(got.trajectory))
+                plots.append({"world": folder, "task": task, "points": points})
                 yield got.trajectory, g, task
             except WorldgenError as exc:
                 row.update(run=row["run"] or unique(item.run or _stem(item.bag)), readable=False, reason=str(exc),
@@ -254,7 +268,7 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
             yield first
             yield from runs_iter
         judged = evaluate(chained(), criteria if criteria is not None else {}).to_dict()
-    return JudgeResult(_assemble(judged, extra), plots)
+    return JudgeResult(_assemble(judged, extra), plots, scratch)
 
 
 def _stem(bag: Path) -> str:

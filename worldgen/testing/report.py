@@ -183,11 +183,11 @@ def write_report(result, out) -> Path:
         shutil.rmtree(tmp, ignore_errors=True)
         (tmp / "runs").mkdir(parents=True)
         report = result.report
-        for row, plot in zip(report["runs"], result.plots):
+        for k, (row, plot) in enumerate(zip(report["runs"], result.plots)):
             row["picture"] = None
             if plot is None:
                 continue
-            image = draw_run(plot["world"], plot["task"], plot["trajectory"], row)
+            image = draw_run(plot["world"], plot["task"], result.trajectory(k), row)
             if image is not None:
                 name = f"runs/{_safe(str(row['run']))}.png"
                 image.save(tmp / name, format="PNG")
