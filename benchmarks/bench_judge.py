@@ -166,7 +166,7 @@ def run(root: Path, args) -> int:
     print(f"target: end to end <= {TIME_TARGET} s: {'met' if met else 'missed'} ({timing['end_to_end_s']:.3f} s)")
     print(f"target: memory does not grow with the batch: peak RSS {first['peak_rss_kib'] / 1024:.1f} MiB at {first['n']} bags, "
           f"{last['peak_rss_kib'] / 1024:.1f} MiB at {last['n']} ({slope:.2f} KiB peak, {held:.2f} KiB held per bag: "
-          "the report's rows and each picture's 400 points)")
+          "the report's rows and the allocator's retention)")
     results = ROOT / "benchmarks" / "results"
     results.mkdir(parents=True, exist_ok=True)
     (results / "judge.json").write_text(json.dumps({"bag_bytes": size, "timing": timing, "batches": batches,
