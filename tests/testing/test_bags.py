@@ -202,3 +202,19 @@ def test_reading_needs_rosbags_and_says_what_to_install(monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "rosbags", None)
     with pytest.raises(MissingRosbagsError, match=r"pip install 'worldgen\[ros\]'$"):
         read_run(tmp_path / "x")
+
+
+def test_a_bag_without_message_definitions_reads_with_the_release_typestore(world, tmp_path):
+    """Humble's sqlite3 recorder stores no message definitions: the reader falls back to the release's types."""
+    import sqlite3
+
+    truth = along(world)
+    bag = write_bag(tmp_path / "run", world, truth, storage="sqlite3", distro="humble")
+    db = _single_file(bag)
+    with sqlite3.connect(db) as conn:
+        conn.execute("DELETE FROM message_definitions")
+        conn.execute("UPDATE topics SET type_description_hash = ''")
+    for distro in ("humble", None):
+        run = read_run(bag, world, distro=distro)
+        assert run.source == "tf"
+        np.testing.assert_allclose(run.trajectory[:, :3], truth[:, :3], atol=1e-9)
