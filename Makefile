@@ -5,6 +5,7 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 RL_STAMP := $(VENV)/.installed-rl
+ROS_STAMP := $(VENV)/.installed-ros
 DEMO_OUT ?= demo-worlds
 
 .PHONY: demo test bench fuzz clean
@@ -20,6 +21,10 @@ $(TEST_STAMP): $(STAMP)
 
 $(RL_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[rl]'
+	touch $@
+
+$(ROS_STAMP): $(STAMP)
+	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[ros]'
 	touch $@
 
 ## demo: install, then generate worlds from the cluttered generator's defaults, say where they are
@@ -42,14 +47,16 @@ test: $(TEST_STAMP)
 	$(PY) -m pytest -q
 
 ## bench: per-stage medians for cluttered worlds against the serialisation floor, a 1,000-world pack
-## with --jobs 2, then the RL environment's steps/s and reset split, then BARN's metrics against
-## worldgen's (ratios over 40 worlds per generator) and barn_metrics' speed; tables on stdout with each
-## target met or missed, JSON in benchmarks/results/
-bench: $(RL_STAMP)
+## with --jobs 2, the RL environment's steps/s and reset split, BARN's metrics against worldgen's
+## (ratios over 40 worlds per generator) and barn_metrics' speed, then `worldgen judge` on a 60 s bag
+## and its peak memory over batches of 10 to 1,000 bags; tables on stdout with each target met or
+## missed, JSON in benchmarks/results/
+bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_pipeline.py
 	$(PY) benchmarks/bench_pack.py --worlds 1000 --jobs 2
 	$(PY) benchmarks/bench_env.py
 	$(PY) benchmarks/bench_barn.py
+	$(PY) benchmarks/bench_judge.py
 
 ## fuzz: the long fuzz sweep over every generator's full parameter ranges (a table; reproducers of defects)
 fuzz: $(TEST_STAMP)

@@ -1,6 +1,7 @@
-"""A differential-drive robot follows the reference path in 20 cluttered worlds, judged by worldgen.oracles.
+"""A differential-drive robot follows the reference path in 20 cluttered worlds; each run is recorded as a
+ROS 2 bag and the bags are judged by ``worldgen judge``: the loop of a Gazebo + nav2 test, closed without ROS.
 
-    .venv/bin/python examples/diffdrive_mujoco.py [OUT_DIR]
+    .venv/bin/python examples/diffdrive_mujoco.py [OUT_DIR [N_WORLDS]]
 
 Each world's MJCF gets a robot added to it: a cylinder the size of world.json's
 ``robot`` footprint on a planar base (slide x, slide y, hinge yaw) driven by
@@ -11,10 +12,17 @@ It is a pure-pursuit follower of the task's reference path from world.json.
 
 The robot's geom has no contacts in MuJoCo (contype 0): a collision is judged by
 the oracles from the recorded trajectory with FCL, exactly as for a run recorded
-from any other simulator. Every run is then judged by ``evaluate`` against the
-acceptance criteria below and against each world's scenario.yaml; the report is
-printed and written as OUT_DIR/report.csv and OUT_DIR/report.json. The exit
-status is 1 when a criterion fails.
+from any other simulator.
+
+Each run is written as a real rosbag2 bag (mcap storage, Jazzy message definitions;
+needs the ``ros`` extra) with the topics a Gazebo run records: ``/clock``, ``/odom``
+zeroed at the spawn, ``/tf`` (map -> odom, odom -> base_footprint) and the
+controller's ``/cmd_vel`` at its 50 Hz, into OUT_DIR/bags/, the worlds into
+OUT_DIR/worlds/. The bags are then judged as ``worldgen judge OUT_DIR/bags/*
+--pack OUT_DIR/worlds --criteria criteria.yaml --out OUT_DIR/report`` would judge
+them (each bag names its world in its metadata) against the acceptance criteria
+below and each world's scenario.yaml: the report folder holds report.json,
+report.csv, report.md and a picture per run. The exit status is 1 when a criterion fails.
 """
 
 from __future__ import annotations
@@ -30,8 +38,8 @@ import numpy as np
 from lxml import etree
 
 import worldgen
-from worldgen import oracles
 from worldgen.export.xml import safe_parser
+from worldgen.ros import judge, write_report, write_run
 
 CRITERIA = """
 navigation:
@@ -106,8 +114,8 @@ def pursue(path: np.ndarray, xy: np.ndarray, yaw: float, progress: int) -> tuple
     return v, w, progress
 
 
-def drive(world) -> np.ndarray:
-    """Simulate one run; return the recorded (n, 4) ``t, x, y, yaw`` trajectory."""
+def drive(world) -> tuple[np.ndarray, np.ndarray]:
+    """Simulate one run; return the recorded (n, 4) ``t, x, y, yaw`` trajectory and the (m, 3) ``t, v, w`` commands."""
     meta = world.metadata
     task = meta["tasks"][0]
     xml, (x0, y0, yaw0) = with_robot(world.to_mjcf(), meta)
@@ -119,7 +127,7 @@ def drive(world) -> np.ndarray:
     path = np.asarray(task["path"]["waypoints"], dtype=float)
     goal = np.asarray(task["goal"][:2])
     steps = int(task["time_limit"] / model.opt.timestep)
-    progress, rows = 0, []
+    progress, rows, commands = 0, [], []
     for k in range(steps):
         xy = np.array([data.qpos[jx], data.qpos[jy]])
         yaw = float(data.qpos[jyaw])
@@ -129,28 +137,44 @@ def drive(world) -> np.ndarray:
                 break
         if k % CONTROL_EVERY == 0:
             v, w, progress = pursue(path, xy, yaw, progress)
+            commands.append((data.time, v, w))
             data.ctrl[:] = (v * math.cos(yaw), v * math.sin(yaw), w)  # unicycle: no sideways motion
         mujoco.mj_step(model, data)
-    return np.array(rows)
+    commands.append((data.time, 0.0, 0.0))  # the robot is told to stop at the goal
+    return np.array(rows), np.array(commands)
 
 
-def main(out_dir: str) -> int:
+def main(out_dir: str, n_worlds: int = 20) -> int:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    runs = []
-    for seed in range(20):
+    bags = []
+    for seed in range(n_worlds):
         world = worldgen.generate("cluttered", seed=seed, size=[10, 10], n_obstacles=15)
-        runs.append((drive(world), world))
-    report = oracles.evaluate(runs, CRITERIA)
-    print(report)
-    report.write_csv(out / "report.csv")
-    report.write_json(out / "report.json")
-    for line in report.failures:
+        world.write(out / "worlds", preview=False)  # the report draws each run over map.pgm
+        trajectory, commands = drive(world)
+        task = world.metadata["tasks"][0]
+        spawn = task["spawn"]
+        bag = out / "bags" / f"{world.world_id}-{task['id']}-run0"
+        write_run(bag, trajectory, commands=commands, spawn=(spawn[0], spawn[1], spawn[5]), storage="mcap",
+                  distro="jazzy", world_id=world.world_id, task=task["id"], run=bag.name)
+        bags.append(bag)
+    result = judge(bags, CRITERIA, pack=out / "worlds")
+    write_report(result, out / "report")
+    report = result.report
+    for c in report["criteria"]:
+        measured = "n/a" if c["measured"] is None else f"{c['measured']:.6g}"
+        print(f"{c['section'] + '.' + c['key']:<30} {c['op']} {c['required']!s:<8} {measured:<10} "
+              f"{'PASS' if c['passed'] else 'FAIL'}")
+    for line in report["failures"]:
         print("FAILED", line)
-    print(f"20 worlds driven and judged in {time.perf_counter() - start:.1f} s")
-    return 0 if report.passed else 1
+    s = report["summary"]
+    print(f"{s['runs']} runs, {s['successes']} succeeded: {'PASS' if result.passed else 'FAIL'}")
+    print(f"{n_worlds} worlds driven, recorded as bags and judged in {time.perf_counter() - start:.1f} s; "
+          f"report in {out / 'report'}")
+    return 0 if result.passed else 1
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp(prefix="worldgen-diffdrive-")))
+    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp(prefix="worldgen-diffdrive-"),
+                  int(sys.argv[2]) if len(sys.argv) > 2 else 20))

@@ -10,16 +10,16 @@ EXAMPLES = sorted((Path(__file__).resolve().parent.parent / "examples").glob("*.
 
 
 #: Examples that need an optional extra, and the module that tells whether it is installed.
-NEEDS = {"rl_navigation.py": "gymnasium"}
+NEEDS = {"rl_navigation.py": ("gymnasium", "rl"), "diffdrive_mujoco.py": ("rosbags", "ros")}
 
 
 def _need_extra(script: Path) -> None:
     import importlib.util
 
-    module = NEEDS.get(script.name)
+    module, extra = NEEDS.get(script.name, (None, None))
     if module and importlib.util.find_spec(module) is None:
         from support import missing_tool
-        missing_tool(f"{module} (pip install 'worldgen[rl]'), for {script.name}")
+        missing_tool(f"{module} (pip install 'worldgen[{extra}]'), for {script.name}")
 
 
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.name)
@@ -31,15 +31,18 @@ def test_example_runs(script, tmp_path):
 
 
 def test_diffdrive_example_report(tmp_path):
-    """The MuJoCo differential-drive example writes its evaluate() report: 20 runs, every criterion met."""
+    """The MuJoCo differential-drive example records 20 bags and judges them: 20 runs, every criterion met."""
     import json
 
     script = EXAMPLES[0].parent / "diffdrive_mujoco.py"
+    _need_extra(script)
     run = subprocess.run([sys.executable, str(script), str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stdout + run.stderr
-    report = json.loads((tmp_path / "report.json").read_text())
+    report = json.loads((tmp_path / "report" / "report.json").read_text())
     assert report["passed"] is True and report["summary"]["runs"] == 20 and report["summary"]["collision_count"] == 0
-    assert (tmp_path / "report.csv").read_text().startswith("criterion,required,measured,verdict,margin\n")
+    assert report["summary"]["unreadable"] == 0 and {r["source"] for r in report["runs"]} == {"tf"}
+    assert (tmp_path / "report" / "report.csv").read_text().startswith("run,bag,readable,world_id,task,")
+    assert len(list((tmp_path / "bags").iterdir())) == 20
     assert run.stdout.splitlines()[-2] == "20 runs, 20 succeeded: PASS"
 
 

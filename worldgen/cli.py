@@ -283,6 +283,10 @@ cli.add_command(pack_group)
 from worldgen.testing.compare_command import compare_command  # noqa: E402
 
 cli.add_command(compare_command)
+# `worldgen judge` lives in worldgen/testing/commands.py; only wired in here.
+from worldgen.testing.commands import judge_command  # noqa: E402
+
+cli.add_command(judge_command)
 
 
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
