@@ -110,8 +110,12 @@ def test_worlds_named_in_the_bags_metadata_and_a_runs_table(setup, tmp_path):
     table.write_text(f"bag,world,task,run\n{setup['clean']},{setup['world']},task_0,first\n"
                      f"{setup['crash']},{setup['world'].name},,second\n")
     r = run("judge", "--runs", table, "--pack", worlds, "--out", tmp_path / "b")
-    assert r.returncode == 0, r.stderr  # no criteria: nothing to fail
-    assert [row["run"] for row in _report(tmp_path / "b")["runs"]] == ["first", "second"]
+    # No criteria: the gate is that every run meets its scenario, and the crash does not.
+    assert r.returncode == 1, r.stderr
+    report = _report(tmp_path / "b")
+    assert [row["run"] for row in report["runs"]] == ["first", "second"]
+    assert [row["success"] for row in report["runs"]] == [True, False]
+    assert report["failures"][0].startswith("navigation.success_rate: required >= 1, measured 0.5")
 
 
 def test_a_bag_from_another_world_is_an_unreadable_row(setup, tmp_path):

@@ -30,7 +30,8 @@ Examples:
                    "metadata (worldgen.world_id) names.")
 @click.option("--runs", "runs_table", type=click.Path(path_type=Path), metavar="TABLE",
               help="CSV with columns bag, world (id in --pack, or a world folder), optional task, run.")
-@click.option("--criteria", type=click.Path(path_type=Path), metavar="FILE", help="Acceptance criteria (YAML, docs/testing.md).")
+@click.option("--criteria", type=click.Path(path_type=Path), metavar="FILE",
+              help="Acceptance criteria (YAML, docs/testing.md); without it, every run must meet its scenario.")
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="The report folder (created; an earlier report there is replaced).")
 @click.option("--start", type=click.Choice(["command", "goal", "motion", "bag"]), default="command", show_default=True,

@@ -36,7 +36,10 @@ import numpy as np
 from worldgen.errors import ParameterError, WorldgenError, read_user_text
 from worldgen.testing.figures import Ground
 
-__all__ = ["Item", "JudgeResult", "judge", "plan", "PLOT_POINTS"]
+__all__ = ["Item", "JudgeResult", "judge", "plan", "PLOT_POINTS", "DEFAULT_CRITERIA"]
+
+#: The gate when no criteria are given: every run reaches its goal within its time limit and touches nothing.
+DEFAULT_CRITERIA = {"navigation": {"success_rate": 1.0}}
 
 #: Most points of a run kept for its picture (decimated evenly in path length; the figures use every sample).
 PLOT_POINTS = 400
@@ -188,12 +191,16 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     """Read every bag, judge the readable runs with :func:`worldgen.testing.evaluate.evaluate`, and return the report.
 
     ``read_options`` go to :func:`worldgen.testing.bags.read_run` (topic and frame names,
-    ``spawn_tolerance``, ``distro``...). ``progress(k)`` is called after each bag.
+    ``spawn_tolerance``, ``distro``...). ``progress(k)`` is called after each bag. Without
+    ``criteria`` the gate is :data:`DEFAULT_CRITERIA`: every run meets its scenario, so a batch of
+    crashed runs never passes for want of a criteria file.
     """
     from worldgen.testing.bags import read_run
     from worldgen.testing.evaluate import evaluate, load_criteria
 
-    load_criteria(criteria if criteria is not None else {})  # a mistake in the criteria stops before any bag is read
+    if criteria is None:
+        criteria = DEFAULT_CRITERIA
+    load_criteria(criteria)  # a mistake in the criteria stops before any bag is read
     items = plan(bags, world=world, pack=pack, runs=runs)
     options = dict(read_options or {})
     grounds: OrderedDict[Path, _WorldGround] = OrderedDict()
@@ -267,7 +274,7 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
         def chained():
             yield first
             yield from runs_iter
-        judged = evaluate(chained(), criteria if criteria is not None else {}).to_dict()
+        judged = evaluate(chained(), criteria).to_dict()
     return JudgeResult(_assemble(judged, extra), plots, scratch)
 
 
