@@ -1,9 +1,22 @@
 """ROS 2 runs in and out, without a ROS install (optional extra ``ros``: ``pip install 'worldgen[ros]'``).
 
-    >>> from worldgen.ros import read_run, write_run
-    >>> run = read_run("runs/r0.mcap", "worlds/cluttered-s0-1f3a9c0b")   # a BagRun
-    >>> oracles.run(run.trajectory, world)                              # the oracles take its trajectory
-    >>> write_run("runs/r1", trajectory, spawn=(x, y, yaw), storage="sqlite3", distro="humble")
+    >>> import numpy as np, worldgen
+    >>> from worldgen.ros import judge, read_run, write_report, write_run
+    >>> world = worldgen.generate("cluttered", seed=7, size=[8, 8], n_obstacles=6)
+    >>> folder = world.write("worlds", preview=False)
+    >>> path = np.array(world.metadata["tasks"][0]["path"]["waypoints"])      # the reference path
+    >>> t = np.arange(len(path)) * 2.0
+    >>> yaw = np.r_[np.arctan2(*np.diff(path, axis=0).T[::-1]), 0.0]
+    >>> bag = write_run("runs/r0", np.c_[t, path, yaw], spawn=(*path[0], yaw[0]), world_id=world.world_id,
+    ...                 task="task_0", storage="sqlite3", distro="humble")     # a real rosbag2 bag
+    >>> run = read_run(bag, folder)         # the true pose over simulation time, from the TF chain
+    >>> run.source, len(run.trajectory) > 1
+    ('tf', True)
+    >>> result = judge([bag], world=folder)        # every run must meet its scenario without criteria
+    >>> result.passed, result.report["summary"]["successes"]
+    (True, 1)
+    >>> write_report(result, "report").name
+    'report'
 
 The public face of :mod:`worldgen.testing.bags` (the reader) and
 :mod:`worldgen.testing.bagwrite` (the writer); both import rosbags only when called,

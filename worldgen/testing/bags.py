@@ -1,8 +1,10 @@
 """Read a recorded ROS 2 run from a bag into the oracles' trajectory, streaming (optional extra ``ros``).
 
-    >>> run = read_run("runs/r0", "worlds/cluttered-s0-1f3a9c0b")
-    >>> run.trajectory            # (n, 4) t, x, y, yaw in the world frame, t in simulation seconds
-    >>> run.source, run.start     # which pose source was used, and where the run was taken to start
+Usage (an example that runs is in :mod:`worldgen.ros`)::
+
+    run = read_run("runs/r0", "worlds/cluttered-s0-1f3a9c0b")
+    run.trajectory            # (n, 4) t, x, y, yaw in the world frame, t in simulation seconds
+    run.source, run.start     # which pose source was used, and where the run was taken to start
 
 A bag is a rosbag2 folder (metadata.yaml plus its storage files), a single ``.mcap`` or
 ``.db3`` file, or a ROS 1 ``.bag``; read with ``rosbags`` (pure Python, no ROS install).

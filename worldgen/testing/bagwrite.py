@@ -1,6 +1,8 @@
 """Write a run as a real ROS 2 bag, with the topics a Gazebo + nav2 run records (optional extra ``ros``).
 
-    >>> write_run("runs/r0", trajectory, spawn=(x, y, yaw), world_id="cluttered-s0-...", task="t0")
+Usage (an example that runs is in :mod:`worldgen.ros`)::
+
+    write_run("runs/r0", trajectory, spawn=(x, y, yaw), world_id="cluttered-s0-...", task="t0")
 
 ``trajectory`` is the robot's true pose over simulation time, an (n, 4) array of
 ``t, x, y, yaw`` in the world frame (world.json's frame, which is also nav2's

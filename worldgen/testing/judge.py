@@ -1,8 +1,10 @@
 """Recorded bags plus the worlds they ran in, judged against acceptance criteria: ``worldgen judge``.
 
-    >>> result = judge(["runs/r0", "runs/r1"], "criteria.yaml", world="worlds/cluttered-s0-1f3a9c0b")
-    >>> result.passed, result.report["summary"]["unreadable"]
-    >>> write_report(result, "report/")          # worldgen.testing.report
+Usage (an example that runs is in :mod:`worldgen.ros`)::
+
+    result = judge(["runs/r0", "runs/r1"], "criteria.yaml", world="worlds/cluttered-s0-1f3a9c0b")
+    result.passed, result.report["summary"]["unreadable"]
+    write_report(result, "report/")          # worldgen.testing.report
 
 Which world a bag ran in, in order of precedence:
 
