@@ -31,14 +31,15 @@ the goal, -100 on a collision, else ``v/2 - |w|/2 - (1 - r)/2`` near obstacles);
 an episode terminates when the robot's centre is within the task's
 ``goal_tolerance`` of the goal at the end of a step, or at its first contact
 with anything but the floor (MuJoCo contacts, checked every physics step;
-door leaves and movers count); it is truncated at the task's ``time_limit``.
+movers count; door leaves do not: the robot may push a leaf open, and those
+contacts are reported apart, ``door_contacts``); it is truncated at the task's ``time_limit``.
 
 Info: at reset ``world_id``, ``task``, ``reference_path_length`` (the optimal
 path length, world.json ``tasks[].path.length``), ``time_limit``, and
 ``world_seed`` (generated worlds) or ``world_index`` (packs); every step
 ``time``; at an episode's end also the figures of
 :meth:`worldgen.envs.episode.Episode.figures`, under the oracles' names:
-``success``, ``spl``, ``path_length``, ``collisions``, ``min_clearance``,
+``success``, ``spl``, ``path_length``, ``collisions``, ``door_contacts``, ``min_clearance``,
 ``duration``, ``time_to_goal``, ``reached_goal``, ...
 
 Seeding: ``reset(seed=s)`` reseeds two independent streams derived from s (one
