@@ -35,12 +35,14 @@ test: $(TEST_STAMP)
 	$(PY) -m pytest -q
 
 ## bench: per-stage medians for cluttered worlds against the serialisation floor, a 1,000-world pack
-## with --jobs 2, then the RL environment's steps/s and reset split; tables on stdout with each
+## with --jobs 2, then the RL environment's steps/s and reset split, then the difficulty score against
+## the probes' failures over 1,600 worlds (docs/metrics.md); tables on stdout with each
 ## target met or missed, JSON in benchmarks/results/
 bench: $(RL_STAMP)
 	$(PY) benchmarks/bench_pipeline.py
 	$(PY) benchmarks/bench_pack.py --worlds 1000 --jobs 2
 	$(PY) benchmarks/bench_env.py
+	nice -n 10 $(PY) benchmarks/bench_difficulty.py
 
 ## fuzz: the long fuzz sweep over every generator's full parameter ranges (a table; reproducers of defects)
 fuzz: $(TEST_STAMP)

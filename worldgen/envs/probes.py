@@ -10,7 +10,8 @@ their failures (benchmarks/bench_difficulty.py), as BARN names its planners:
   the observation alone (the scan, the goal's distance and bearing) it picks,
   among :data:`HEADINGS` headings, the one closest to the goal's bearing along
   which a corridor as wide as the robot plus :data:`MARGIN` is free for
-  ``min(goal distance, horizon)``; where none is, the freest heading. It turns
+  ``min(goal distance, horizon)`` (1.5 m; failing that, half and a quarter of
+  it), within a right angle of the bearing; where none is, the freest heading. It turns
   toward it and drives at a speed the free distance ahead allows. It is myopic
   on purpose: dead ends, pockets and long detours trap it.
 - :class:`CornerCutter` (``"tracker"``): the path follower with a lookahead of
@@ -78,7 +79,8 @@ class ReactiveProbe:
         along = px * ch + py * sh
         lateral = -px * sh + py * ch
         width = self.radius + MARGIN
-        inside = (np.abs(lateral) < width) & (along > -width)
+        # Only points ahead block a heading: moving away from a point beside or behind never reaches it.
+        inside = (np.abs(lateral) < width) & (along > 0.0)
         # The disc moving along the heading first touches a point at along - sqrt(width^2 - lateral^2).
         reach = along - np.sqrt(np.maximum(width * width - lateral * lateral, 0.0))
         return np.where(inside, reach, self.range_max).min(axis=1, initial=self.range_max)
@@ -89,9 +91,15 @@ class ReactiveProbe:
         scan, distance, bearing = obs[:-4], float(obs[-4]), float(obs[-3])
         free = self.free(scan)
         off = np.abs((self.headings - bearing + math.pi) % (2.0 * math.pi) - math.pi)
-        ok = free >= min(distance, self.horizon)
-        # The free heading nearest the goal's bearing; else the freest, nearer the bearing on a tie.
-        k = int(np.argmin(np.where(ok, off, np.inf))) if ok.any() else int(np.lexsort((off, -free))[0])
+        # The heading nearest the goal's bearing, within a right angle of it, that is free for min(goal distance,
+        # horizon); failing that, for half and a quarter of the horizon (a corridor's bend); else the freest
+        # heading, nearer the bearing on a tie (it turns back only when nothing goal-ward is free).
+        k = int(np.lexsort((off, -free))[0])
+        for reach in (self.horizon, self.horizon / 2.0, self.horizon / 4.0):
+            ok = (free >= min(distance, reach)) & (off <= math.pi / 2.0)
+            if ok.any():
+                k = int(np.argmin(np.where(ok, off, np.inf)))
+                break
         err = float(self.headings[k])
         w = float(np.clip(self.gain * err, -self.w_max, self.w_max))
         if abs(err) > self.turn_in_place:
