@@ -218,7 +218,8 @@ def validate(records: list[dict]) -> dict:
         per_gen = {}
         for g in out["generators"]:
             sel = np.array([r["generator"] == g for r in rows])
-            per_gen[g] = {"success": round(float((~fail[sel]).mean()), 3), "auc": round(auc(d[sel], fail[sel]), 3)}
+            a = auc(d[sel], fail[sel])  # undefined (None) where every world failed or none did
+            per_gen[g] = {"success": round(float((~fail[sel]).mean()), 3), "auc": None if math.isnan(a) else round(a, 3)}
         out["probes"][probe] = {"failures": int(fail.sum()), "spearman": round(float(rho), 3),
                                 "auc": round(auc(d, fail), 3), "per_level": per_level, "per_generator": per_gen}
     return out
