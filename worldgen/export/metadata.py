@@ -88,6 +88,8 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
     meta["metrics"].update(difficulty.assess(meta))
     if world.preset:
         meta["preset"] = world.preset
+    if getattr(world, "difficulty_request", None):
+        meta["difficulty_request"] = world.difficulty_request
     return _plain(meta)
 
 
