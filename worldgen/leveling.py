@@ -31,7 +31,7 @@ from worldgen.floats import finite_or_none
 from worldgen.groundtruth import difficulty, truth
 from worldgen.seeding import level_seed
 
-__all__ = ["LEVELS", "MAX_DRAWS", "STEP", "START", "MAX_KNOB", "KNOBS", "parse_level", "score",
+__all__ = ["LEVELS", "MAX_DRAWS", "STEP", "START", "MAX_KNOB", "KNOBS", "parse_level", "check_request", "score",
            "generate_at_level"]
 
 #: Levels of world.json's ``difficulty_level``.
@@ -83,9 +83,9 @@ def score(world) -> dict:
     return difficulty.assess(meta)
 
 
-def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any]):
-    """A world of generator ``name`` at the level ``level_value`` asks for (see the module); ``generate`` is
-    :func:`worldgen.generate`."""
+def check_request(name: str, level_value: Any, params: Mapping[str, Any]) -> tuple[int, str]:
+    """(level, knob) of a request for ``level_value`` from generator ``name`` with ``params``; one-line
+    ParameterError for a bad level, a generator without a knob, or a knob the caller also set."""
     level = parse_level(level_value)
     knob = KNOBS.get(name)
     if knob is None:
@@ -95,6 +95,13 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         if params.get(fixed) is not None:
             raise ParameterError(f"parameter 'difficulty' sets {knob} itself; leave out {fixed!r} "
                                  f"(got {fixed}={quoted(params[fixed])})")
+    return level, knob
+
+
+def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any]):
+    """A world of generator ``name`` at the level ``level_value`` asks for (see the module); ``generate`` is
+    :func:`worldgen.generate`."""
+    level, knob = check_request(name, level_value, params)
     size = params.get("size", (10.0, 10.0))
     area = float(size[0]) * float(size[1]) if isinstance(size, (list, tuple)) and len(size) == 2 else 100.0
     scale = area / 100.0

@@ -79,12 +79,12 @@ class NavigationEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
     def __init__(self, generator: Optional[str] = None, params: Optional[dict] = None, preset: Optional[str] = None,
-                 pack=None, render_mode: Optional[str] = None, **settings: Any):
+                 pack=None, render_mode: Optional[str] = None, difficulty: Optional[str] = None, **settings: Any):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"parameter 'render_mode' must be one of None, "
                                  f"{', '.join(self.metadata['render_modes'])}, got {render_mode!r}")
         self.config = cfg = resolve(settings)
-        self.source = make_source(generator, params, preset, pack)
+        self.source = make_source(generator, params, preset, pack, difficulty)  # difficulty: "7/10" (worldgen.leveling)
         self.render_mode = render_mode
         self.metadata = dict(self.metadata, render_fps=1.0 / cfg.control_period)
         self.lidar = Lidar(cfg.lidar_beams, cfg.lidar_fov, cfg.lidar_angle_min, cfg.lidar_range_min,

@@ -109,7 +109,7 @@ class GeneratorSource:
     """A fresh world per episode from ``generator`` and ``params`` (or a preset), checked up front."""
 
     def __init__(self, generator: Optional[str] = None, params: Optional[Mapping[str, Any]] = None,
-                 preset: Optional[str] = None):
+                 preset: Optional[str] = None, difficulty: Any = None):
         from worldgen.generators import get
 
         if params is not None and not isinstance(params, Mapping):
@@ -128,6 +128,12 @@ class GeneratorSource:
         self.generator = generator
         self.params = params
         get(generator).resolve(params)  # bad parameters fail now, not at the first reset
+        #: A difficulty level every world is drawn at ("7/10", worldgen.leveling), or None.
+        self.difficulty = difficulty
+        if difficulty is not None:
+            from worldgen.leveling import check_request
+
+            check_request(generator, difficulty, params)
 
     def __len__(self) -> int:
         return 0  # unbounded: any seed
@@ -135,7 +141,7 @@ class GeneratorSource:
     def world(self, seed: int) -> EpisodeWorld:
         from worldgen.api import generate
 
-        world = generate(self.generator, seed, **self.params)
+        world = generate(self.generator, seed, difficulty=self.difficulty, **self.params)
         world.preset = self.preset
         return episode_world(world)
 
@@ -194,12 +200,13 @@ class PackSource:
         return parse_bytes(world.to_mjcf().encode()).getroot()
 
 
-def make_source(generator=None, params=None, preset=None, pack=None):
+def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):
     """The source for the environment's arguments: a pack, a preset, a generator; the ``drl_arena`` preset by default."""
     if pack is not None:
-        if generator is not None or preset is not None or params:
-            raise ParameterError("parameter 'pack' excludes 'generator', 'preset' and 'params': a pack's worlds are fixed")
+        if generator is not None or preset is not None or params or difficulty is not None:
+            raise ParameterError("parameter 'pack' excludes 'generator', 'preset', 'params' and 'difficulty': "
+                                 "a pack's worlds are fixed")
         return PackSource(pack)
     if generator is None and preset is None:
         preset = "drl_arena"
-    return GeneratorSource(generator, params, preset)
+    return GeneratorSource(generator, params, preset, difficulty)
