@@ -44,6 +44,8 @@ def test_the_same_request_gives_the_same_world_from_the_cli_in_another_process(t
     meta = json.loads((folder / "world.json").read_text())
     assert meta["world_id"] == worldgen.generate("cluttered", seed=3, difficulty="7/10").world_id
     assert meta["metrics"]["difficulty_level"] == 7 and meta["difficulty_request"]["level"] == "7/10"
+    checked = run("check", folder)  # a received world at a level re-verifies, its request included
+    assert checked.returncode == 0, checked.stdout + checked.stderr
 
 
 @pytest.mark.parametrize("generator, params, message", [
