@@ -13,7 +13,7 @@ from collections import Counter
 from typing import Any
 
 from worldgen import feasibility
-from worldgen.errors import InfeasibleError
+from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.generators import Draft, get, robot_from_params
 from worldgen.generators.infeasible import wall_in_goals
 from worldgen.generators.movers import place_movers
@@ -25,16 +25,25 @@ from worldgen.world import World
 __all__ = ["generate"]
 
 
-def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, **params: Any) -> World:
+def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, difficulty: Any = None,
+             **params: Any) -> World:
     """Generate, check and return one world; no disk I/O.
 
     Raises :class:`~worldgen.errors.ParameterError` for bad parameters and
     :class:`~worldgen.errors.InfeasibleError` when ``max_attempts`` draws all
     failed a check. With ``allow_infeasible`` the last failed draw that has a
     scene is returned instead, its ``feasibility`` saying why (for negative tests).
+    ``difficulty`` (``"7/10"``) asks for a world at that ``metrics.difficulty_level``
+    (:mod:`worldgen.leveling`: the cluttered generator).
     """
     spec = get(name)
     seed = check_seed(seed)
+    if difficulty is not None:
+        if allow_infeasible:
+            raise ParameterError("parameter 'difficulty' asks for a drivable world; it excludes allow_infeasible")
+        from worldgen.leveling import generate_at_level
+
+        return generate_at_level(generate, spec.name, seed, difficulty, params)
     try:
         resolved = spec.resolve(params)
     except InfeasibleError:

@@ -169,6 +169,9 @@ def parameter_tables(specs) -> str:
               help="SDFormat version: 1.9 (Gazebo Fortress to Harmonic) or 1.6 (Gazebo classic).")
 @click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
               help="Number of worlds, one per consecutive seed.")
+@click.option("--difficulty", "level", default=None, metavar="K/10",
+              help="A world at difficulty level K of 10 (world.json metrics.difficulty_level; the cluttered "
+                   "generator), e.g. --difficulty 7/10; world.json's difficulty_request says how it was reached.")
 @click.option("--allow-infeasible", is_flag=True,
               help="For negative tests: where no draw passes, write the last checked one; "
                    "its world.json says feasible false and which checks failed.")
@@ -182,7 +185,8 @@ def parameter_tables(specs) -> str:
                    f"[default: {DEFAULT_GZ_RELEASE}].")
 def generate_command(generator: Optional[str], seed: int, settings: Sequence[str], out: Path, formats: str,
                      sdf_version: str, count: int, allow_infeasible: bool, overwrite: bool = False,
-                     preset_name: Optional[str] = None, ros: bool = False, gz_release: Optional[str] = None) -> None:
+                     preset_name: Optional[str] = None, ros: bool = False, gz_release: Optional[str] = None,
+                     level: Optional[str] = None) -> None:
     """Generate, check and write worlds of GENERATOR.
 
     Prints one line per world: its folder, the reference path length of each
@@ -213,7 +217,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         raise ParameterError(f"parameter 'count' must be in [1, {MAX_SEED - seed + 1}] for seed {seed}, got {count}")
     _check_out(out)
     for s in range(seed, seed + count):
-        world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, **params)
+        world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, difficulty=level, **params)
         world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
         folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
                              ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)

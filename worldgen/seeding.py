@@ -10,6 +10,7 @@ draw ``k`` of a world           ``(k,)``                      ``api.generate``, 
 its movers                      ``(k, MOVER_STREAM)``         ``generators.movers``
 an environment's worlds         ``(WORLD_STREAM,)``           ``envs.navigation`` (reset's seed)
 an environment's sensor noise   ``(NOISE_STREAM,)``           ``envs.navigation`` (reset's seed)
+draw ``k`` towards a level      ``(LEVEL_STREAM, k)``         ``leveling`` (a world asked for at a level)
 a recipe's sampled parameter    ``[seed, entry, tag(name)]``  ``pack.recipe`` (entropy, no key)
 ==============================  ============================  =====================================
 
@@ -30,7 +31,8 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 
-__all__ = ["MAX_SEED", "MOVER_STREAM", "WORLD_STREAM", "NOISE_STREAM", "check_seed", "attempt_rng", "mover_rng",
+__all__ = ["MAX_SEED", "MOVER_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "level_seed",
+           "check_seed", "attempt_rng", "mover_rng",
            "env_rngs", "draw_seed", "recipe_rng"]
 
 #: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
@@ -40,6 +42,8 @@ MAX_SEED = 2**63 - 1
 MOVER_STREAM = 0x6D6F76
 #: Keys of the two streams an environment derives from a reset's seed.
 WORLD_STREAM, NOISE_STREAM = 0, 1
+#: Key of the seeds of the draws towards a difficulty level ("lvl").
+LEVEL_STREAM = 0x6C766C
 
 
 def check_seed(seed: Any, what: str = "parameter 'seed'") -> int:
@@ -67,6 +71,11 @@ def mover_rng(seed: int, attempt: int) -> np.random.Generator:
 def env_rngs(entropy: int) -> tuple[np.random.Generator, np.random.Generator]:
     """An environment's (world seeds, sensor noise) streams for a reset's seed."""
     return _stream(entropy, WORLD_STREAM), _stream(entropy, NOISE_STREAM)
+
+
+def level_seed(seed: int, draw: int) -> int:
+    """The world seed of draw ``draw`` of a request for a level with ``seed`` (worldgen.leveling)."""
+    return draw_seed(_stream(seed, LEVEL_STREAM, draw))
 
 
 def draw_seed(rng: np.random.Generator) -> int:

@@ -151,6 +151,13 @@ def _regenerate(meta: dict):
     except WorldgenError as exc:
         raise _Fail("regenerate", f"{meta['generator']} seed {meta['seed']} with the recorded params: {exc}") from None
     world.preset = meta.get("preset")  # not a parameter: where the world came from (world.json and folder name)
+    request = meta.get("difficulty_request")  # not a parameter either: how a world at a level was drawn
+    if request:
+        last = request["draws"][-1] if request.get("draws") else {}
+        if (last.get("seed"), last.get(request.get("knob"))) != (meta["seed"], meta["params"].get(request.get("knob"))):
+            raise _Fail("regenerate", "difficulty_request's last draw is not this world's seed and "
+                                      f"{request.get('knob')}")
+        world.difficulty_request = request
     if world.content_hash != meta["content_hash"]:
         raise _Fail("regenerate", f"content_hash {_h(world.content_hash)} regenerated, "
                                   f"{_h(meta['content_hash'])} recorded{_versions(meta)}")

@@ -41,6 +41,8 @@ class World:
         self.allow_infeasible = bool(allow_infeasible)
         self.path: Optional[Path] = None  # the folder once written
         self.preset: Optional[str] = None
+        #: How a world asked for at a difficulty level was reached (worldgen.leveling); None otherwise.
+        self.difficulty_request: Optional[dict] = None
         self._texts: dict[tuple, str] = {}  # export()'s renderings, by (format, SDF version)
 
     def __repr__(self) -> str:

@@ -17,6 +17,11 @@ the oracles' own functions from the recorded trajectory; ``min_clearance`` is
 their FCL distance from the footprint to every collider along it (negative: a
 contact's depth). ``collisions`` are MuJoCo's contacts, which also ended the
 episode.
+
+A door leaf (the world's ``door_leaves``) is a hinged body the robot may push
+open, as the world's truth plans through doors at their open limit: a contact
+with a leaf is no collision; it goes to ``door_contacts`` instead (the same
+``{time, entity}`` records), and it neither ends the episode nor fails it.
 """
 
 from __future__ import annotations
@@ -45,6 +50,9 @@ class Episode:
         self.world = world
         self.rows: list[tuple[float, float, float, float]] = [(0.0, x, y, yaw)]
         self.contacts: list[Contact] = []
+        #: Contacts with door leaves (pushed open, not collisions).
+        self.door_contacts: list[Contact] = []
+        self._leaves: frozenset = getattr(world, "door_leaves", frozenset())
         #: The entities the robot touched at the last physics step checked.
         self.touching: frozenset = frozenset()
         self.done = False
@@ -53,11 +61,13 @@ class Episode:
         self.rows.append((t, x, y, yaw))
 
     def touch(self, t: float, entities: frozenset) -> bool:
-        """Note the entities the robot touches at time ``t``; True when a contact begins."""
+        """Note the entities the robot touches at time ``t``; True when a collision (not a door leaf) begins."""
         new = sorted(entities - self.touching)
         self.touching = entities
-        self.contacts.extend(Contact(float(t), name) for name in new)
-        return bool(new)
+        hits = [name for name in new if name not in self._leaves]
+        self.contacts.extend(Contact(float(t), name) for name in hits)
+        self.door_contacts.extend(Contact(float(t), name) for name in new if name in self._leaves)
+        return bool(hits)
 
     @property
     def trajectory(self) -> np.ndarray:
@@ -83,7 +93,8 @@ class Episode:
             path_efficiency=length / ref if ref > 0 else None,
             min_clearance=oracles.min_clearance(traj, ground), collisions=tuple(self.contacts),
             min_separation=oracles.min_separation(traj, ground),
-            max_velocity=float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0)
+            max_velocity=float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0,
+            door_contacts=tuple(self.door_contacts))
         limit: Optional[float] = task.get("time_limit")
         # evaluate's rule (worldgen.testing.evaluate): the goal, within the scenario's max_time, and no collision.
         ok = bool(run.reached_goal and not run.collisions and (limit is None or run.time_to_goal <= limit))

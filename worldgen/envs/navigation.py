@@ -31,14 +31,15 @@ the goal, -100 on a collision, else ``v/2 - |w|/2 - (1 - r)/2`` near obstacles);
 an episode terminates when the robot's centre is within the task's
 ``goal_tolerance`` of the goal at the end of a step, or at its first contact
 with anything but the floor (MuJoCo contacts, checked every physics step;
-door leaves and movers count); it is truncated at the task's ``time_limit``.
+movers count; door leaves do not: the robot may push a leaf open, and those
+contacts are reported apart, ``door_contacts``); it is truncated at the task's ``time_limit``.
 
 Info: at reset ``world_id``, ``task``, ``reference_path_length`` (the optimal
 path length, world.json ``tasks[].path.length``), ``time_limit``, and
 ``world_seed`` (generated worlds) or ``world_index`` (packs); every step
 ``time``; at an episode's end also the figures of
 :meth:`worldgen.envs.episode.Episode.figures`, under the oracles' names:
-``success``, ``spl``, ``path_length``, ``collisions``, ``min_clearance``,
+``success``, ``spl``, ``path_length``, ``collisions``, ``door_contacts``, ``min_clearance``,
 ``duration``, ``time_to_goal``, ``reached_goal``, ...
 
 Seeding: ``reset(seed=s)`` reseeds two independent streams derived from s (one
@@ -78,12 +79,12 @@ class NavigationEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
     def __init__(self, generator: Optional[str] = None, params: Optional[dict] = None, preset: Optional[str] = None,
-                 pack=None, render_mode: Optional[str] = None, **settings: Any):
+                 pack=None, render_mode: Optional[str] = None, difficulty: Optional[str] = None, **settings: Any):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"parameter 'render_mode' must be one of None, "
                                  f"{', '.join(self.metadata['render_modes'])}, got {render_mode!r}")
         self.config = cfg = resolve(settings)
-        self.source = make_source(generator, params, preset, pack)
+        self.source = make_source(generator, params, preset, pack, difficulty)  # difficulty: "7/10" (worldgen.leveling)
         self.render_mode = render_mode
         self.metadata = dict(self.metadata, render_fps=1.0 / cfg.control_period)
         self.lidar = Lidar(cfg.lidar_beams, cfg.lidar_fov, cfg.lidar_angle_min, cfg.lidar_range_min,

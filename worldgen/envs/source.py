@@ -33,7 +33,9 @@ class EpisodeWorld:
     ``task`` has world.json's ``tasks[]`` shape (``spawn``, ``goal``,
     ``goal_tolerance``, ``path`` with ``waypoints`` and ``length``,
     ``time_limit``); ``movers`` world.json's ``dynamic_obstacles[]`` shape;
-    ``floor`` the names of the floor geoms (contacts with them are no collision).
+    ``floor`` the names of the floor geoms (contacts with them are no collision);
+    ``door_leaves`` the names of the door leaves (world.json ``doors[].name``, each
+    a hinged body the robot may push open: touching one is a door contact, not a collision).
     """
 
     world_id: str
@@ -47,6 +49,7 @@ class EpisodeWorld:
     _ground: Callable[[], Any] = field(repr=False)
     _metadata: Callable[[], dict] = field(repr=False)
     _cache: dict = field(default_factory=dict, repr=False)
+    door_leaves: frozenset = frozenset()
 
     @property
     def reference_path_length(self) -> float:
@@ -90,20 +93,23 @@ def episode_world(world) -> EpisodeWorld:
     task = _task_of_world(world)
     movers = [mover_entry(m, world.params) for m in world.scene.movers]
     robot = world.robot
+    leaves = frozenset(n.name for n in world.scene.nodes if n.role == "door")
     light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": movers,
-             "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance}}
+             "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
+             "doors": [{"name": name} for name in sorted(leaves)]}
     return EpisodeWorld(
         world_id=world.world_id, mjcf=parse_bytes(world.to_mjcf().encode()).getroot(), robot=robot,
         task=task, movers=movers, floor=frozenset(n.name for n in world.scene.nodes if n.role == "floor"),
         lidar_height=float(world.params.get("lidar_height", 0.3)), params=dict(world.params),
-        _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}))
+        _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}),
+        door_leaves=leaves)
 
 
 class GeneratorSource:
     """A fresh world per episode from ``generator`` and ``params`` (or a preset), checked up front."""
 
     def __init__(self, generator: Optional[str] = None, params: Optional[Mapping[str, Any]] = None,
-                 preset: Optional[str] = None):
+                 preset: Optional[str] = None, difficulty: Any = None):
         from worldgen.generators import get
 
         if params is not None and not isinstance(params, Mapping):
@@ -122,6 +128,12 @@ class GeneratorSource:
         self.generator = generator
         self.params = params
         get(generator).resolve(params)  # bad parameters fail now, not at the first reset
+        #: A difficulty level every world is drawn at ("7/10", worldgen.leveling), or None.
+        self.difficulty = difficulty
+        if difficulty is not None:
+            from worldgen.leveling import check_request
+
+            check_request(generator, difficulty, params)
 
     def __len__(self) -> int:
         return 0  # unbounded: any seed
@@ -129,7 +141,7 @@ class GeneratorSource:
     def world(self, seed: int) -> EpisodeWorld:
         from worldgen.api import generate
 
-        world = generate(self.generator, seed, **self.params)
+        world = generate(self.generator, seed, difficulty=self.difficulty, **self.params)
         world.preset = self.preset
         return episode_world(world)
 
@@ -172,7 +184,8 @@ class PackSource:
             task=task, movers=list(meta.get("dynamic_obstacles") or []),
             floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
             lidar_height=float(params.get("lidar_height", 0.3)), params=params,
-            _ground=lambda: ground_of(pw), _metadata=lambda: meta)
+            _ground=lambda: ground_of(pw), _metadata=lambda: meta,
+            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []))
 
     @staticmethod
     def _regenerated_mjcf(pw, meta):
@@ -187,12 +200,13 @@ class PackSource:
         return parse_bytes(world.to_mjcf().encode()).getroot()
 
 
-def make_source(generator=None, params=None, preset=None, pack=None):
+def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):
     """The source for the environment's arguments: a pack, a preset, a generator; the ``drl_arena`` preset by default."""
     if pack is not None:
-        if generator is not None or preset is not None or params:
-            raise ParameterError("parameter 'pack' excludes 'generator', 'preset' and 'params': a pack's worlds are fixed")
+        if generator is not None or preset is not None or params or difficulty is not None:
+            raise ParameterError("parameter 'pack' excludes 'generator', 'preset', 'params' and 'difficulty': "
+                                 "a pack's worlds are fixed")
         return PackSource(pack)
     if generator is None and preset is None:
         preset = "drl_arena"
-    return GeneratorSource(generator, params, preset)
+    return GeneratorSource(generator, params, preset, difficulty)

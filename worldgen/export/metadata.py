@@ -21,7 +21,7 @@ import shapely
 from worldgen.export.formats import movers_note
 from worldgen.export.tasks import task_entry
 from worldgen.floats import finite_or_none, round_float
-from worldgen.groundtruth import truth
+from worldgen.groundtruth import difficulty, truth
 from worldgen.scene.doors import door_records
 from worldgen.scene.footprint import scene_footprints
 
@@ -85,8 +85,12 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "occupancy": truth.occupancy_block(world),
         "files": {key: {"path": path, "sha256": digest} for key, (path, digest) in sorted(files.items())},
     }
+    # The score reads the figures above (metrics, robot, tasks), as it would from a written world.json.
+    meta["metrics"].update(difficulty.assess(meta))
     if world.preset:
         meta["preset"] = world.preset
+    if getattr(world, "difficulty_request", None):
+        meta["difficulty_request"] = world.difficulty_request
     return _plain(meta)
 
 

@@ -31,7 +31,7 @@ from worldgen.files import METADATA_NAME
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "min_separation", "run", "BARN_K", "BARN_REFERENCE_SPEED", "barn_score",
+    "collisions", "door_contacts", "min_separation", "run", "BARN_K", "BARN_REFERENCE_SPEED", "barn_score",
 ]
 
 
@@ -179,8 +179,25 @@ def collisions(trajectory, world) -> list[Contact]:
     A contact is reported once, at the first sample where it begins; the same
     entity touched again after a gap is a second contact. A mover is touched
     where its disc, at the sample's time, meets the footprint's (gap <= 0, as
-    FCL counts touching).
+    FCL counts touching). A door leaf (world.json ``doors[].name``) is not a
+    collision: a robot may push it open, the way the reference path goes through
+    its doorway; :func:`door_contacts` reports those contacts.
     """
+    leaves = _leaves(load(world))
+    return [c for c in _contacts(trajectory, world) if c.entity not in leaves]
+
+
+def door_contacts(trajectory, world) -> list[Contact]:
+    """The contacts of :func:`collisions`' kind with door leaves, each leaf where it starts (pushed, not hit)."""
+    leaves = _leaves(load(world))
+    return [c for c in _contacts(trajectory, world) if c.entity in leaves] if leaves else []
+
+
+def _leaves(ground: Ground) -> frozenset:
+    return frozenset(str(d["name"]) for d in ground.meta.get("doors") or [])
+
+
+def _contacts(trajectory, world) -> list[Contact]:
     ground = load(world)
     pts = _samples(as_trajectory(trajectory), ground)
     col = ground.colliders
@@ -253,10 +270,13 @@ class Run:
     max_velocity: float
     #: The task's exact reference path length (m); None where the world has no proven path.
     reference_length: Optional[float] = None
+    #: Contacts with door leaves (pushed open: not collisions).
+    door_contacts: tuple[Contact, ...] = ()
 
     def as_dict(self) -> dict[str, Any]:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
-        d["collisions"] = [{"time": c.time, "entity": c.entity} for c in self.collisions]
+        for key in ("collisions", "door_contacts"):
+            d[key] = [{"time": c.time, "entity": c.entity} for c in getattr(self, key)]
         return d
 
 
@@ -271,14 +291,16 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
     step = np.hypot(*np.diff(traj[:, 1:], axis=0).T)
     moving = dt > 0
     vmax = float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0
+    contacts, leaves = _contacts(traj, ground), _leaves(ground)  # FCL once, split as collisions() and door_contacts()
     return Run(
         world_id=str(ground.meta.get("world_id", "")), task=t["id"],
         reached_goal=reached_goal(traj, ground, task), time_to_goal=time_to_goal(traj, ground, task),
         duration=float(traj[-1, 0] - traj[0, 0]), path_length=length,
         path_efficiency=(length / float(ref)) if ref else None,
-        min_clearance=min_clearance(traj, ground), collisions=tuple(collisions(traj, ground)),
+        min_clearance=min_clearance(traj, ground), collisions=tuple(c for c in contacts if c.entity not in leaves),
         min_separation=min_separation(traj, ground), max_velocity=vmax,
         reference_length=float(ref) if ref else None,
+        door_contacts=tuple(c for c in contacts if c.entity in leaves),
     )
 
 

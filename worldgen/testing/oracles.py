@@ -29,6 +29,7 @@ from worldgen.testing.figures import (
     as_trajectory,
     barn_score,
     collisions,
+    door_contacts,
     load,
     min_clearance,
     min_separation,
@@ -42,5 +43,5 @@ from worldgen.testing.figures import (
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "min_separation", "run", "evaluate", "barn_score",
+    "collisions", "door_contacts", "min_separation", "run", "evaluate", "barn_score",
 ]

@@ -1,0 +1,66 @@
+"""Worlds at a requested difficulty level (worldgen.leveling): in the level, deterministic, recorded, regenerable."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from support.cli import run, world_dirs
+
+import worldgen
+from worldgen.errors import ParameterError
+from worldgen.export import metadata
+from worldgen.seeding import level_seed
+
+
+def test_a_world_asked_for_at_a_level_is_at_that_level_and_says_how_it_got_there():
+    world = worldgen.generate("cluttered", seed=3, difficulty="7/10")
+    meta = world.metadata
+    assert meta["metrics"]["difficulty_level"] == 7 and 0.6 <= meta["metrics"]["difficulty"] < 0.7
+    req = meta["difficulty_request"]
+    assert (req["level"], req["seed"], req["knob"]) == ("7/10", 3, "n_obstacles")
+    draws = req["draws"]
+    assert [d["seed"] for d in draws] == [level_seed(3, k) for k in range(len(draws))]
+    assert [d["level"] for d in draws][-1] == 7 and 7 not in [d["level"] for d in draws[:-1]]
+    last = draws[-1]
+    assert (world.seed, world.params["n_obstacles"], meta["metrics"]["difficulty"]) == \
+        (last["seed"], last["n_obstacles"], last["difficulty"])
+    metadata.validate(meta)
+    # An ordinary world: its seed and params regenerate it without the request.
+    again = worldgen.generate("cluttered", world.seed, **{k: world.params[k] for k in ("n_obstacles",)})
+    assert again.content_hash == world.content_hash and "difficulty_request" not in again.metadata
+
+
+@pytest.mark.parametrize("level", [1, 4, 9])
+def test_levels_across_the_range_land(level):
+    world = worldgen.generate("cluttered", seed=0, difficulty=f"{level}/10")
+    assert world.metadata["metrics"]["difficulty_level"] == level
+
+
+def test_the_same_request_gives_the_same_world_from_the_cli_in_another_process(tmp_path):
+    done = run("generate", "cluttered", "--difficulty", "7/10", "--seed", "3", "--out", tmp_path)
+    assert done.returncode == 0, done.stderr
+    (folder,) = world_dirs(tmp_path)
+    meta = json.loads((folder / "world.json").read_text())
+    assert meta["world_id"] == worldgen.generate("cluttered", seed=3, difficulty="7/10").world_id
+    assert meta["metrics"]["difficulty_level"] == 7 and meta["difficulty_request"]["level"] == "7/10"
+    checked = run("check", folder)  # a received world at a level re-verifies, its request included
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+
+
+@pytest.mark.parametrize("generator, params, message", [
+    ("cluttered", {"difficulty": "11/10"}, "parameter 'difficulty' must be a level 'k/10' with k in 1..10 (or the integer k), got '11/10'"),
+    ("cluttered", {"difficulty": "3/5"}, "parameter 'difficulty' must be a level 'k/10'"),
+    ("cluttered", {"difficulty": "7/10", "n_obstacles": 5}, "parameter 'difficulty' sets n_obstacles itself; leave out 'n_obstacles'"),
+    ("corridor", {"difficulty": "2/10"}, "parameter 'difficulty' is offered by the generators cluttered, not by 'corridor'"),
+])
+def test_bad_requests_are_one_line(generator, params, message):
+    with pytest.raises(ParameterError) as err:
+        worldgen.generate(generator, 0, **params)
+    assert message in str(err.value) and "\n" not in str(err.value)
+
+
+def test_the_cli_refuses_a_bad_level_with_exit_2(tmp_path):
+    done = run("generate", "cluttered", "--difficulty", "0/10", "--out", tmp_path)
+    assert done.returncode == 2 and done.stderr.strip().splitlines()[-1].startswith("error: parameter 'difficulty'")
+    assert world_dirs(tmp_path) == []
