@@ -228,3 +228,17 @@ def test_scenario_yaml_bytes_do_not_depend_on_libyaml(monkeypatch):
     monkeypatch.delattr(yaml, "CSafeDumper", raising=False)
     assert scenario.dumps(spec) == fast
     monkeypatch.setattr(scenario, "_DUMPER", None)  # the next caller gets libyaml again
+
+
+def test_a_run_through_a_closed_door_keeps_its_clearance_to_everything_but_the_leaf(tmp_path):
+    """The reference path pushes the leaf open: the leaf is a door contact, not a collision, and the
+    clearance is the proven path's to the walls and frames (the leaf where it started is left out)."""
+    world = worldgen.generate("door", 2)
+    task = world.metadata["tasks"][0]
+    assert task["requires_door_open"]
+    path = np.asarray(task["path"]["waypoints"])
+    trajectory = np.c_[np.arange(len(path), dtype=float), path]
+    for where in (world, world.write(tmp_path, preview=False)):
+        assert oracles.collisions(trajectory, where) == []
+        assert [c.entity for c in oracles.door_contacts(trajectory, where)] == ["door_0"]
+        assert oracles.min_clearance(trajectory, where) == pytest.approx(task["path"]["min_clearance"], abs=1e-4)

@@ -51,6 +51,7 @@ class Ground:
         self._scene = scene
         self._read = read  # a file of the world by its relative path (meshes), where there is no scene
         self._colliders = None
+        self._fixed_colliders = None
 
     @property
     def robot(self):
@@ -73,6 +74,26 @@ class Ground:
             from worldgen.feasibility.collision import Colliders
             self._colliders = Colliders(self._scene) if self._scene is not None else _entity_colliders(self.meta, self._read)
         return self._colliders
+
+    @property
+    def fixed_colliders(self):
+        """The colliders less the door leaves and what hangs on them: what no robot moves by pushing."""
+        leaves = _leaves(self)
+        if not leaves:
+            return self.colliders
+        if self._fixed_colliders is None:
+            from worldgen.feasibility.collision import Colliders
+            if self._scene is not None:
+                from worldgen.scene import Scene
+                scene = self._scene
+                kept = tuple(n for n in scene.nodes if not _on_leaf(scene, n, leaves))
+                names = {n.name for n in kept} | {"world"}
+                joints = tuple(j for j in scene.joints if j.parent in names and j.child in names)
+                self._fixed_colliders = Colliders(Scene(kept, joints, scene.bounds, scene.physics, scene.movers))
+            else:
+                meta = dict(self.meta, entities=[e for e in self.meta["entities"] if e["name"] not in leaves])
+                self._fixed_colliders = _entity_colliders(meta, self._read)
+        return self._fixed_colliders
 
 
 def load(world) -> Ground:
@@ -163,14 +184,19 @@ def _samples(traj: np.ndarray, ground: Ground) -> np.ndarray:
 
 
 def min_clearance(trajectory, world) -> float:
-    """Smallest FCL distance (m) from the footprint to any collider along the run; negative = FCL contact depth."""
+    """Smallest FCL distance (m) from the footprint to any collider along the run; negative = FCL contact depth.
+
+    Door leaves are left out, as from :func:`collisions`: a robot may push one open, and a leaf where it
+    started says nothing about a leaf that swung (its contacts are :func:`door_contacts`).
+    """
     ground = load(world)
     pts = _samples(as_trajectory(trajectory), ground)
-    best = float(ground.colliders.nearest(ground.robot, pts[:, 1:], expect=ground.robot.clearance).distance)
+    fixed = ground.fixed_colliders
+    best = float(fixed.nearest(ground.robot, pts[:, 1:], expect=ground.robot.clearance).distance)
     if best > 0:
         return best
     # FCL's signed distance reads ~0 for a cylinder inside a box: take its contact depth instead.
-    return min(best, -max((depth for _, _, depth in _touching(pts, ground)), default=0.0))
+    return min(best, -max((depth for _, _, depth in _touching(pts, ground, fixed)), default=0.0))
 
 
 def collisions(trajectory, world) -> list[Contact]:
@@ -191,6 +217,15 @@ def door_contacts(trajectory, world) -> list[Contact]:
     """The contacts of :func:`collisions`' kind with door leaves, each leaf where it starts (pushed, not hit)."""
     leaves = _leaves(load(world))
     return [c for c in _contacts(trajectory, world) if c.entity in leaves] if leaves else []
+
+
+def _on_leaf(scene, node, leaves) -> bool:
+    """Whether ``node`` is a door leaf or hangs on one (a handle)."""
+    while node is not None:
+        if node.name in leaves:
+            return True
+        node = scene.node(node.parent) if node.parent else None
+    return False
 
 
 def _leaves(ground: Ground) -> frozenset:
@@ -225,9 +260,10 @@ def _mover_gaps(pts: np.ndarray, ground: Ground) -> np.ndarray:
     return gaps
 
 
-def _touching(pts: np.ndarray, ground: Ground):
-    """(sample index, collider index, FCL penetration depth) of every touching pair."""
-    col, robot = ground.colliders, ground.robot
+def _touching(pts: np.ndarray, ground: Ground, colliders=None):
+    """(sample index, collider index, FCL penetration depth) of every touching pair (of ``colliders``,
+    by default every collider of the world)."""
+    col, robot = colliders if colliders is not None else ground.colliders, ground.robot
     if len(col) == 0:
         return
     # Only pairs whose box bound says they could touch are asked of FCL.
