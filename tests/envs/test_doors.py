@@ -9,23 +9,9 @@ oracles judge the recorded run the same way.
 from __future__ import annotations
 
 import pytest
-from support import missing_tool
+from support.envs import ENV_ID, gymnasium
 
 import worldgen
-
-try:
-    import gymnasium
-except ImportError:  # pragma: no cover - exercised on machines without the extra
-    gymnasium = None
-
-ENV_ID = "worldgen/Navigation-v0"
-
-
-@pytest.fixture(autouse=True)
-def _gymnasium():
-    if gymnasium is None:
-        missing_tool("gymnasium (pip install 'worldgen[rl]')")
-    import worldgen.envs  # noqa: F401  (registers the id)
 
 
 def follow(env, seed):

@@ -1,7 +1,7 @@
 """worldgen.envs: the Gymnasium navigation environment (worldgen/Navigation-v0).
 
 Gymnasium is an optional extra (``rl``, also in ``test``): these tests skip where it is
-missing, except under CI, where they fail (conftest.missing_tool).
+missing, except under CI, where they fail (tests/envs/conftest.py).
 """
 
 from __future__ import annotations
@@ -13,25 +13,7 @@ import textwrap
 
 import numpy as np
 import pytest
-from support import missing_tool
-
-try:
-    import gymnasium
-except ImportError:  # pragma: no cover - exercised on machines without the extra
-    gymnasium = None
-
-ENV_ID = "worldgen/Navigation-v0"
-
-
-@pytest.fixture(autouse=True)
-def _gymnasium():
-    if gymnasium is None:
-        missing_tool("gymnasium (pip install 'worldgen[rl]')")
-    import worldgen.envs  # noqa: F401  (registers the id)
-
-
-def make(**kwargs):
-    return gymnasium.make(ENV_ID, **kwargs).unwrapped
+from support.envs import ENV_ID, gymnasium, make
 
 
 def run_python(code: str, timeout: int = 120) -> subprocess.CompletedProcess:

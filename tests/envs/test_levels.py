@@ -3,24 +3,10 @@
 from __future__ import annotations
 
 import pytest
-from support import missing_tool
+from support.envs import ENV_ID, gymnasium
 
 import worldgen
 from worldgen.errors import ParameterError
-
-try:
-    import gymnasium
-except ImportError:  # pragma: no cover - exercised on machines without the extra
-    gymnasium = None
-
-ENV_ID = "worldgen/Navigation-v0"
-
-
-@pytest.fixture(autouse=True)
-def _gymnasium():
-    if gymnasium is None:
-        missing_tool("gymnasium (pip install 'worldgen[rl]')")
-    import worldgen.envs  # noqa: F401  (registers the id)
 
 
 def test_every_episode_is_a_world_at_the_level_asked_for():

@@ -6,27 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from support import missing_tool
+from support.envs import make
 
 from worldgen.errors import ParameterError
-
-try:
-    import gymnasium
-except ImportError:  # pragma: no cover - exercised on machines without the extra
-    gymnasium = None
-
-ENV_ID = "worldgen/Navigation-v0"
-
-
-@pytest.fixture(autouse=True)
-def _gymnasium():
-    if gymnasium is None:
-        missing_tool("gymnasium (pip install 'worldgen[rl]')")
-    import worldgen.envs  # noqa: F401  (registers the id)
-
-
-def make(**kwargs):
-    return gymnasium.make(ENV_ID, **kwargs).unwrapped
 
 
 def actions(env, probe, seed):

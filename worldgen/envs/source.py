@@ -88,7 +88,7 @@ def episode_world(world) -> EpisodeWorld:
     """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
     from worldgen.export.metadata import mover_entry
     from worldgen.export.xml import parse_bytes
-    from worldgen.testing.figures import Ground
+    from worldgen.testing.ground import Ground
 
     task = _task_of_world(world)
     movers = [mover_entry(m, world.params) for m in world.scene.movers]
@@ -168,7 +168,7 @@ class PackSource:
 
         from worldgen.export.xml import safe_parser
         from worldgen.scene import Robot as _Robot
-        from worldgen.testing.figures import load as ground_of
+        from worldgen.testing.ground import load as ground_of
 
         pw = self.pack[index]
         meta = pw.metadata

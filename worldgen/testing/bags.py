@@ -150,7 +150,7 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
         raise fail(path, "does not exist")
     spawn = None
     if world is not None:
-        from worldgen.testing.figures import load
+        from worldgen.testing.ground import load
         spawn = np.asarray(load(world).task(task)["spawn"], dtype=float)[[0, 1, 5]]
     try:
         source, meta = storage(path)

@@ -37,8 +37,9 @@ from typing import Any, Iterable, Mapping, Optional, Union
 from worldgen.errors import ParameterError
 from worldgen.files import SCENARIO_NAME
 from worldgen.testing.criteria import CRITERIA, SCORING, load_criteria
-from worldgen.testing.figures import Run, barn_score, load
+from worldgen.testing.figures import Run, barn_score
 from worldgen.testing.figures import run as run_figures
+from worldgen.testing.ground import load
 
 __all__ = ["CRITERIA", "AVERAGED_OVER", "Criterion", "Report", "load_criteria", "evaluate", "scenario_of"]
 

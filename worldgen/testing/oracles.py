@@ -24,13 +24,11 @@ from __future__ import annotations
 from worldgen.testing.evaluate import evaluate
 from worldgen.testing.figures import (
     Contact,
-    Ground,
     Run,
     as_trajectory,
     barn_score,
     collisions,
     door_contacts,
-    load,
     min_clearance,
     min_separation,
     path_efficiency,
@@ -39,6 +37,7 @@ from worldgen.testing.figures import (
     run,
     time_to_goal,
 )
+from worldgen.testing.ground import Ground, load
 
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",

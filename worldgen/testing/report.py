@@ -125,7 +125,7 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
     from PIL import Image, ImageDraw
 
     from worldgen.export.preview_frame import text_font
-    from worldgen.testing.figures import load
+    from worldgen.testing.ground import load
 
     found = _map(Path(world))
     if found is None:

@@ -1,0 +1,135 @@
+"""What the oracles know of one world: its world.json, and FCL colliders built once, on first use.
+
+A world is a :class:`~worldgen.World` (its scene is used), a world of a built pack
+(:class:`~worldgen.PackWorld`, folder or archive) or a written world folder; without a scene the
+colliders are rebuilt from world.json's entities, exactly as the feasibility check places them.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Callable, Optional
+
+import numpy as np
+
+from worldgen.errors import ParameterError
+from worldgen.files import METADATA_NAME
+
+__all__ = ["Ground", "load", "leaves_of"]
+
+
+class Ground:
+    """What the oracles need of one world: world.json, and FCL colliders built once (on first use)."""
+
+    def __init__(self, meta: dict, scene=None, read: Optional[Callable[[str], bytes]] = None):
+        self.meta = meta
+        self._scene = scene
+        self._read = read  # a file of the world by its relative path (meshes), where there is no scene
+        self._colliders = None
+        self._fixed_colliders = None
+
+    @property
+    def robot(self):
+        from worldgen.scene import Robot
+        r = self.meta["robot"]
+        return Robot(float(r["radius"]), float(r["height"]), float(r["clearance"]))
+
+    def task(self, task: Optional[str] = None) -> dict:
+        tasks = self.meta["tasks"]
+        if task is None:
+            return tasks[0]
+        for t in tasks:
+            if t["id"] == task:
+                return t
+        raise ParameterError(f"parameter 'task' must be one of {', '.join(t['id'] for t in tasks)}, got {task!r}")
+
+    @property
+    def colliders(self):
+        if self._colliders is None:
+            from worldgen.feasibility.collision import Colliders
+            self._colliders = Colliders(self._scene) if self._scene is not None else _entity_colliders(self.meta, self._read)
+        return self._colliders
+
+    @property
+    def fixed_colliders(self):
+        """The colliders less the door leaves and what hangs on them: what no robot moves by pushing."""
+        leaves = leaves_of(self)
+        if not leaves:
+            return self.colliders
+        if self._fixed_colliders is None:
+            from worldgen.feasibility.collision import Colliders
+            if self._scene is not None:
+                from worldgen.scene import Scene
+                scene = self._scene
+                kept = tuple(n for n in scene.nodes if not _on_leaf(scene, n, leaves))
+                names = {n.name for n in kept} | {"world"}
+                joints = tuple(j for j in scene.joints if j.parent in names and j.child in names)
+                self._fixed_colliders = Colliders(Scene(kept, joints, scene.bounds, scene.physics, scene.movers))
+            else:
+                meta = dict(self.meta, entities=[e for e in self.meta["entities"] if e["name"] not in leaves])
+                self._fixed_colliders = _entity_colliders(meta, self._read)
+        return self._fixed_colliders
+
+
+def load(world) -> Ground:
+    """A :class:`Ground` for a World, a PackWorld, a world folder (str/Path) or a Ground (returned as is)."""
+    if isinstance(world, Ground):
+        return world
+    scene = getattr(world, "scene", None)
+    if scene is not None and hasattr(world, "metadata"):
+        return Ground(world.metadata, scene=scene)
+    if hasattr(world, "metadata") and hasattr(world, "read"):  # a PackWorld, in a folder or an archive
+        return Ground(world.metadata, read=world.read)
+    if isinstance(world, (str, Path)):
+        folder = Path(world)
+        path = folder / METADATA_NAME if folder.is_dir() else folder
+        try:
+            meta = json.loads(path.read_text())
+        except (OSError, ValueError) as exc:
+            raise ParameterError(f"parameter 'world' must be a World or a world folder with world.json, "
+                                 f"got {str(world)!r} ({exc})") from None
+        return Ground(meta, read=lambda rel: (path.parent / rel).read_bytes())
+    raise ParameterError(f"parameter 'world' must be a World, a PackWorld or a world folder, got {type(world).__name__}")
+
+
+def leaves_of(ground: Ground) -> frozenset:
+    """The names of the world's door leaves (world.json ``doors[].name``)."""
+    return frozenset(str(d["name"]) for d in ground.meta.get("doors") or [])
+
+
+def _on_leaf(scene, node, leaves) -> bool:
+    """Whether ``node`` is a door leaf or hangs on one (a handle)."""
+    while node is not None:
+        if node.name in leaves:
+            return True
+        node = scene.node(node.parent) if node.parent else None
+    return False
+
+
+def _entity_colliders(meta: dict, read: Callable[[str], bytes]):
+    """The same Colliders the feasibility check uses, rebuilt from world.json's entities."""
+    from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere
+
+    nodes = []
+    for e in meta["entities"]:
+        if e["role"] in ("floor", "marker"):
+            continue
+        s = e["shape"]
+        if s["type"] == "box":
+            shape = Box(tuple(s["size"]))
+        elif s["type"] == "cylinder":
+            shape = Cylinder(s["radius"], s["length"])
+        elif s["type"] == "sphere":
+            shape = Sphere(s["radius"])
+        else:
+            import io
+
+            import trimesh
+            mesh = trimesh.load(io.BytesIO(read(s["uri"])), file_type=Path(s["uri"]).suffix.lstrip("."), force="mesh")
+            shape = Mesh(s["uri"], np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64),
+                         tuple(s.get("scale", (1.0, 1.0, 1.0))))
+        # world.json poses are world-frame, so every node becomes a root node here.
+        nodes.append(Node(e["name"], e["role"], shape, Pose(*e["pose"])))
+    from worldgen.feasibility.collision import Colliders
+    return Colliders(Scene(tuple(nodes)))
