@@ -6,6 +6,9 @@ visited in order and joined by straight lines walked at constant speed. The
 first row is at t = 0. When ``loop`` is true the script repeats after its last
 row; worldgen's movers end where they start, so the repetition is seamless.
 
+A person (``person=True``, docs/people.md) is a mover whose trajectory was walked by the
+crowd model rather than scripted: it does not loop, and world.json lists it under ``people``.
+
 Movers are not nodes: they carry no static collision geometry, the static
 feasibility check ignores them, and each exporter writes them its own way
 (SDF actor, MJCF mocap body, left out of URDF).
@@ -36,6 +39,7 @@ class Mover:
     trajectory: tuple[tuple[float, float, float], ...]
     loop: bool = True
     friction: float = 1.0
+    person: bool = False
 
     def __post_init__(self):
         if not NAME_PATTERN.match(self.name):
@@ -54,6 +58,7 @@ class Mover:
             raise SceneError(f"mover {self.name!r}: trajectory times must strictly increase")
         object.__setattr__(self, "trajectory", rows)
         object.__setattr__(self, "loop", bool(self.loop))
+        object.__setattr__(self, "person", bool(self.person))
 
     @property
     def period(self) -> float:
@@ -61,7 +66,8 @@ class Mover:
         return self.trajectory[-1][0]
 
     def canonical(self) -> dict:
-        return {
+        # "person" only where true, so that worlds with scripted movers keep their hashes.
+        return ({"person": True} if self.person else {}) | {
             "name": self.name,
             "radius": round_float(self.radius),
             "height": round_float(self.height),

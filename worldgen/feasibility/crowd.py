@@ -1,0 +1,284 @@
+"""The crowd model: people walking from place to place by the social force model, at a fixed step.
+
+Helbing & Molnár, "Social force model for pedestrian dynamics", Phys. Rev. E 51, 4282 (1995).
+Each person ``a`` accelerates as
+
+    dv_a/dt = (v0_a e_a - v_a) / tau  +  sum_b w(e_a, r_b - r_a) f_ab  +  sum_B f_aB
+
+- ``e_a``: the unit direction to the next waypoint of a path planned for the person's disc by the
+  exact planner (:mod:`~worldgen.feasibility.planner`); a waypoint is passed when the next one is in
+  sight (checked every :data:`LOOK` steps), and the path is planned again from where the person
+  stands when its waypoint has been out of sight for :data:`REPLAN` checks;
+- ``f_ab = -grad V(b)``, ``V = V0 exp(-(b - 2 r) / sigma)``, ``b`` the semi-minor axis of the
+  ellipse of the paper (``2 b = sqrt((|r_ab| + |r_ab - v_b dt_h|)^2 - |v_b dt_h|^2)``), less the two
+  radii: the paper's pedestrians are points, ours discs;
+- ``w = 1`` when the other person is within ``phi`` of ``e_a``, else ``c``;
+- ``f_aB = (U0 / R) exp(-gap / R)`` along the normal from the nearest point of obstacle ``B``, with
+  ``gap`` the exact distance from the person's edge to the footprint (or to the floor's edge).
+
+Integration is semi-implicit Euler at ``dt``, speeds capped at ``1.3 v0`` (the paper's v_max).
+Then the geometry is enforced, not hoped for: a step whose straight segment would bring the disc
+within ``radius + 2 SLACK`` of a footprint (exact segment distances) or the floor's edge is halved
+up to four times, else not taken, and the velocity set to the step actually made. So every
+position, and every point between two rows of the written trajectory, keeps the person's disc off
+every obstacle. People may still touch each other: the model makes it rare, nothing forbids it.
+
+:func:`simulate` is a pure function of its arguments: no randomness, same inputs, same rows.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Mapping, Optional, Sequence
+
+import numpy as np
+
+from worldgen.feasibility.cspace import ConfigSpace
+from worldgen.feasibility.geometry import Obstacles2D
+from worldgen.feasibility.planner import Planner
+from worldgen.floats import round_float
+from worldgen.generators.people import PERSON_HEIGHT, SLACK, draw_people, people_footprints
+from worldgen.scene import Mover, Robot, Scene, Task
+
+__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "simulate", "walk_people"]
+
+#: The integration step (s); the trajectories are written at it.
+DT = 0.1
+#: Steps between two looks ahead (is the next waypoint in sight?).
+LOOK = 5
+#: Looks with the waypoint out of sight before the path is planned again from where the person is.
+REPLAN = 4
+#: Distance (m) at which a waypoint counts as reached.
+ARRIVE = 0.2
+
+
+@dataclass(frozen=True)
+class SocialForce:
+    """The model's parameters, Helbing & Molnár (1995) values (docs/people.md)."""
+
+    tau: float = 0.5  # relaxation time, s
+    v0: float = 2.1  # V0 of the person-person potential, m^2/s^2
+    sigma: float = 0.3  # its range, m
+    u0: float = 10.0  # U0 of the obstacle potential, m^2/s^2
+    r: float = 0.2  # its range R, m
+    horizon: float = 2.0  # dt_h: how far ahead the other's step is anticipated, s
+    phi: float = math.radians(100.0)  # half the field of view, rad
+    c: float = 0.5  # weight of what is outside the field of view
+    v_max_ratio: float = 1.3  # v_max = 1.3 v0
+
+
+class _Walls:
+    """The footprints as arrays for nearest points: discs, polygon edges (grouped by polygon), the bounds."""
+
+    def __init__(self, obstacles: Obstacles2D, bounds):
+        self.obstacles = obstacles
+        self.disc_xy, self.disc_r = obstacles.disc_xy, obstacles.disc_r
+        self.ea, self.eb = obstacles.edge_a, obstacles.edge_b
+        self.ab = self.eb - self.ea
+        self.ab2 = np.maximum(np.einsum("ij,ij->i", self.ab, self.ab), 1e-300)
+        self.starts = obstacles.edge_start[:-1]
+        self.owner = obstacles.edge_owner
+        (self.x0, self.y0), (self.x1, self.y1) = bounds
+
+    def near(self, p: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
+        """(gap (n, m), unit normal away from the obstacle (n, m, 2)) to each disc, polygon and floor edge."""
+        gaps, dirs = [], []
+        if len(self.disc_r):
+            d = p[:, None, :] - self.disc_xy[None]
+            dist = np.sqrt(np.einsum("nmk,nmk->nm", d, d))
+            gaps.append(dist - self.disc_r[None] - radius)
+            dirs.append(d / np.maximum(dist, 1e-12)[..., None])
+        if len(self.starts):
+            ap = p[:, None, :] - self.ea[None]
+            t = np.clip(np.einsum("nmk,mk->nm", ap, self.ab) / self.ab2, 0.0, 1.0)
+            q = self.ea[None] + t[..., None] * self.ab[None]
+            d = p[:, None, :] - q
+            dist = np.sqrt(np.einsum("nmk,nmk->nm", d, d))
+            best = np.minimum.reduceat(dist, self.starts, axis=1)
+            # The nearest point of each polygon: of the edges that reach the minimum (two at a corner,
+            # which share it), their nearest points averaged.
+            hit = (dist <= best[:, self.owner] + 1e-12).astype(float)
+            q_best = np.add.reduceat(q * hit[..., None], self.starts, axis=1) / np.add.reduceat(
+                hit, self.starts, axis=1)[..., None]
+            d = p[:, None, :] - q_best
+            gaps.append(best - radius)
+            dirs.append(d / np.maximum(best, 1e-12)[..., None])
+        x, y = p[:, 0], p[:, 1]
+        gaps.append(np.stack([x - self.x0, self.x1 - x, y - self.y0, self.y1 - y], axis=1) - radius)
+        unit = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+        dirs.append(np.broadcast_to(unit, (len(p), 4, 2)))
+        return np.concatenate(gaps, axis=1), np.concatenate(dirs, axis=1)
+
+    def segments_keep(self, a: np.ndarray, b: np.ndarray, keep: float) -> np.ndarray:
+        """(m,) bool: every point of segment a[i]b[i] is at least ``keep`` from every footprint and the floor's edge."""
+        d, _ = self.obstacles.segments_distance(a, b, keep)
+        inside = ((np.minimum(a[:, 0], b[:, 0]) >= self.x0 + keep) & (np.maximum(a[:, 0], b[:, 0]) <= self.x1 - keep)
+                  & (np.minimum(a[:, 1], b[:, 1]) >= self.y0 + keep) & (np.maximum(a[:, 1], b[:, 1]) <= self.y1 - keep))
+        return inside & (d >= keep)
+
+
+class _Router:
+    """Each person's places and the planned path to the current one; ``target`` the waypoint steered to."""
+
+    def __init__(self, planner: Planner, starts: np.ndarray, places: np.ndarray):
+        self.planner, self.places = planner, places
+        n = len(starts)
+        self.place = np.full(n, -1)
+        self.route: list[np.ndarray] = [np.zeros((0, 2))] * n
+        self.way = np.zeros(n, dtype=np.int64)
+        self.unseen = np.zeros(n, dtype=np.int64)
+        self.done = np.zeros(n, dtype=bool)
+        self.target = starts.copy()
+        for i in range(n):
+            self._next_place(i, starts[i])
+
+    def _next_place(self, i: int, at: np.ndarray) -> None:
+        """Plan from ``at`` to the next place that can be reached; done when none is left."""
+        while self.place[i] + 1 < self.places.shape[1]:
+            self.place[i] += 1
+            if self._plan(i, at):
+                return
+        self.done[i] = True
+        self.target[i] = at
+
+    def _plan(self, i: int, at: np.ndarray) -> bool:
+        route = self.planner.shortest(at, self.places[i, self.place[i]])
+        if route is None:
+            return False
+        self.route[i], self.way[i], self.unseen[i] = route.points[1:], 0, 0
+        self.target[i] = self.route[i][0]
+        return True
+
+    def update(self, p: np.ndarray, step: int) -> None:
+        """Pass reached waypoints; every LOOK steps, skip to a waypoint in sight or plan again."""
+        reached = ~self.done & (np.hypot(*(self.target - p).T) < ARRIVE)
+        for i in np.flatnonzero(reached):
+            self._advance(i, p[i])
+        if step % LOOK:
+            return
+        live = np.flatnonzero(~self.done)
+        if not len(live):
+            return
+        cs = self.planner.cs
+        ahead = np.array([self.route[i][min(self.way[i] + 1, len(self.route[i]) - 1)] for i in live])
+        for i in live[cs.segments_clear(p[live], ahead)]:
+            if self.way[i] + 1 < len(self.route[i]):
+                self.way[i] += 1
+                self.target[i] = self.route[i][self.way[i]]
+        in_sight = cs.segments_clear(p[live], self.target[live])
+        self.unseen[live[in_sight]] = 0
+        blind = live[~in_sight]
+        self.unseen[blind] += 1  # looks in a row with the waypoint out of sight
+        for i in blind[self.unseen[blind] >= REPLAN]:
+            if cs.points_clearance(p[i][None])[0] > 0 and self._plan(i, p[i]):
+                continue
+            self.unseen[i] = 0
+
+    def _advance(self, i: int, at: np.ndarray) -> None:
+        if self.way[i] + 1 < len(self.route[i]):
+            self.way[i] += 1
+            self.target[i] = self.route[i][self.way[i]]
+        else:
+            self._next_place(i, at)
+
+
+def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndarray, speeds: np.ndarray,
+             radius: float, duration: float, dt: float = DT, model: SocialForce = SocialForce()) -> np.ndarray:
+    """(steps + 1, n, 2) positions of the people at t = 0, dt, 2 dt, ... up to ``duration``.
+
+    ``obstacles`` are what people walk round (:func:`worldgen.generators.people.people_footprints`
+    as :class:`Obstacles2D`), ``starts`` (n, 2) free for the disc of ``radius + 2 SLACK``,
+    ``places`` (n, k, 2) each person's places in order, ``speeds`` (n,) preferred speeds (m/s).
+    """
+    starts = np.asarray(starts, dtype=float).reshape(-1, 2)
+    n = len(starts)
+    steps = int(round(duration / dt))
+    out = np.zeros((steps + 1, n, 2))
+    out[0] = starts
+    if n == 0:
+        return out
+    walls = _Walls(obstacles, bounds)
+    router = _Router(Planner(ConfigSpace.build(obstacles, radius + SLACK, bounds)), starts, places)
+    keep = radius + 2 * SLACK
+    v_max = model.v_max_ratio * np.asarray(speeds, dtype=float)
+    p, v = starts.copy(), np.zeros((n, 2))
+    cos_phi = math.cos(model.phi)
+    for k in range(1, steps + 1):
+        router.update(p, k - 1)
+        to = router.target - p
+        dist = np.hypot(to[:, 0], to[:, 1])
+        e = np.where(dist[:, None] > 1e-9, to / np.maximum(dist, 1e-9)[:, None], 0.0)
+        v0 = np.where(router.done, 0.0, speeds)
+        acc = (v0[:, None] * e - v) / model.tau
+        acc += _people_force(p, v, e, radius, model, cos_phi)
+        gaps, normals = walls.near(p, radius)
+        acc += np.einsum("nm,nmk->nk", (model.u0 / model.r) * np.exp(-np.maximum(gaps, 0.0) / model.r), normals)
+        v_new = v + dt * acc
+        speed = np.hypot(v_new[:, 0], v_new[:, 1])
+        v_new *= np.minimum(1.0, v_max / np.maximum(speed, 1e-12))[:, None]
+        p_new = _keep_off(walls, p, p + dt * v_new, gaps.min(axis=1) - 2 * SLACK, keep)
+        v = (p_new - p) / dt
+        p = out[k] = p_new
+    return out
+
+
+def _people_force(p: np.ndarray, v: np.ndarray, e: np.ndarray, radius: float, m: SocialForce,
+                  cos_phi: float) -> np.ndarray:
+    """(n, 2) the sum over the others of w f_ab, the elliptic repulsion of Helbing & Molnár."""
+    n = len(p)
+    if n < 2:
+        return np.zeros((n, 2))
+    r_ab = p[:, None, :] - p[None, :, :]
+    s = np.broadcast_to(m.horizon * v[None, :, :], r_ab.shape)
+    rs = r_ab - s
+    n1 = np.maximum(np.sqrt(np.einsum("abk,abk->ab", r_ab, r_ab)), 1e-9)
+    n2 = np.maximum(np.sqrt(np.einsum("abk,abk->ab", rs, rs)), 1e-9)
+    sn2 = np.einsum("abk,abk->ab", s, s)
+    b = 0.5 * np.sqrt(np.maximum((n1 + n2) ** 2 - sn2, 1e-18))
+    grad = ((n1 + n2) / (4 * b))[..., None] * (r_ab / n1[..., None] + rs / n2[..., None])
+    mag = (m.v0 / m.sigma) * np.exp(np.minimum(-(b - 2 * radius) / m.sigma, 20.0))
+    seen = np.einsum("ak,abk->ab", e, -r_ab) >= n1 * cos_phi
+    w = np.where(seen, 1.0, m.c)
+    np.fill_diagonal(w, 0.0)
+    return np.einsum("ab,abk->ak", w * mag, grad)
+
+
+def _keep_off(walls: _Walls, p: np.ndarray, p_new: np.ndarray, room: np.ndarray, keep: float) -> np.ndarray:
+    """The steps shortened (halved up to four times, else not taken) where the disc would come within
+    ``keep`` of a footprint; ``room`` (n,) how far each may move with no test (its exact gap)."""
+    length = np.hypot(*(p_new - p).T)
+    check = np.flatnonzero(length >= room)
+    if not len(check):
+        return p_new
+    out = p_new.copy()
+    for share in (1.0, 0.5, 0.25, 0.125, 0.0625):
+        if not len(check):
+            break
+        trial = p[check] + share * (p_new[check] - p[check])
+        ok = walls.segments_keep(p[check], trial, keep)
+        out[check[ok]] = trial[ok]
+        check = check[~ok]
+    out[check] = p[check]
+    return out
+
+
+def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping[str, Any],
+                rng: np.random.Generator) -> tuple[tuple[Mover, ...], Optional[str]]:
+    """The people of ``params`` drawn (:func:`~worldgen.generators.people.draw_people`) and walked:
+    (movers with ``person=True``, None), or ((), reason) when they do not fit."""
+    plan, reason = draw_people(scene, tasks, robot, params, rng)
+    if plan is None:
+        return (), reason
+    obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot))
+    track = simulate(obstacles, scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius, plan.duration)
+    times = [round_float(k * DT) for k in range(len(track))]
+    people = []
+    for i in range(track.shape[1]):
+        xy = np.round(track[:, i, :], 6)
+        # A person standing still needs only the first and last row of the stay.
+        still = np.all(xy[1:-1] == xy[:-2], axis=1) & np.all(xy[1:-1] == xy[2:], axis=1)
+        keep = np.r_[True, ~still, True]
+        rows = tuple((times[k], float(xy[k, 0]), float(xy[k, 1])) for k in np.flatnonzero(keep))
+        people.append(Mover(f"person_{i}", plan.radius, PERSON_HEIGHT, rows, False, params["friction"], person=True))
+    return tuple(people), None
