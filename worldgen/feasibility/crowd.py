@@ -8,15 +8,19 @@ Each person ``a`` accelerates as
 - ``e_a``: the unit direction to the next waypoint of a path planned for the person's disc by the
   exact planner (:mod:`~worldgen.feasibility.planner`); a waypoint is passed when the next one is in
   sight (checked every :data:`LOOK` steps), and the path is planned again from where the person
-  stands when its waypoint has been out of sight for :data:`REPLAN` checks;
+  stands when its waypoint has been out of sight for :data:`REPLAN` checks; a person who has moved
+  less than :data:`STUCK` m a look for ``2 x REPLAN`` looks in a row (held by others or by a wall's
+  push near a place) gives that place up and walks to the next;
 - ``f_ab = -grad V(b)``, ``V = V0 exp(-(b - 2 r) / sigma)``, ``b`` the semi-minor axis of the
   ellipse of the paper (``2 b = sqrt((|r_ab| + |r_ab - v_b dt_h|)^2 - |v_b dt_h|^2)``), less the two
   radii: the paper's pedestrians are points, ours discs;
 - ``w = 1`` when the other person is within ``phi`` of ``e_a``, else ``c``;
-- ``f_aB = (U0 / R) exp(-gap / R)`` along the normal from the nearest point of obstacle ``B``, with
-  ``gap`` the exact distance from the person's edge to the footprint (or to the floor's edge).
+- ``f_aB = (U0 / R) exp(-d / R)`` along the normal from the nearest point of obstacle ``B``, with
+  ``d`` the exact distance from the person's centre to the footprint (or to the floor's edge), as in
+  the paper (the disc itself is kept off by the correction below).
 
-Integration is semi-implicit Euler at ``dt``, speeds capped at ``1.3 v0`` (the paper's v_max).
+Integration is semi-implicit Euler at ``dt``, speeds capped at ``1.3 v0`` (the paper's v_max). A
+person past its last place stands still there, an obstacle the others walk round.
 Then the geometry is enforced, not hoped for: a step whose straight segment would bring the disc
 within ``radius + 2 SLACK`` of a footprint (exact segment distances) or the floor's edge is halved
 up to four times, else not taken, and the velocity set to the step actually made. So every
@@ -41,7 +45,7 @@ from worldgen.floats import round_float
 from worldgen.generators.people import PERSON_HEIGHT, SLACK, draw_people, people_footprints
 from worldgen.scene import Mover, Robot, Scene, Task
 
-__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "simulate", "walk_people"]
+__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "simulate", "walk_people"]
 
 #: The integration step (s); the trajectories are written at it.
 DT = 0.1
@@ -51,6 +55,8 @@ LOOK = 5
 REPLAN = 4
 #: Distance (m) at which a waypoint counts as reached.
 ARRIVE = 0.2
+#: Least distance (m) a walking person covers between two looks before it counts as held up.
+STUCK = 0.1
 
 
 @dataclass(frozen=True)
@@ -128,6 +134,8 @@ class _Router:
         self.route: list[np.ndarray] = [np.zeros((0, 2))] * n
         self.way = np.zeros(n, dtype=np.int64)
         self.unseen = np.zeros(n, dtype=np.int64)
+        self.held = np.zeros(n, dtype=np.int64)
+        self.last = starts.copy()
         self.done = np.zeros(n, dtype=bool)
         self.target = starts.copy()
         for i in range(n):
@@ -158,6 +166,15 @@ class _Router:
         if step % LOOK:
             return
         live = np.flatnonzero(~self.done)
+        if not len(live):
+            return
+        moved = np.hypot(*(p - self.last).T) >= STUCK
+        self.held = np.where(moved, 0, self.held + 1)
+        self.last = p.copy()
+        for i in live[self.held[live] >= 2 * REPLAN]:
+            self.held[i] = 0
+            self._next_place(i, p[i])
+        live = live[~self.done[live]]
         if not len(live):
             return
         cs = self.planner.cs
@@ -213,10 +230,11 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
         acc = (v0[:, None] * e - v) / model.tau
         acc += _people_force(p, v, e, radius, model, cos_phi)
         gaps, normals = walls.near(p, radius)
-        acc += np.einsum("nm,nmk->nk", (model.u0 / model.r) * np.exp(-np.maximum(gaps, 0.0) / model.r), normals)
+        acc += np.einsum("nm,nmk->nk", (model.u0 / model.r) * np.exp(-(gaps + radius) / model.r), normals)
         v_new = v + dt * acc
         speed = np.hypot(v_new[:, 0], v_new[:, 1])
         v_new *= np.minimum(1.0, v_max / np.maximum(speed, 1e-12))[:, None]
+        v_new[router.done] = 0.0  # at the last place a person stands there (a still obstacle to the others)
         p_new = _keep_off(walls, p, p + dt * v_new, gaps.min(axis=1) - 2 * SLACK, keep)
         v = (p_new - p) / dt
         p = out[k] = p_new
