@@ -1,17 +1,18 @@
 """The certificate among people: a timed path along the proven static path that no person comes near.
 
 Method (docs/people.md): the robot keeps to its task's proven static path (its polyline, which
-keeps ``robot.clearance`` from every obstacle) and only chooses *when* to be where along it. Arc
-length is cut into cells ``ds = max_speed x DT / CELLS_PER_STEP`` (the last one shorter, ending at
-the goal), time into steps of :data:`DT`; a cell is blocked at a step when the robot's centre
-there is closer than ``robot.inflation + person radius + margin`` to any person's centre, with
-``margin = MARGIN + w DT / 2`` and ``w`` the robot's top speed plus the fastest any person walks:
-two positions that far apart at both ends of a step cannot come closer than ``inflation + radius
-+ MARGIN`` in between, the robot moving along its path at constant speed. The robot may wait,
-go ahead or back by up to ``CELLS_PER_STEP`` cells a step (so never faster than ``max_speed``);
-a forward sweep over the steps keeps the set of cells it can be in (a dilation, then the
-step's free cells), and the first step the goal's cell is reachable is the arrival time. The
-path is read back from the stored sets.
+keeps ``robot.clearance`` from every obstacle) and only chooses *when* to be where along it. Each
+leg of the polyline is cut into equal cells no longer than ``ds = 0.999 max_speed x DT /
+CELLS_PER_STEP`` (so every corner is a cell), time into steps of :data:`DT`; a cell is blocked at a
+step when the robot's centre there is closer than ``robot.inflation + person radius + margin`` to
+any person's centre, with ``margin = MARGIN + w DT / 2`` and ``w`` the robot's top speed plus the
+fastest any person walks: two positions that far apart at both ends of a step cannot come closer
+than ``inflation + radius + MARGIN`` in between, each moving straight at constant speed. In a step
+the robot may wait, or go ahead or back by up to ``CELLS_PER_STEP`` cells of one leg (a corner is
+passed at a step's end), so it never leaves the path nor goes faster than ``max_speed`` (the 0.1 %
+spare pays for the 6-decimal rounding of the rows). A forward sweep over the steps keeps the set of
+cells it can be in (a dilation, then the step's free cells); the first step the goal's cell is
+reachable is the arrival time, and the path is read back from the stored sets.
 
 The arrival time is optimal only among such profiles along this one static path at this
 resolution; another route round the people, or a finer grid, could arrive earlier. It is an
@@ -30,7 +31,7 @@ import numpy as np
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.scene.motion import positions_at
 
-__all__ = ["DT", "CELLS_PER_STEP", "MARGIN", "TimedPath", "timed_path", "person_speed", "certify"]
+__all__ = ["DT", "CELLS_PER_STEP", "MARGIN", "SPARE", "TimedPath", "timed_path", "person_speed", "certify"]
 
 #: Time step (s) of the sweep, and the largest one between two rows of a timed path.
 DT = 0.05
@@ -38,6 +39,8 @@ DT = 0.05
 CELLS_PER_STEP = 2
 #: Distance (m) kept beyond contact at every instant, over and above the sampling bound.
 MARGIN = 0.01
+#: Share of the top speed the cells leave spare, for the rounding of the written rows.
+SPARE = 1e-3
 #: Time (s) the sweep goes on after the last person stops, beyond the time the path takes.
 AFTER = 5.0
 
@@ -66,18 +69,24 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     """The earliest timed path along ``waypoints`` (k, 2) at up to ``max_speed`` that keeps the robot's
     disc (``inflation``) and every person's (its (m, 3) track, not looping, and radius) apart, or None."""
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
-    seg = np.hypot(*np.diff(w, axis=0).T)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    s, corner = _cells(w, max_speed * DT / CELLS_PER_STEP * (1 - SPARE))
+    cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(w, axis=0).T))])
     length = float(cum[-1])
-    ds = max_speed * DT / CELLS_PER_STEP
-    n_cells = max(1, math.ceil(length / ds - 1e-9))
-    s = np.minimum(np.arange(n_cells + 1) * ds, length)
-    xy = _at(w, cum, s)
+    n_cells = len(s) - 1
+    i = np.arange(n_cells + 1)
+    # Each cell's window: up to CELLS_PER_STEP cells either way, not past a corner (a corner cell reaches
+    # into both of its legs). The relation is symmetric, so it serves both the sweep and the read-back.
+    before = corner[np.maximum(np.searchsorted(corner, i, side="left") - 1, 0)]
+    after = corner[np.minimum(np.searchsorted(corner, i, side="right"), len(corner) - 1)]
+    on_corner = np.isin(i, corner)
+    lo = np.maximum(i - CELLS_PER_STEP, np.where(on_corner, before, corner[np.searchsorted(corner, i, side="right") - 1]))
+    hi = np.minimum(i + CELLS_PER_STEP, np.where(on_corner, after, corner[np.searchsorted(corner, i, side="left")]))
+    lo[0], hi[-1] = 0, n_cells
     end = max((float(t[-1, 0]) for t in tracks), default=0.0)
     steps = math.ceil((end + length / max_speed + AFTER) / DT)
     times = np.arange(steps + 1) * DT
     reach = np.asarray(radii, dtype=float) + inflation + MARGIN + (max_speed + person_speed(tracks)) * DT / 2
-    free = _free_cells(w, cum, s, xy, tracks, reach, times)
+    free = _free_cells(w, cum, s, tracks, reach, times)
     sets = np.zeros((steps + 1, n_cells + 1), dtype=bool)
     sets[0, 0] = free[0, 0]
     k_goal = None
@@ -86,9 +95,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
         if not prev.any():
             return None
         c = np.concatenate([[0], np.cumsum(prev)])
-        i = np.arange(n_cells + 1)
-        near = c[np.minimum(i + CELLS_PER_STEP + 1, n_cells + 1)] - c[np.maximum(i - CELLS_PER_STEP, 0)]
-        sets[k] = (near > 0) & free[k]
+        sets[k] = (c[hi + 1] - c[lo] > 0) & free[k]
         if sets[k, n_cells]:
             k_goal = k
             break
@@ -96,12 +103,26 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
         return None
     cells = [n_cells]
     for k in range(k_goal, 0, -1):
-        i = cells[-1]
-        lo, hi = max(0, i - CELLS_PER_STEP), min(n_cells, i + CELLS_PER_STEP)
-        options = np.flatnonzero(sets[k - 1, lo:hi + 1]) + lo
-        cells.append(int(options[np.argmin(np.abs(options - i))]))  # wait where it can, else move least
+        j = cells[-1]
+        options = np.flatnonzero(sets[k - 1, lo[j]:hi[j] + 1]) + lo[j]
+        cells.append(int(options[np.argmin(np.abs(options - j))]))  # wait where it can, else move least
     profile = s[np.array(cells[::-1])]
     return TimedPath(_rows(w, cum, times[: k_goal + 1], profile), k_goal * DT)
+
+
+def _cells(w: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarray]:
+    """(arc length of every cell (m,), the cell index of every corner, spawn and goal included): each leg
+    cut into equal cells no longer than ``ds``."""
+    seg = np.hypot(*np.diff(w, axis=0).T)
+    cum = np.concatenate([[0.0], np.cumsum(seg)])
+    parts = [np.zeros(1)]
+    corner = [0]
+    for q, length in enumerate(seg):
+        n = max(1, math.ceil(length / ds - 1e-9))
+        parts.append(cum[q] + np.arange(1, n + 1) * (length / n))
+        parts[-1][-1] = cum[q + 1]
+        corner.append(corner[-1] + n)
+    return np.concatenate(parts), np.array(corner)
 
 
 def certify(report: FeasibilityReport, scene, tasks, robot, max_speed: float) -> FeasibilityReport:
@@ -134,7 +155,7 @@ def _at(w: np.ndarray, cum: np.ndarray, s: np.ndarray) -> np.ndarray:
     return np.column_stack([np.interp(s, cum, w[:, 0]), np.interp(s, cum, w[:, 1])])
 
 
-def _free_cells(w, cum, s, xy, tracks, reach, times) -> np.ndarray:
+def _free_cells(w, cum, s, tracks, reach, times) -> np.ndarray:
     """(steps + 1, cells) bool: no person within its ``reach`` of the cell's point at the step's time.
 
     Only (step, person) pairs within reach of the polyline are looked at; each blocks the cells
@@ -177,25 +198,11 @@ def _free_cells(w, cum, s, xy, tracks, reach, times) -> np.ndarray:
 
 
 def _rows(w: np.ndarray, cum: np.ndarray, times: np.ndarray, profile: np.ndarray) -> np.ndarray:
-    """(k, 3) t, x, y rows: the profile's samples, the polyline's corners crossed between two of them
-    (at the time the robot passes them), and nothing a straight constant-speed leg already says."""
-    t_out, s_out = [times[0]], [profile[0]]
-    for k in range(1, len(times)):
-        s0, s1 = profile[k - 1], profile[k]
-        corners = cum[(cum > min(s0, s1)) & (cum < max(s0, s1))]
-        if s1 < s0:
-            corners = corners[::-1]
-        for c in corners:
-            t_out.append(times[k - 1] + (c - s0) / (s1 - s0) * (times[k] - times[k - 1]))
-            s_out.append(c)
-        t_out.append(times[k])
-        s_out.append(s1)
-    t_arr, s_arr = np.array(t_out), np.array(s_out)
-    pts = _at(w, cum, s_arr)
-    rows = np.column_stack([t_arr, pts])
-    # Drop a row where the velocity before and after it is the same and it is no corner.
-    vel = np.diff(pts, axis=0) / np.diff(t_arr)[:, None]
+    """(k, 3) t, x, y rows of the profile's samples (every corner is one: corners are passed at a
+    step's end), less those a straight constant-speed leg between their neighbours already says."""
+    pts = _at(w, cum, profile)
+    rows = np.column_stack([times, pts])
+    vel = np.diff(pts, axis=0) / np.diff(times)[:, None]
     same = np.all(np.abs(vel[1:] - vel[:-1]) < 1e-9, axis=1)
-    is_corner = np.isin(s_arr[1:-1], cum)
-    keep = np.r_[True, ~same | is_corner, True]
+    keep = np.r_[True, ~same, True]
     return rows[keep]
