@@ -6,7 +6,7 @@ people's own RNG stream (:func:`worldgen.seeding.people_rng`), so adding people 
 obstacle, a task or a mover:
 
 - a start per person: free floor for the person's disc, at least ``2 x radius`` from every other
-  start, and off the robot's spawn and goal discs;
+  start, and :data:`KEEP_OUT` off the robot's spawn and goal discs;
 - a list of places per person, each leg between consecutive places between :data:`LEG_MIN` and
   :data:`LEG_MAX` metres long (straight-line), enough of them to keep walking for the whole
   duration at the fastest speed;
@@ -28,13 +28,18 @@ import numpy as np
 from worldgen.scene import Robot, Scene, Task
 from worldgen.scene.footprint import Footprint, FootprintIndex, scene_footprints
 
-__all__ = ["PeoplePlan", "draw_people", "people_footprints", "PERSON_HEIGHT", "SLACK", "LEG_MIN", "LEG_MAX"]
+__all__ = ["PeoplePlan", "draw_people", "people_footprints", "PERSON_HEIGHT", "SLACK", "KEEP_OUT", "LEG_MIN",
+           "LEG_MAX"]
 
 #: Height (m) of a person's cylinder in the exports, and of the slab whose obstacles they walk round.
 PERSON_HEIGHT = 1.75
 #: Extra distance (m) people keep from obstacles beyond their radius: far above the 6-decimal
 #: rounding of the written rows, far below anything a person would notice.
 SLACK = 1e-3
+#: How much farther (m) than touching people keep from a robot standing at its spawn or goal: more than
+#: the certificate's margin (worldgen.feasibility.timed: 0.01 m + (robot + person speed) x 0.025 s, 0.07 m
+#: at 0.5 m/s) for robot speeds up to 1.7 m/s, so that a robot waiting at its spawn is in nobody's way.
+KEEP_OUT = 0.1
 #: Straight-line length (m) of a leg between two consecutive places: at least, at most.
 LEG_MIN, LEG_MAX = 2.0, 8.0
 #: Most places per person (the walk ends at the last one if the duration is not over).
@@ -55,10 +60,11 @@ class PeoplePlan:
 
 
 def people_footprints(scene: Scene, tasks: Sequence[Task], robot: Robot) -> list[Footprint]:
-    """What people walk round: every collider's floor shadow below :data:`PERSON_HEIGHT`, and the
-    robot's disc (radius ``robot.inflation``) at every task's spawn and goal."""
+    """What people walk round: every collider's floor shadow below :data:`PERSON_HEIGHT`, and a disc of
+    radius ``robot.inflation + KEEP_OUT`` at every task's spawn and goal."""
     prints = scene_footprints(scene, PERSON_HEIGHT)
-    keep_out = [Footprint(f"{task.id}_{which}", "keep_out", centre=(p.x, p.y), radius=robot.inflation)
+    keep_out = [Footprint(f"{task.id}_{which}", "keep_out", centre=(p.x, p.y),
+                          radius=robot.inflation + KEEP_OUT)
                 for task in tasks for which, p in (("spawn", task.spawn), ("goal", task.goal))]
     return prints + keep_out
 
