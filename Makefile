@@ -43,6 +43,7 @@ bench: $(RL_STAMP)
 	$(PY) benchmarks/bench_pack.py --worlds 1000 --jobs 2
 	$(PY) benchmarks/bench_env.py
 	$(PY) benchmarks/bench_barn.py
+	$(PY) benchmarks/bench_people.py
 
 ## fuzz: the long fuzz sweep over every generator's full parameter ranges (a table; reproducers of defects)
 fuzz: $(TEST_STAMP)
