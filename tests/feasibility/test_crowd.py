@@ -102,8 +102,10 @@ def test_a_step_into_a_wall_is_shortened_and_the_result_keeps_off_it():
     walls = _Walls(obstacles, ((0.0, 0.0), (4.0, 4.0)))
     p = np.array([[1.70, 2.0], [1.0, 1.0]])
     p_new = np.array([[2.40, 2.0], [1.1, 1.0]])  # the first would cross the wall, the second is far from it
-    gaps, _ = walls.near(p, 0.25)
-    out = _keep_off(walls, p, p_new, gaps.min(axis=1) - 0.002, 0.252)
+    walls.refresh(p, 3.0)
+    _, room = walls.push(p, 0.25, 10.0, 0.2, 1.5)
+    np.testing.assert_allclose(room, [2.0 - 1.70 - 0.25, 1.0 - 0.25])  # the wall; the floor's edge at y = 0
+    out = _keep_off(walls, p, p_new, room - 0.002, 0.252)
     np.testing.assert_array_equal(out[1], p_new[1])
     assert out[0, 0] < 2.0 - 0.252 + 1e-12 and out[0, 0] >= 1.70  # shortened (halved), not past the wall
     assert shapely.distance(shapely.LineString([p[0], out[0]]), wall.polygon) >= 0.252
