@@ -8,7 +8,8 @@ Each person ``a`` accelerates as
 - ``e_a``: the unit direction to the next waypoint of a path planned for the person's disc by the
   exact planner (:mod:`~worldgen.feasibility.planner`); a waypoint is passed when the next one is in
   sight (checked every :data:`LOOK` steps), and the path is planned again from where the person
-  stands when its waypoint has been out of sight for :data:`REPLAN` checks; a person who has moved
+  stands when its waypoint has been out of sight for :data:`REPLAN` checks (unless the waypoint
+  before it is in sight: then the person walks back to that one, which leads on); a person who has moved
   less than :data:`STUCK` m a look for ``2 x REPLAN`` looks in a row (held by others or by a wall's
   push near a place) gives that place up and walks to the next;
 - ``f_ab = -grad V(b)``, ``V = V0 exp(-(b - 2 r) / sigma)``, ``b`` the semi-minor axis of the
@@ -186,8 +187,9 @@ class _Router:
         route = self.planner.shortest(at, self.places[i, self.place[i]])
         if route is None:
             return False
-        self.route[i], self.way[i], self.unseen[i] = route.points[1:], 0, 0
-        self.target[i] = self.route[i][0]
+        # The route keeps its start, so that the waypoint before the one steered at always exists.
+        self.route[i], self.way[i], self.unseen[i] = route.points, 1, 0
+        self.target[i] = self.route[i][1]
         return True
 
     def update(self, p: np.ndarray, step: int) -> None:
@@ -210,19 +212,28 @@ class _Router:
         if not len(live):
             return
         cs = self.planner.cs
-        ahead = np.array([self.route[i][min(self.way[i] + 1, len(self.route[i]) - 1)] for i in live])
-        for i in live[cs.segments_clear(p[live], ahead)]:
-            if self.way[i] + 1 < len(self.route[i]):
+        routes, way = [self.route[i] for i in live], self.way[live]
+        ahead = np.array([r[min(w + 1, len(r) - 1)] for r, w in zip(routes, way)])
+        back = np.array([r[w - 1] for r, w in zip(routes, way)])
+        seen = cs.segments_clear(np.vstack([p[live]] * 3), np.vstack([ahead, self.target[live], back]))
+        m = len(live)
+        see_ahead, see_target, see_back = seen[:m], seen[m:2 * m], seen[2 * m:]
+        for k, i in enumerate(live):
+            if see_ahead[k] and self.way[i] + 1 < len(self.route[i]):
                 self.way[i] += 1
                 self.target[i] = self.route[i][self.way[i]]
-        in_sight = cs.segments_clear(p[live], self.target[live])
-        self.unseen[live[in_sight]] = 0
-        blind = live[~in_sight]
-        self.unseen[blind] += 1  # looks in a row with the waypoint out of sight
-        for i in blind[self.unseen[blind] >= REPLAN]:
-            if cs.points_clearance(p[i][None])[0] > 0 and self._plan(i, p[i]):
-                continue
+                see_target[k] = True
+        self.unseen[live[see_target]] = 0
+        blind = np.flatnonzero(~see_target)
+        self.unseen[live[blind]] += 1  # looks in a row with the waypoint out of sight
+        for k in blind[self.unseen[live[blind]] >= REPLAN]:
+            i = live[k]
             self.unseen[i] = 0
+            if see_back[k]:  # pushed back round a corner: the waypoint before is in sight, and leads on
+                self.way[i] -= 1
+                self.target[i] = self.route[i][self.way[i]]
+            elif cs.points_clearance(p[i][None])[0] > 0:
+                self._plan(i, p[i])
 
     def _advance(self, i: int, at: np.ndarray) -> None:
         if self.way[i] + 1 < len(self.route[i]):

@@ -85,13 +85,14 @@ def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     starts: list[np.ndarray] = []
     places = np.zeros((n, k, 2))
     for i in range(n):
-        start = pool.take(lambda p: all(math.hypot(*(p - q)) >= 2 * r + SLACK for q in starts))
+        start = pool.take(lambda q: np.all(np.hypot(*(q[:, None] - np.array(starts).reshape(1, -1, 2)).transpose(
+            2, 0, 1)) >= 2 * r + SLACK, axis=1))
         if start is None:
             return None, f"could not place {n} people of radius {r:g} m on free floor (placed {i})"
         starts.append(start)
         last = start
         for j in range(k):
-            nxt = pool.take(lambda p, last=last: LEG_MIN <= math.hypot(*(p - last)) <= LEG_MAX)
+            nxt = pool.take(lambda q, last=last: (np.hypot(*(q - last).T) >= LEG_MIN) & (np.hypot(*(q - last).T) <= LEG_MAX))
             if nxt is None:
                 return None, f"could not find places {LEG_MIN:g}-{LEG_MAX:g} m apart for a person of radius {r:g} m"
             places[i, j] = last = nxt
@@ -117,12 +118,15 @@ class _Pool:
         self.used = np.r_[self.used, np.zeros(len(xy), dtype=bool)]
 
     def take(self, accept) -> Optional[np.ndarray]:
+        """The first unused point that ``accept`` ((m, 2) points -> (m,) bool) takes, drawing more as needed."""
         start = 0
         for _ in range(_ROUNDS):
-            for i in range(start, len(self.points)):
-                if not self.used[i] and accept(self.points[i]):
-                    self.used[i] = True
-                    return self.points[i]
+            rest = np.flatnonzero(~self.used[start:]) + start
+            if len(rest):
+                ok = np.flatnonzero(accept(self.points[rest]))
+                if len(ok):
+                    self.used[rest[ok[0]]] = True
+                    return self.points[rest[ok[0]]]
             start = len(self.points)
             self._more()
         return None
