@@ -166,7 +166,7 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
 
 
 #: The people's parameters: recorded in a world's params only when it has people (n_people > 0).
-PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration")
+PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration", "people_scenario")
 
 
 def parse_value(p: Param, text: str) -> Any:
@@ -229,6 +229,9 @@ COMMON_PARAMS: tuple[Param, ...] = (
           0.1, 3.0, unit="m/s"),
     Param("people_duration", "float", 60.0, "how long people walk; afterwards each stands where it stopped",
           1.0, 600.0, unit="s"),
+    Param("people_scenario", "choice", "walk", "walk: everyone walks from place to place; head_on / crossing: "
+          "the first person walks toward the robot along its path / across it at right angles (docs/people.md)",
+          choices=("walk", "head_on", "crossing")),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
     # Ground truth written with every world (worldgen.groundtruth).
     Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn",

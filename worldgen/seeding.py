@@ -31,8 +31,8 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 
-__all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "check_seed", "attempt_rng", "mover_rng", "people_rng",
-           "env_rngs", "draw_seed", "recipe_rng"]
+__all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "check_seed", "attempt_rng",
+           "mover_rng", "people_rng", "env_rngs", "draw_seed", "recipe_rng"]
 
 #: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
 MAX_SEED = 2**63 - 1

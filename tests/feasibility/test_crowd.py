@@ -14,7 +14,7 @@ import pytest
 import shapely
 
 import worldgen
-from worldgen.feasibility.crowd import DT, SocialForce, _Walls, _keep_off, simulate
+from worldgen.feasibility.crowd import DT, SocialForce, _keep_off, _Walls, simulate
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.generators.people import PERSON_HEIGHT, people_footprints
 from worldgen.scene.footprint import Footprint

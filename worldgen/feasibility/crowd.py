@@ -160,8 +160,10 @@ class _Walls:
 class _Router:
     """Each person's places and the planned path to the current one; ``target`` the waypoint steered to."""
 
-    def __init__(self, planner: Planner, starts: np.ndarray, places: np.ndarray):
-        self.planner, self.places = planner, places
+    def __init__(self, planner: Planner, sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
+        # Sight is tested in a configuration space SLACK thinner than the planner's: a waypoint on a
+        # planner's circle is then in sight, not touching.
+        self.planner, self.sight, self.places = planner, sight, places
         n = len(starts)
         self.place = np.full(n, -1)
         self.route: list[np.ndarray] = [np.zeros((0, 2))] * n
@@ -176,7 +178,7 @@ class _Router:
 
     def _next_place(self, i: int, at: np.ndarray) -> None:
         """Plan from ``at`` to the next place that can be reached; done when none is left."""
-        while self.place[i] + 1 < self.places.shape[1]:
+        while self.place[i] + 1 < self.places.shape[1] and not np.isnan(self.places[i, self.place[i] + 1, 0]):
             self.place[i] += 1
             if self._plan(i, at):
                 return
@@ -192,18 +194,19 @@ class _Router:
         self.target[i] = self.route[i][1]
         return True
 
-    def update(self, p: np.ndarray, step: int) -> None:
-        """Pass reached waypoints; every LOOK steps, skip to a waypoint in sight or plan again."""
-        reached = ~self.done & (np.hypot(*(self.target - p).T) < ARRIVE)
+    def update(self, p: np.ndarray, step: int, waiting: np.ndarray) -> None:
+        """Pass reached waypoints; every LOOK steps, skip to a waypoint in sight or plan again
+        (``waiting``: those not yet set off, left alone)."""
+        reached = ~self.done & ~waiting & (np.hypot(*(self.target - p).T) < ARRIVE)
         for i in np.flatnonzero(reached):
             self._advance(i, p[i])
         if step % LOOK:
             return
-        live = np.flatnonzero(~self.done)
+        live = np.flatnonzero(~self.done & ~waiting)
         if not len(live):
             return
         moved = np.hypot(*(p - self.last).T) >= STUCK
-        self.held = np.where(moved, 0, self.held + 1)
+        self.held = np.where(moved | waiting, 0, self.held + 1)
         self.last = p.copy()
         for i in live[self.held[live] >= 2 * REPLAN]:
             self.held[i] = 0
@@ -211,7 +214,7 @@ class _Router:
         live = live[~self.done[live]]
         if not len(live):
             return
-        cs = self.planner.cs
+        cs = self.sight
         routes, way = [self.route[i] for i in live], self.way[live]
         ahead = np.array([r[min(w + 1, len(r) - 1)] for r, w in zip(routes, way)])
         back = np.array([r[w - 1] for r, w in zip(routes, way)])
@@ -232,7 +235,7 @@ class _Router:
             if see_back[k]:  # pushed back round a corner: the waypoint before is in sight, and leads on
                 self.way[i] -= 1
                 self.target[i] = self.route[i][self.way[i]]
-            elif cs.points_clearance(p[i][None])[0] > 0:
+            elif self.planner.cs.points_clearance(p[i][None])[0] > 0:
                 self._plan(i, p[i])
 
     def _advance(self, i: int, at: np.ndarray) -> None:
@@ -244,12 +247,14 @@ class _Router:
 
 
 def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndarray, speeds: np.ndarray,
-             radius: float, duration: float, dt: float = DT, model: SocialForce = SocialForce()) -> np.ndarray:
+             radius: float, duration: float, dt: float = DT, model: SocialForce = SocialForce(),
+             depart: Optional[np.ndarray] = None) -> np.ndarray:
     """(steps + 1, n, 2) positions of the people at t = 0, dt, 2 dt, ... up to ``duration``.
 
     ``obstacles`` are what people walk round (:func:`worldgen.generators.people.people_footprints`
     as :class:`Obstacles2D`), ``starts`` (n, 2) free for the disc of ``radius + 2 SLACK``,
-    ``places`` (n, k, 2) each person's places in order, ``speeds`` (n,) preferred speeds (m/s).
+    ``places`` (n, k, 2) each person's places in order (NaN rows end a shorter list), ``speeds`` (n,)
+    preferred speeds (m/s), ``depart`` (n,) when each sets off (s; until then it stands still).
     """
     starts = np.asarray(starts, dtype=float).reshape(-1, 2)
     n = len(starts)
@@ -259,17 +264,20 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
     if n == 0:
         return out
     walls = _Walls(obstacles, bounds)
-    router = _Router(Planner(ConfigSpace.build(obstacles, radius + SLACK, bounds)), starts, places)
+    router = _Router(Planner(ConfigSpace.build(obstacles, radius + SLACK, bounds)),
+                     ConfigSpace.build(obstacles, radius, bounds), starts, places)
     keep = radius + 2 * SLACK
+    leave = np.zeros(n) if depart is None else np.asarray(depart, dtype=float)
     v_max = model.v_max_ratio * np.asarray(speeds, dtype=float)
     p, v = starts.copy(), np.zeros((n, 2))
     cos_phi = math.cos(model.phi)
     for k in range(1, steps + 1):
-        router.update(p, k - 1)
+        waiting = leave > (k - 1) * dt + 1e-9
+        router.update(p, k - 1, waiting)
         to = router.target - p
         dist = np.hypot(to[:, 0], to[:, 1])
         e = np.where(dist[:, None] > 1e-9, to / np.maximum(dist, 1e-9)[:, None], 0.0)
-        v0 = np.where(router.done, 0.0, speeds)
+        v0 = np.where(router.done | waiting, 0.0, speeds)
         acc = (v0[:, None] * e - v) / model.tau
         acc += _people_force(p, v, e, radius, model, cos_phi)
         if (k - 1) % LOOK == 0:
@@ -279,7 +287,8 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
         v_new = v + dt * acc
         speed = np.hypot(v_new[:, 0], v_new[:, 1])
         v_new *= np.minimum(1.0, v_max / np.maximum(speed, 1e-12))[:, None]
-        v_new[router.done] = 0.0  # at the last place a person stands there (a still obstacle to the others)
+        # Before setting off and after its last place a person stands still (an obstacle to the others).
+        v_new[router.done | waiting] = 0.0
         p_new = _keep_off(walls, p, p + dt * v_new, room - 2 * SLACK, keep)
         v = (p_new - p) / dt
         p = out[k] = p_new
@@ -334,7 +343,8 @@ def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     if plan is None:
         return (), reason
     obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot))
-    track = simulate(obstacles, scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius, plan.duration)
+    track = simulate(obstacles, scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius, plan.duration,
+                     depart=plan.depart)
     times = [round_float(k * DT) for k in range(len(track))]
     people = []
     for i in range(track.shape[1]):

@@ -10,7 +10,9 @@ obstacle, a task or a mover:
 - a list of places per person, each leg between consecutive places between :data:`LEG_MIN` and
   :data:`LEG_MAX` metres long (straight-line), enough of them to keep walking for the whole
   duration at the fastest speed;
-- a preferred speed per person, uniform in ``person_speed``.
+- a preferred speed per person, uniform in ``person_speed``;
+- with ``people_scenario`` ``head_on`` or ``crossing``, the first person instead walks the
+  human-encounter scenario of that name against the first task (:func:`_scripted`).
 
 Walking between the places, around the obstacles and each other, is the crowd model's
 (:mod:`worldgen.feasibility.crowd`); the robot's spawn and goal discs are obstacles to it too
@@ -29,7 +31,7 @@ from worldgen.scene import Robot, Scene, Task
 from worldgen.scene.footprint import Footprint, FootprintIndex, scene_footprints
 
 __all__ = ["PeoplePlan", "draw_people", "people_footprints", "PERSON_HEIGHT", "SLACK", "KEEP_OUT", "LEG_MIN",
-           "LEG_MAX"]
+           "LEG_MAX", "HEAD_ON_SHORT", "HEAD_ON_BEHIND", "CROSSING_HALF", "LAG"]
 
 #: Height (m) of a person's cylinder in the exports, and of the slab whose obstacles they walk round.
 PERSON_HEIGHT = 1.75
@@ -40,6 +42,15 @@ SLACK = 1e-3
 #: the certificate's margin (worldgen.feasibility.timed: 0.01 m + (robot + person speed) x 0.025 s, 0.07 m
 #: at 0.5 m/s) for robot speeds up to 1.7 m/s, so that a robot waiting at its spawn is in nobody's way.
 KEEP_OUT = 0.1
+#: The human-encounter scenarios (``people_scenario``; see :func:`_scripted`): head-on, the person
+#: starts this far short of the goal (m), walks along the path to this far short of the spawn (m), then
+#: round the robot to as far behind it
+HEAD_ON_SHORT, HEAD_ON_BEHIND = 1.0, 1.5
+#: crossing, the person walks from this far right of the path's midpoint to as far left (m)
+CROSSING_HALF = 3.0
+#: how far behind a steady walker (s) a person starting from rest falls: the crowd model's tau (0.5 s)
+#: less one step (0.1 s) of its semi-implicit integration, which moves with the velocity just updated
+LAG = 0.4
 #: Straight-line length (m) of a leg between two consecutive places: at least, at most.
 LEG_MIN, LEG_MAX = 2.0, 8.0
 #: Most places per person (the walk ends at the last one if the duration is not over).
@@ -50,13 +61,15 @@ _BATCH, _ROUNDS = 512, 40
 
 @dataclass(frozen=True, eq=False)
 class PeoplePlan:
-    """What the crowd model needs: ``starts`` (n, 2), ``places`` (n, k, 2), ``speeds`` (n,) m/s."""
+    """What the crowd model needs: ``starts`` (n, 2), ``places`` (n, k, 2) (NaN rows end a shorter list),
+    ``speeds`` (n,) m/s, ``depart`` (n,) s: when each sets off."""
 
     starts: np.ndarray
     places: np.ndarray
     speeds: np.ndarray
     radius: float
     duration: float
+    depart: np.ndarray
 
 
 def people_footprints(scene: Scene, tasks: Sequence[Task], robot: Robot) -> list[Footprint]:
@@ -84,7 +97,18 @@ def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     k = min(MAX_PLACES, math.ceil(duration * hi * 1.3 / LEG_MIN) + 1)
     starts: list[np.ndarray] = []
     places = np.zeros((n, k, 2))
-    for i in range(n):
+    depart = np.zeros(n)
+    scenario = params.get("people_scenario", "walk")
+    if scenario != "walk":
+        scripted, reason = _scripted(scenario, tasks[0], float(speeds[0]), params["robot_speed"], pool.index, clear_r,
+                                     scene.bounds)
+        if scripted is None:
+            return None, reason
+        (start, route, depart[0]) = scripted
+        starts.append(start)
+        places[0] = np.nan
+        places[0, : len(route)] = route
+    for i in range(len(starts), n):
         start = pool.take(lambda q: np.all(np.hypot(*(q[:, None] - np.array(starts).reshape(1, -1, 2)).transpose(
             2, 0, 1)) >= 2 * r + SLACK, axis=1))
         if start is None:
@@ -96,7 +120,41 @@ def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
             if nxt is None:
                 return None, f"could not find places {LEG_MIN:g}-{LEG_MAX:g} m apart for a person of radius {r:g} m"
             places[i, j] = last = nxt
-    return PeoplePlan(np.array(starts).reshape(-1, 2), places, speeds, float(r), float(duration)), None
+    return PeoplePlan(np.array(starts).reshape(-1, 2), places, speeds, float(r), float(duration), depart), None
+
+
+def _scripted(scenario: str, task: Task, speed: float, robot_speed: float, index: FootprintIndex, radius: float,
+              bounds) -> tuple[Optional[tuple[np.ndarray, np.ndarray, float]], Optional[str]]:
+    """((start, places (k, 2), departure time), None) of the first person in a human-encounter scenario, set
+    against the first task's straight line from spawn S to goal G (u its direction, n its left normal,
+    L its length); or (None, reason) when its start or place is not free floor.
+
+    - ``head_on``: starts on the line :data:`HEAD_ON_SHORT` m short of G and walks along it toward the
+      robot to :data:`HEAD_ON_BEHIND` m short of S, then round the robot's disc at S to as far behind
+      it: it sets off at once.
+    - ``crossing``: starts :data:`CROSSING_HALF` m to the right of the line's midpoint M and walks to as
+      far to the left, across the line at right angles; it sets off so as to reach M when a robot
+      driving the line at ``robot_speed`` would, ``L / 2 / robot_speed`` s (:data:`LAG`: a person starting
+      from rest falls behind a steady walker by its speed times the crowd model's tau).
+    """
+    s = np.array([task.spawn.x, task.spawn.y])
+    g = np.array([task.goal.x, task.goal.y])
+    length = float(np.hypot(*(g - s)))
+    u = (g - s) / length
+    n = np.array([-u[1], u[0]])
+    if scenario == "head_on":
+        start, route, depart = g - HEAD_ON_SHORT * u, [s + HEAD_ON_BEHIND * u, s - HEAD_ON_BEHIND * u], 0.0
+    else:
+        mid = s + u * length / 2
+        start, route = mid - CROSSING_HALF * n, [mid + CROSSING_HALF * n]
+        depart = max(0.0, length / 2 / robot_speed - CROSSING_HALF / speed - LAG)
+    start, route = np.round(start, 6), np.round(np.array(route), 6)
+    (x0, y0), (x1, y1) = bounds
+    for label, p in (("start", start), *(("place", q) for q in route)):
+        inside = x0 + radius <= p[0] <= x1 - radius and y0 + radius <= p[1] <= y1 - radius
+        if not inside or index.blocked(p[None], radius)[0]:
+            return None, f"the {scenario} person's {label} ({p[0]:.3f}, {p[1]:.3f}) is not free floor"
+    return (start, route, round(depart, 6)), None
 
 
 class _Pool:
