@@ -122,7 +122,7 @@ class _Walls:
             mag = k * np.exp(-centre_gap / rr) / dist
             acc[:, 0] += np.bincount(who, mag * d[:, 0], minlength=n)
             acc[:, 1] += np.bincount(who, mag * d[:, 1], minlength=n)
-            np.minimum.at(room, who, centre_gap - radius)
+            _lower(room, who, centre_gap - radius)
         if len(self.g_person):
             e, who = self.e_edge, self.e_person
             ap = p[who] - self.ea[e]
@@ -141,7 +141,7 @@ class _Walls:
             mag = k * np.exp(-best / rr) / safe
             acc[:, 0] += np.bincount(g, mag * (p[g, 0] - qx), minlength=n)
             acc[:, 1] += np.bincount(g, mag * (p[g, 1] - qy), minlength=n)
-            np.minimum.at(room, g, best - radius)
+            _lower(room, g, best - radius)
         x, y = p[:, 0], p[:, 1]
         edges = np.stack([x - self.x0, self.x1 - x, y - self.y0, self.y1 - y], axis=1)
         mag = k * np.exp(-edges / rr)
@@ -155,6 +155,13 @@ class _Walls:
         inside = ((np.minimum(a[:, 0], b[:, 0]) >= self.x0 + keep) & (np.maximum(a[:, 0], b[:, 0]) <= self.x1 - keep)
                   & (np.minimum(a[:, 1], b[:, 1]) >= self.y0 + keep) & (np.maximum(a[:, 1], b[:, 1]) <= self.y1 - keep))
         return inside & (d >= keep)
+
+
+def _lower(room: np.ndarray, who: np.ndarray, values: np.ndarray) -> None:
+    """room[i] = min(room[i], values of i) for ``who`` sorted (np.nonzero's row order), in one pass."""
+    first = np.flatnonzero(np.r_[True, who[1:] != who[:-1]])
+    owner = who[first]
+    room[owner] = np.minimum(room[owner], np.minimum.reduceat(values, first))
 
 
 class _Router:
@@ -301,19 +308,17 @@ def _people_force(p: np.ndarray, v: np.ndarray, e: np.ndarray, radius: float, m:
     n = len(p)
     if n < 2:
         return np.zeros((n, 2))
-    r_ab = p[:, None, :] - p[None, :, :]
-    s = np.broadcast_to(m.horizon * v[None, :, :], r_ab.shape)
-    rs = r_ab - s
-    n1 = np.maximum(np.sqrt(np.einsum("abk,abk->ab", r_ab, r_ab)), 1e-9)
-    n2 = np.maximum(np.sqrt(np.einsum("abk,abk->ab", rs, rs)), 1e-9)
-    sn2 = np.einsum("abk,abk->ab", s, s)
-    b = 0.5 * np.sqrt(np.maximum((n1 + n2) ** 2 - sn2, 1e-18))
-    grad = ((n1 + n2) / (4 * b))[..., None] * (r_ab / n1[..., None] + rs / n2[..., None])
-    mag = (m.v0 / m.sigma) * np.exp(np.minimum(-(b - 2 * radius) / m.sigma, 20.0))
-    seen = np.einsum("ak,abk->ab", e, -r_ab) >= n1 * cos_phi
-    w = np.where(seen, 1.0, m.c)
+    dx, dy = p[:, 0, None] - p[None, :, 0], p[:, 1, None] - p[None, :, 1]  # r_ab = r_a - r_b
+    sx, sy = m.horizon * v[None, :, 0], m.horizon * v[None, :, 1]  # b's step anticipated
+    rx, ry = dx - sx, dy - sy
+    n1 = np.maximum(np.sqrt(dx * dx + dy * dy), 1e-9)
+    n2 = np.maximum(np.sqrt(rx * rx + ry * ry), 1e-9)
+    b = 0.5 * np.sqrt(np.maximum((n1 + n2) ** 2 - (sx * sx + sy * sy), 1e-18))
+    mag = (m.v0 / m.sigma) * np.exp(np.minimum(-(b - 2 * radius) / m.sigma, 20.0)) * (n1 + n2) / (4 * b)
+    seen = -(e[:, 0, None] * dx + e[:, 1, None] * dy) >= n1 * cos_phi
+    w = np.where(seen, mag, m.c * mag)
     np.fill_diagonal(w, 0.0)
-    return np.einsum("ab,abk->ak", w * mag, grad)
+    return np.column_stack([np.sum(w * (dx / n1 + rx / n2), axis=1), np.sum(w * (dy / n1 + ry / n2), axis=1)])
 
 
 def _keep_off(walls: _Walls, p: np.ndarray, p_new: np.ndarray, room: np.ndarray, keep: float) -> np.ndarray:
@@ -345,13 +350,13 @@ def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot))
     track = simulate(obstacles, scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius, plan.duration,
                      depart=plan.depart)
-    times = [round_float(k * DT) for k in range(len(track))]
+    times = np.array([round_float(k * DT) for k in range(len(track))])
     people = []
     for i in range(track.shape[1]):
         xy = np.round(track[:, i, :], 6)
         # A person standing still needs only the first and last row of the stay.
         still = np.all(xy[1:-1] == xy[:-2], axis=1) & np.all(xy[1:-1] == xy[2:], axis=1)
         keep = np.r_[True, ~still, True]
-        rows = tuple((times[k], float(xy[k, 0]), float(xy[k, 1])) for k in np.flatnonzero(keep))
+        rows = np.column_stack([times[keep], xy[keep]])
         people.append(Mover(f"person_{i}", plan.radius, PERSON_HEIGHT, rows, False, params["friction"], person=True))
     return tuple(people), None

@@ -57,6 +57,8 @@ LEG_MIN, LEG_MAX = 2.0, 8.0
 MAX_PLACES = 64
 #: Candidate points drawn at once, and the most batches drawn for one point.
 _BATCH, _ROUNDS = 512, 40
+#: Unused points screened at once when looking for the next acceptable one.
+_CHUNK = 64
 
 
 @dataclass(frozen=True, eq=False)
@@ -180,11 +182,12 @@ class _Pool:
         start = 0
         for _ in range(_ROUNDS):
             rest = np.flatnonzero(~self.used[start:]) + start
-            if len(rest):
-                ok = np.flatnonzero(accept(self.points[rest]))
+            for chunk in range(0, len(rest), _CHUNK):  # in chunks: the first acceptable one is usually near
+                part = rest[chunk:chunk + _CHUNK]
+                ok = np.flatnonzero(accept(self.points[part]))
                 if len(ok):
-                    self.used[rest[ok[0]]] = True
-                    return self.points[rest[ok[0]]]
+                    self.used[part[ok[0]]] = True
+                    return self.points[part[ok[0]]]
             start = len(self.points)
             self._more()
         return None

@@ -19,6 +19,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from worldgen.errors import SceneError
 from worldgen.floats import round_float
 from worldgen.scene.names import NAME_PATTERN
@@ -31,7 +33,8 @@ MOVER_RGBA = (0.85, 0.20, 0.20, 1.0)
 
 @dataclass(frozen=True)
 class Mover:
-    """One mover. ``trajectory`` is a tuple of ``(t, x, y)`` rows, t strictly increasing from 0."""
+    """One mover. ``trajectory`` is a tuple of ``(t, x, y)`` rows, t strictly increasing from 0 (given as
+    rows or as a (k, 3) array)."""
 
     name: str
     radius: float
@@ -47,10 +50,17 @@ class Mover:
         for what, value in (("radius", self.radius), ("height", self.height)):
             if not (math.isfinite(value) and value > 0):
                 raise SceneError(f"mover {self.name!r}: {what} must be > 0 m, got {value!r}")
-        rows = tuple(tuple(float(v) for v in row) for row in self.trajectory)
+        traj = self.trajectory
+        if isinstance(traj, np.ndarray) and traj.ndim == 2 and traj.shape[1] == 3:
+            # A (k, 3) array (a person's hundreds of rows): checked and read at once.
+            finite = bool(np.isfinite(traj).all())
+            rows = tuple(map(tuple, traj.astype(float).tolist()))
+        else:
+            rows = tuple(tuple(float(v) for v in row) for row in traj)
+            finite = all(math.isfinite(v) for row in rows for v in row if len(row) == 3)
         if len(rows) < 2 or any(len(row) != 3 for row in rows):
             raise SceneError(f"mover {self.name!r}: trajectory must be at least two (t, x, y) rows")
-        if not all(math.isfinite(v) for row in rows for v in row):
+        if not finite:
             raise SceneError(f"mover {self.name!r}: trajectory values must be finite")
         if rows[0][0] != 0.0:
             raise SceneError(f"mover {self.name!r}: trajectory must start at t = 0, got t = {rows[0][0]!r}")
