@@ -174,3 +174,15 @@ def test_a_draw_without_a_timed_path_is_refused_and_counted():
     metadata.validate(meta)
     assert not meta["feasibility"]["feasible"] and meta["tasks"][0]["timed_path"] is None
     assert meta["tasks"][0]["arrival_time"] is None and meta["tasks"][0]["path"] is not None
+
+
+def test_the_certificate_agrees_with_brute_force_on_a_generated_world():
+    w = worldgen.generate("cluttered", seed=1, size=[5.0, 5.0], n_obstacles=3, n_people=3, people_duration=10.0)
+    people = [m for m in w.scene.movers if m.person]
+    tracks = [np.array(m.trajectory) for m in people]
+    radii = [m.radius for m in people]
+    path = w.feasibility.paths[0].waypoints
+    found = w.feasibility.timed_paths[0]
+    assert found.arrival == timed_path(path, tracks, radii, w.robot.inflation, 0.5).arrival
+    assert abs(found.arrival - _brute_force(path, tracks, radii, w.robot.inflation, 0.5)) < 1e-9
+    assert found.arrival > float(np.sum(np.hypot(*np.diff(path, axis=0).T))) / 0.5 + 1.0  # the people held it up
