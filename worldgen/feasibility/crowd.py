@@ -23,8 +23,8 @@ Each person ``a`` accelerates as
   walked meanwhile).
 
 Integration is semi-implicit Euler at ``dt``, speeds capped at ``1.3 v0`` (the paper's v_max). A
-person past its last place stands still there, an obstacle the others walk round.
-Then the geometry is enforced, not hoped for: a step whose straight segment would bring the disc
+person before its departure time, or past its last place, stands still: an obstacle the others walk
+round. After each step the geometry is enforced, not hoped for: a step whose straight segment would bring the disc
 within ``radius + 2 SLACK`` of a footprint (exact segment distances) or the floor's edge is halved
 up to four times, else not taken, and the velocity set to the step actually made. So every
 position, and every point between two rows of the written trajectory, keeps the person's disc off
