@@ -17,7 +17,7 @@ from worldgen import presets
 from worldgen.errors import InfeasibleError, ParameterError
 
 SHIPPED = ["clutter_50_boxes", "door_crossing", "drl_arena", "empty_room", "lidar_wall", "narrow_corridor",
-           "room_5_obstacles"]
+           "person_crossing", "person_head_on", "room_5_obstacles"]
 
 
 def roles(world, role):
@@ -139,7 +139,99 @@ def _spans(values, lo, hi):
     return min(values) >= lo and max(values) <= hi and min(values) < lo + 0.1 and max(values) > hi - 0.1
 
 
+def _line(world):
+    """The first task's straight line: spawn S, goal G, unit direction u, left normal n, length L."""
+    t = world.tasks[0]
+    s, g = np.array([t.spawn.x, t.spawn.y]), np.array([t.goal.x, t.goal.y])
+    u = (g - s) / np.hypot(*(g - s))
+    return s, g, u, np.array([-u[1], u[0]]), float(np.hypot(*(g - s)))
+
+
+def _walker(world):
+    """The scenario's person: (its rows (k, 3), its radius)."""
+    person = next(m for m in world.scene.movers if m.person)
+    return np.array(person.trajectory), person.radius
+
+
+def _on_line(world):
+    """The rows of the head-on person while it walks on the robot's line (lateral offset under 1 um)."""
+    rows, _ = _walker(world)
+    s, _, u, n, _ = _line(world)
+    off = (rows[:, 1:] - s) @ n
+    first_off = np.flatnonzero(np.abs(off) >= 1e-6)
+    return rows[: first_off[0] if len(first_off) else len(rows)]
+
+
+def _headings(rows, u):
+    """Angle (degrees) between each moving step of ``rows`` and ``u``."""
+    d = np.diff(rows[:, 1:], axis=0)
+    moving = np.hypot(*d.T) > 1e-9
+    d = d[moving] / np.hypot(*d[moving].T)[:, None]
+    return np.degrees(np.arccos(np.clip(d @ u, -1, 1)))
+
+
+def _steady_speed(rows, v):
+    """Once up to speed (2 s after setting off: within exp(-4) of v0) the person walks at ``v`` (median of
+    its steps), never over 1.3 v."""
+    speed = np.hypot(*np.diff(rows[:, 1:], axis=0).T) / np.diff(rows[:, 0])
+    off = rows[int(np.argmax(speed > 1e-9)), 0]
+    steady = (speed > 1e-9) & (rows[1:, 0] > off + 2.0)
+    return speed.max() <= 1.3 * v + 1e-4 and abs(float(np.median(speed[steady])) - v) < 1e-3
+
+
+def _crossing_time(world):
+    rows, _ = _walker(world)
+    s, _, _, n, _ = _line(world)
+    off = (rows[:, 1:] - s) @ n
+    i = int(np.flatnonzero(off >= 0)[0])
+    a, b = rows[i - 1], rows[i]
+    return a[0] + (0 - off[i - 1]) / (off[i] - off[i - 1]) * (b[0] - a[0]), a[1:] + (b[1:] - a[1:]) * (0 - off[i - 1]) / (
+        off[i] - off[i - 1])
+
+
+def _must_yield(world):
+    """Driving the line at full speed meets the person; the certificate arrives later than that would."""
+    rows, radius = _walker(world)
+    s, _, u, _, length = _line(world)
+    v = world.params["robot_speed"]
+    t = np.arange(0.0, length / v, 0.01)
+    me = s + np.outer(np.minimum(v * t, length), u)
+    them = np.column_stack([np.interp(t, rows[:, 0], rows[:, 1]), np.interp(t, rows[:, 0], rows[:, 2])])
+    meets = np.hypot(*(me - them).T).min() < world.robot.inflation + radius
+    return meets and world.feasibility.timed_paths[0].arrival > length / v + 1.0
+
+
 CLAIMS = {
+    "person_head_on": [
+        (rf"along its {N} m straight path in an empty {N} x {N} m room",
+         lambda w, length, a, b: _line(w)[4] == pytest.approx(length) and _extent(w) == (a, b)
+         and len(w.feasibility.paths[0].waypoints) == 2),
+        (r"the robot must yield", _must_yield),
+        (rf"radius {N} m, {N} m/s", lambda w, r, v: _walker(w)[1] == r and _steady_speed(_on_line(w), v)),
+        (rf"starts on the robot's path {N} m short of its goal",
+         lambda w, d: np.allclose(_walker(w)[0][0, 1:], _line(w)[1] - d * _line(w)[2], atol=1e-6)),
+        (rf"heading opposite to the robot's \({N} degrees\)",
+         lambda w, deg: np.all(np.abs(_headings(_on_line(w), _line(w)[2]) - deg) < 1e-3)),
+        (rf"to {N} m short of the robot's spawn, then round the robot to {N} m behind it",
+         # On the line until within ARRIVE (0.2 m) plus one step (0.15 m) of the point short of the spawn ...
+         lambda w, a, b: a <= (_on_line(w)[-1, 1:] - _line(w)[0]) @ _line(w)[2] <= a + 0.35
+         # ... and at the end within ARRIVE of the point behind it.
+         and np.hypot(*(_walker(w)[0][-1, 1:] - (_line(w)[0] - b * _line(w)[2]))) < 0.2),
+    ],
+    "person_crossing": [
+        (rf"robot's {N} m straight path at right angles at its midpoint, in an empty {N} x {N} m room",
+         lambda w, length, a, b: _line(w)[4] == pytest.approx(length) and _extent(w) == (a, b)
+         and np.hypot(*(_crossing_time(w)[1] - (_line(w)[0] + _line(w)[2] * length / 2))) < 1e-6),
+        (rf"radius {N} m, {N} m/s", lambda w, r, v: _walker(w)[1] == r and _steady_speed(_walker(w)[0], v)),
+        (rf"walks from {N} m to the right of the robot's path to {N} m to its left",
+         lambda w, a, b: np.allclose(_walker(w)[0][0, 1:], _line(w)[0] + _line(w)[2] * _line(w)[4] / 2 - a * _line(w)[3],
+                                     atol=1e-6)
+         and np.hypot(*(_walker(w)[0][-1, 1:] - (_line(w)[0] + _line(w)[2] * _line(w)[4] / 2 + b * _line(w)[3]))) < 0.2),
+        (rf"crossing it at {N} degrees", lambda w, deg: np.all(np.abs(_headings(_walker(w)[0], _line(w)[2]) - deg) < 1e-3)),
+        (rf"top speed \(robot_speed {N} m/s: {N} s after the start\)",
+         lambda w, v, t: w.params["robot_speed"] == v and t == pytest.approx(_line(w)[4] / 2 / v)
+         and abs(_crossing_time(w)[0] - t) <= 0.1),
+    ],
     "empty_room": [
         (rf"{N} x {N} m", lambda w, a, b: _extent(w) == (a, b)),
         (rf"start at \({N}, {N}\)", lambda w, x, y: (w.tasks[0].spawn.x, w.tasks[0].spawn.y) == (x, y)),

@@ -19,7 +19,7 @@ from worldgen.generators.infeasible import wall_in_goals
 from worldgen.generators.movers import place_movers
 from worldgen.groundtruth import occupancy
 from worldgen.params import validate_params
-from worldgen.seeding import attempt_rng, check_seed, mover_rng
+from worldgen.seeding import attempt_rng, check_seed, mover_rng, people_rng
 from worldgen.world import World
 
 __all__ = ["generate"]
@@ -71,6 +71,9 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
         if map_extent is None:  # the map's size follows from the floor: refuse before planning on it
             map_extent = occupancy.extent(draft.scene, resolved["map_resolution"])
         report = feasibility.check(draft.scene, draft.tasks, robot)
+        if resolved.get("n_people"):
+            from worldgen.feasibility.timed import certify
+            report = certify(report, draft.scene, draft.tasks, robot, resolved["robot_speed"])
         world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1, allow_infeasible)
         if report.feasible or (resolved.get("infeasible") and _infeasible_on_purpose(report)):
             return world
@@ -96,7 +99,9 @@ def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt:
 
     ``infeasible``: every goal walled in (worldgen.generators.infeasible), unless the generator
     declares its own ``infeasible`` parameter; ``n_movers``: movers on their own
-    RNG stream (worldgen.generators.movers), laid out after any goal walls so they avoid them.
+    RNG stream (worldgen.generators.movers), laid out after any goal walls so they avoid them;
+    ``n_people``: people on theirs, walked by the crowd model (worldgen.feasibility.crowd), after
+    the movers (docs/people.md).
     """
     scene = draft.scene
     assert scene is not None, "a draft that is not rejected has a scene"
@@ -109,10 +114,16 @@ def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt:
         if reason:
             return Draft(scene, draft.tasks, rejected="mover_placement", detail=reason)
         scene = scene.with_movers(movers)
+    if resolved.get("n_people"):
+        from worldgen.feasibility.crowd import walk_people
+        people, reason = walk_people(scene, draft.tasks, robot, resolved, people_rng(seed, attempt))
+        if reason:
+            return Draft(scene, draft.tasks, rejected="people_placement", detail=reason)
+        scene = scene.with_movers(scene.movers + people)
     return draft if scene is draft.scene else Draft(scene, draft.tasks)
 
 
 def _infeasible_on_purpose(report) -> bool:
     """A world asked to be infeasible: its start and goal are fine, and the route is what fails."""
     failed = {c.name for c in report.failed()}
-    return bool(failed) and failed <= {"path_exists", "path_clearance"}
+    return bool(failed) and failed <= {"path_exists", "path_clearance", "timed_path"}

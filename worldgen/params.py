@@ -14,7 +14,7 @@ from typing import Any, Mapping, Optional, Sequence
 from worldgen.errors import ParameterError, did_you_mean, quoted
 from worldgen.floats import round_float
 
-__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "describe_range"]
+__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "PEOPLE_PARAMS", "describe_range"]
 
 _KINDS = ("float", "int", "bool", "choice", "pair", "range", "triple", "list", "words")
 #: Most items a ``list`` or ``words`` parameter may hold.
@@ -151,6 +151,11 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
     for name in sorted(by_name):
         p = by_name[name]
         resolved[name] = p.check(given.get(name, p.default))
+    if not resolved.get("n_people"):
+        # A world without people records none of their parameters, so that every world made before
+        # people existed keeps its params, content_hash and bytes (docs/people.md).
+        for name in PEOPLE_PARAMS:
+            resolved.pop(name, None)
     if "lidar_range_min" in resolved and "lidar_range_max" in resolved:
         # The one rule between two common parameters: a lidar needs a non-empty range.
         if resolved["lidar_range_min"] >= resolved["lidar_range_max"]:
@@ -159,6 +164,10 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
                 f"got {resolved['lidar_range_min']!r}"
             )
     return resolved
+
+
+#: The people's parameters: recorded in a world's params only when it has people (n_people > 0).
+PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration", "people_scenario")
 
 
 def parse_value(p: Param, text: str) -> Any:
@@ -214,6 +223,16 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("mover_waypoints", "int", 4, "distinct waypoints of each mover's loop", 2, 32),
     Param("sdf_actors", "bool", True, "write movers into the SDF as <actor>s; false leaves them out of the SDF only "
           "(for SDF readers that reject actors, e.g. Drake): they stay in the MJCF and world.json"),
+    Param("n_people", "int", 0, "pedestrians walking from place to place by the social force model (docs/people.md)",
+          0, 64),
+    Param("person_radius", "float", 0.25, "radius of each person's disc", 0.1, 1.0, unit="m"),
+    Param("person_speed", "range", [1.0, 1.4], "range each person's preferred walking speed is drawn from",
+          0.1, 3.0, unit="m/s"),
+    Param("people_duration", "float", 60.0, "how long people walk; afterwards each stands where it stopped",
+          1.0, 600.0, unit="s"),
+    Param("people_scenario", "choice", "walk", "walk: everyone walks from place to place; head_on / crossing: "
+          "the first person walks toward the robot along its path / across it at right angles (docs/people.md)",
+          choices=("walk", "head_on", "crossing")),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
     # Ground truth written with every world (worldgen.groundtruth).
     Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn",

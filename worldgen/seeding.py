@@ -8,6 +8,7 @@ stream                          key                           used by
 ==============================  ============================  =====================================
 draw ``k`` of a world           ``(k,)``                      ``api.generate``, every generator
 its movers                      ``(k, MOVER_STREAM)``         ``generators.movers``
+its people                      ``(k, PEOPLE_STREAM)``        ``generators.people``
 an environment's worlds         ``(WORLD_STREAM,)``           ``envs.navigation`` (reset's seed)
 an environment's sensor noise   ``(NOISE_STREAM,)``           ``envs.navigation`` (reset's seed)
 draw ``k`` towards a level      ``(LEVEL_STREAM, k)``         ``leveling`` (a world asked for at a level)
@@ -31,15 +32,16 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 
-__all__ = ["MAX_SEED", "MOVER_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "level_seed",
-           "check_seed", "attempt_rng", "mover_rng",
-           "env_rngs", "draw_seed", "recipe_rng"]
+__all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "level_seed",
+           "check_seed", "attempt_rng", "mover_rng", "people_rng", "env_rngs", "draw_seed", "recipe_rng"]
 
 #: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
 MAX_SEED = 2**63 - 1
 #: Key of the movers' stream, beside the draw number (an arbitrary tag far from the small integers
 #: generators use for their own ``rng.spawn()`` children).
 MOVER_STREAM = 0x6D6F76
+#: Key of the people's stream ("pep"), beside the draw number: people never move a mover or an obstacle.
+PEOPLE_STREAM = 0x706570
 #: Keys of the two streams an environment derives from a reset's seed.
 WORLD_STREAM, NOISE_STREAM = 0, 1
 #: Key of the seeds of the draws towards a difficulty level ("lvl").
@@ -66,6 +68,11 @@ def attempt_rng(seed: int, attempt: int) -> np.random.Generator:
 def mover_rng(seed: int, attempt: int) -> np.random.Generator:
     """The movers' own RNG for draw ``attempt`` of ``seed`` (independent of the generator's)."""
     return _stream(seed, attempt, MOVER_STREAM)
+
+
+def people_rng(seed: int, attempt: int) -> np.random.Generator:
+    """The people's own RNG for draw ``attempt`` of ``seed`` (independent of the generator's and the movers')."""
+    return _stream(seed, attempt, PEOPLE_STREAM)
 
 
 def env_rngs(entropy: int) -> tuple[np.random.Generator, np.random.Generator]:

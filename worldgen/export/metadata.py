@@ -25,7 +25,7 @@ from worldgen.groundtruth import difficulty, truth
 from worldgen.scene.doors import door_records
 from worldgen.scene.footprint import scene_footprints
 
-__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "free_area_ratio", "mover_entry"]
+__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "free_area_ratio", "mover_entry", "person_entry"]
 
 #: The value of world.json's ``schema`` field; a breaking change bumps the number.
 SCHEMA_ID = "worldgen.world/1"
@@ -57,7 +57,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
         "entities": [_entity(scene, node) for node in scene.nodes],
         "doors": door_records(scene),
-        "dynamic_obstacles": [mover_entry(m, world.params) for m in scene.movers],
+        "dynamic_obstacles": [mover_entry(m, world.params) for m in scene.movers if not m.person],
         "tasks": [task_entry(world, task, path) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
@@ -91,7 +91,21 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         meta["preset"] = world.preset
     if getattr(world, "difficulty_request", None):
         meta["difficulty_request"] = world.difficulty_request
+    people = [m for m in scene.movers if m.person]
+    if people:  # only then, so that every world without people keeps its bytes
+        _add_people(meta, world, people)
     return _plain(meta)
+
+
+def _add_people(meta: dict, world, people) -> None:
+    """world.json's ``people``, ``robot.max_speed`` and each task's ``timed_path`` (docs/people.md)."""
+    meta["people"] = [person_entry(m, world.params) for m in people]
+    meta["robot"]["max_speed"] = world.params["robot_speed"]
+    timed = list(getattr(world.feasibility, "timed_paths", ()))
+    timed += [None] * max(0, len(meta["tasks"]) - len(timed))
+    for entry, certificate in zip(meta["tasks"], timed):
+        entry["timed_path"] = None if certificate is None else certificate.rows.tolist()
+        entry["arrival_time"] = None if certificate is None else certificate.arrival
 
 
 def dumps(meta: Mapping[str, Any]) -> str:
@@ -115,6 +129,14 @@ def mover_entry(mover, params: Mapping[str, Any]) -> dict:
         "loop": mover.loop,
         "formats": movers_note(params),
     }
+
+
+def person_entry(person, params: Mapping[str, Any]) -> dict:
+    """A person's ``people[]`` entry of world.json: a mover's, without ``loop`` (a person walks once
+    and then stands where it stopped)."""
+    entry = mover_entry(person, params)
+    del entry["loop"]
+    return entry
 
 
 def free_area_ratio(scene, height: float) -> float:

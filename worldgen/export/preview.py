@@ -55,6 +55,8 @@ from worldgen.scene.pose import rpy_matrix
 
 __all__ = ["DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
            "Layout", "layout", "draw", "render", "blocking"]
+#: Seconds between two dots on a person's track.
+TIME_MARK = 5.0
 
 # -- geometry from the metadata ------------------------------------------------
 
@@ -202,6 +204,13 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
         pen.line(traj, COLOURS["mover"], width=2, dash=7)
         x, y = traj[0]
         pen.shape("circle", (x, y, mover["radius"]), outline=COLOURS["mover"], width=2)
+    for person in meta.get("people", []) or []:  # a person's track, with a dot every TIME_MARK seconds
+        rows = np.asarray(person["trajectory"], dtype=float)
+        pen.line(rows[:, 1:].tolist(), COLOURS["mover"], width=1)
+        marks = np.arange(0.0, rows[-1, 0] + 1e-9, TIME_MARK)
+        for x, y in zip(np.interp(marks, rows[:, 0], rows[:, 1]), np.interp(marks, rows[:, 0], rows[:, 2])):
+            pen.shape("circle", (x, y, 0.05), fill=COLOURS["mover"])
+        pen.shape("circle", (rows[0, 1], rows[0, 2], person["radius"]), outline=COLOURS["mover"], width=2)
 
     tasks = list(meta.get("tasks", []))
     for t in tasks:

@@ -181,7 +181,7 @@ def legend(meta: Mapping[str, Any], unreachable: bool) -> tuple[tuple[str, str, 
         "no-go zone": bool(roles - {"floor", "marker"}), "unreachable": unreachable,
         "path": any(t.get("path") and not t.get("requires_door_open") for t in tasks),
         "path (opens a door)": through_door, "spawn": bool(tasks), "goal": bool(tasks),
-        "door": bool(meta.get("doors")) or "door" in roles, "mover": bool(meta.get("dynamic_obstacles")),
+        "door": bool(meta.get("doors")) or "door" in roles, "mover": bool(meta.get("dynamic_obstacles") or meta.get("people")),
     }
     return tuple(entry for entry in _LEGEND if shown[entry[0]])
 

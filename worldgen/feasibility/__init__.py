@@ -11,7 +11,9 @@ in the order the data flows through them:
 - ``passage``: the exact narrowest passage (the widest disc that gets through);
 - ``collision``: FCL objects and broad-phased distance queries;
 - ``verify``: the FCL proof of a path, on the volume the footprint sweeps along it;
-- ``check``: running it all and assembling the report.
+- ``check``: running it all and assembling the report;
+- ``crowd``: people walked by the social force model round the exact geometry (docs/people.md);
+- ``timed``: the timed path among them, the certificate ``api.generate`` adds with people.
 """
 
 from worldgen.feasibility.check import check

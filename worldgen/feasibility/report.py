@@ -59,6 +59,9 @@ class FeasibilityReport:
     #: Checks that inform but never decide ``feasible`` (e.g. ``reachable_initial_state``
     #: for doors: the reference path assumes them open).
     informational: tuple[Check, ...] = ()
+    #: With people: per task, the certificate among them (a TimedPath of
+    #: :mod:`worldgen.feasibility.timed`, None where there is none); () without people.
+    timed_paths: tuple = ()
 
     @property
     def feasible(self) -> bool:

@@ -27,13 +27,14 @@ def _mover_rows(source) -> list[tuple[str, float, np.ndarray, bool]]:
     if isinstance(source, Scene):
         source = source.movers
     elif isinstance(source, Mapping):
-        source = source.get("dynamic_obstacles", [])
+        # The order of the scene's movers and of the MJCF's mocap bodies: scripted movers, then people.
+        source = list(source.get("dynamic_obstacles", [])) + list(source.get("people", []))
     out = []
     for m in source:
         if isinstance(m, Mover):
             out.append((m.name, m.height, np.asarray(m.trajectory, dtype=float), m.loop))
         else:
-            out.append((m["name"], float(m["height"]), np.asarray(m["trajectory"], dtype=float), bool(m["loop"])))
+            out.append((m["name"], float(m["height"]), np.asarray(m["trajectory"], dtype=float), bool(m.get("loop", False))))
     return out
 
 
@@ -45,7 +46,7 @@ def mover_names(source) -> list[str]:
 def mover_positions(source, t: float) -> np.ndarray:
     """(n, 2) float: where each mover's centre is at time ``t`` s (straight legs, constant speed).
 
-    ``source`` is a World, a Scene, a world.json dict (``dynamic_obstacles``) or a
+    ``source`` is a World, a Scene, a world.json dict (``dynamic_obstacles``, then ``people``) or a
     list of movers. A looping mover repeats its script; one that does not loop
     waits at its last point.
     """
