@@ -217,6 +217,8 @@ def test_the_legend_lists_what_the_world_has():
     assert "door" not in plain and "mover" not in plain and "path (opens a door)" not in plain and "path" in plain
     moving = names(worldgen.generate("cluttered", 0, size=[8, 8], n_obstacles=3, n_movers=1))
     assert "mover" in moving and "door" not in moving
+    people = names(worldgen.generate("cluttered", 1, size=[8, 8], n_obstacles=3, n_people=2))
+    assert "person (dot every 5 s)" in people and "mover" not in people
     door = worldgen.generate("door", 2)
     assert door.metadata["tasks"][0]["requires_door_open"]
     assert {"door", "path (opens a door)"} <= set(names(door)) and "path" not in names(door)

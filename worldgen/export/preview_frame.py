@@ -166,7 +166,7 @@ def _fit(text: str, font, room: float) -> str:
 _LEGEND = (("obstacle", "obstacle", "box"), ("wall", "wall", "box"), ("no-go zone", "nogo", "zone"),
            ("unreachable", "unreachable", "box"), ("path", "path", "line"),
            ("path (opens a door)", "path", "line"), ("spawn", "spawn", "disc"), ("goal", "goal", "disc"),
-           ("door", "door", "box"), ("mover", "mover", "dash"))
+           ("door", "door", "box"), ("mover", "mover", "dash"), ("person (dot every 5 s)", "mover", "track"))
 _LEGEND_START = _MARGIN + _SCALE_BAR_MAX + 28 + 40  # right of the longest scale bar and the axes
 _LEGEND_GAP = 12  # px between one entry's text and the next glyph
 
@@ -181,7 +181,8 @@ def legend(meta: Mapping[str, Any], unreachable: bool) -> tuple[tuple[str, str, 
         "no-go zone": bool(roles - {"floor", "marker"}), "unreachable": unreachable,
         "path": any(t.get("path") and not t.get("requires_door_open") for t in tasks),
         "path (opens a door)": through_door, "spawn": bool(tasks), "goal": bool(tasks),
-        "door": bool(meta.get("doors")) or "door" in roles, "mover": bool(meta.get("dynamic_obstacles") or meta.get("people")),
+        "door": bool(meta.get("doors")) or "door" in roles, "mover": bool(meta.get("dynamic_obstacles")),
+        "person (dot every 5 s)": bool(meta.get("people")),
     }
     return tuple(entry for entry in _LEGEND if shown[entry[0]])
 
@@ -228,6 +229,9 @@ def footer(image: Image.Image, lay: Layout, entries=_LEGEND) -> None:
                 d.line([(gx + 5, gy), (gx + 9, gy)], fill=COLOURS["door"], width=3)
         elif glyph == "disc":
             d.ellipse([gx + 1, gy - 6, gx + 13, gy + 6], fill=COLOURS[colour + "_fill"], outline=c, width=2)
+        elif glyph == "track":
+            d.line([(gx, gy), (gx + 14, gy)], fill=c, width=1)
+            d.ellipse([gx + 5, gy - 2, gx + 9, gy + 2], fill=c)
         else:
             d.line([(gx, gy), (gx + 5, gy)], fill=c, width=2)
             d.line([(gx + 9, gy), (gx + 14, gy)], fill=c, width=2)
