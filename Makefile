@@ -5,9 +5,10 @@ PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 RL_STAMP := $(VENV)/.installed-rl
+TRAIN_STAMP := $(VENV)/.installed-train
 DEMO_OUT ?= demo-worlds
 
-.PHONY: demo test bench fuzz clean
+.PHONY: demo test bench bench-learning fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -20,6 +21,11 @@ $(TEST_STAMP): $(STAMP)
 
 $(RL_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[rl]'
+	touch $@
+
+# stable-baselines3 brings PyTorch (the benchmark runs it on the CPU, one thread).
+$(TRAIN_STAMP): $(RL_STAMP)
+	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[train]'
 	touch $@
 
 ## demo: install, then generate worlds from the cluttered generator's defaults and say where they are
@@ -41,6 +47,13 @@ bench: $(RL_STAMP)
 	$(PY) benchmarks/bench_pipeline.py
 	$(PY) benchmarks/bench_pack.py --worlds 1000 --jobs 2
 	$(PY) benchmarks/bench_env.py
+
+## bench-learning: PPO (stable-baselines3) on one core learns worldgen/Navigation-v0 with the default
+## reward and with `walkthrough`, against random, heuristic and path-follower baselines on held-out
+## worlds: hours of CPU, not in `make test` or CI (benchmarks/bench_learning.py; JSON in
+## benchmarks/results/, the curves in docs/img/learning.png)
+bench-learning: $(TRAIN_STAMP)
+	$(PY) benchmarks/bench_learning.py
 
 ## fuzz: the long fuzz sweep over every generator's full parameter ranges (a table; reproducers of defects)
 fuzz: $(TEST_STAMP)
