@@ -7,8 +7,9 @@ world's bounds, and the distance to the goal is propagated over it:
 
 - **exact where the goal is in sight**: a grid node whose straight segment to the goal is
   free for the disc (the configuration space's own exact segment test) gets the
-  straight-line distance; so does any query point whose cell touches such nodes and
-  whose own segment is free (tested exactly for the cells on the edge of the goal's view);
+  straight-line distance; so does a query point in a cell whose four corners all are, and a
+  point in a cell on the edge of the goal's view or of the free space whose own segment is
+  free (tested exactly);
 - **elsewhere**: Dijkstra over the free nodes with 16-connectivity (moves (1, 0), (1, 1),
   (2, 1) and their mirrors), seeded with those exact values. A 16-connected path is at most
   1 / cos(13.28 deg) - 1 = 2.75 % longer than the straight line it stands for, and it may
@@ -101,9 +102,14 @@ class GeodesicField:
             dist = euclid.copy()
         self.values = dist.reshape(nx, ny)
         self.seen = seen.reshape(nx, ny)
-        # Per cell: 0 none of its corners in sight of the goal, 4 all of them.
+        # Per cell: 1 all four corners in sight of the goal (the straight line holds inside, up to an obstacle
+        # corner poking in between nodes); 2 some are, or some corner is not free (a point inside may still
+        # see the goal): test the point itself; 0 none is and all are free: interpolate.
         s4 = self.seen.astype(np.int8)
-        self._cell_seen = s4[:-1, :-1] + s4[1:, :-1] + s4[:-1, 1:] + s4[1:, 1:]
+        f4 = free.reshape(nx, ny).astype(np.int8)
+        seen_corners = s4[:-1, :-1] + s4[1:, :-1] + s4[:-1, 1:] + s4[1:, 1:]
+        free_corners = f4[:-1, :-1] + f4[1:, :-1] + f4[:-1, 1:] + f4[1:, 1:]
+        self._cell = np.where(seen_corners == 4, 1, np.where((seen_corners > 0) | (free_corners < 4), 2, 0)).astype(np.int8)
 
     @classmethod
     def for_scene(cls, scene, robot, goal, spacing: float = 0.05) -> "GeodesicField":
@@ -130,8 +136,8 @@ class GeodesicField:
         nx, ny = self.shape
         i = min(max(int(fx), 0), nx - 2)
         j = min(max(int(fy), 0), ny - 2)
-        k = self._cell_seen[i, j]
-        if k == 4 or (k and self.straight_free(x, y)):
+        k = self._cell[i, j]
+        if k == 1 or (k == 2 and self.straight_free(x, y)):
             return math.hypot(x - gx, y - gy)
         u = min(max(fx - i, 0.0), 1.0)
         t = min(max(fy - j, 0.0), 1.0)
