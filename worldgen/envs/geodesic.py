@@ -81,8 +81,10 @@ class GeodesicField:
             both = ok[a] & ok[b]
             a, b = a[both], b[both]
             length = h * math.hypot(dx, dy)
-            forward = ~(band[a] & free[b])  # a -> b, unless it leaves the band for free space
-            backward = ~(free[a] & band[b])
+            # a -> b, unless it leaves the band for free space; never into a node in sight of the goal
+            # (its exact value is final), which leaves most edges out of the search.
+            forward = ~(band[a] & free[b]) & ~seen[b]
+            backward = ~(free[a] & band[b]) & ~seen[a]
             src += [a[forward], b[backward]]
             dst += [b[forward], a[backward]]
             w += [np.full(int(forward.sum()), length), np.full(int(backward.sum()), length)]
