@@ -99,11 +99,12 @@ class GapHeuristic:
     """
 
     def __init__(self, angles, sectors: int, v_max: float, w_max: float, free: float = 0.8, gain: float = 2.0,
-                 turn_in_place: float = 0.6, slow: float = 0.25):
+                 turn_in_place: float = 0.6, slow: float = 0.25, cone: float = math.pi / 3):
         a = np.asarray(angles, dtype=float).reshape(sectors, -1)
         self.bearing = np.arctan2(np.sin(a).mean(axis=1), np.cos(a).mean(axis=1))
         self.v_max, self.w_max = float(v_max), float(w_max)
         self.free, self.gain, self.turn_in_place, self.slow = float(free), float(gain), float(turn_in_place), float(slow)
+        self.cone = float(cone)
 
     @classmethod
     def for_env(cls, env, **kwargs) -> "GapHeuristic":
@@ -120,9 +121,9 @@ class GapHeuristic:
         wide = np.minimum(scan, np.minimum(np.roll(scan, 1), np.roll(scan, -1)))  # the robot is wider than a ray
         ok = (wide > self.free) | (scan > distance)
         target = self.bearing[int(np.argmin(np.where(ok, off, np.inf)))] if ok.any() else goal
-        # Anything in the forward half-plane closer than `free` (a box beside the robot too) slows the robot
-        # and pushes its heading away, the harder the closer.
-        fwd = np.abs(self.bearing) < math.pi / 2
+        # Anything within `cone` of the heading closer than `free` (a box beside the robot's path too) slows
+        # the robot and pushes its heading away, the harder the closer.
+        fwd = np.abs(self.bearing) < self.cone
         push = np.clip((self.free - scan[fwd]) / self.free, 0.0, 1.0)
         w = float(np.clip(self.gain * target - self.gain * float(np.sum(push * np.sign(self.bearing[fwd]))),
                           -self.w_max, self.w_max))
