@@ -13,8 +13,8 @@ Protocol (the same for every reward; all of it recorded in the JSON):
 - training worlds: each environment draws its world seeds from its own seeded stream (uniform over 63-bit
   seeds); held-out worlds: world seeds 10^9 + i for i < ``--eval-worlds`` (100), which the training draws
   hit with probability below 1e-10 over the whole run;
-- PPO: ``n_steps`` 256 per env (2,048 a rollout), batch 256, 10 epochs, lr 3e-4, gamma 0.99 (the shaping's
-  ``reward_discount``), GAE 0.95, clip 0.2, MLP 64 x 64, one torch thread, the process pinned to one core;
+- PPO: ``n_steps`` 256 per env (2,048 a rollout), batch 256, 10 epochs, lr 3e-4, gamma 0.99, GAE 0.95,
+  clip 0.2, MLP 64 x 64, one torch thread, the process pinned to one core;
 - evaluation every ``--eval-every`` steps (50,000): the deterministic policy drives each held-out world
   once; success rate and mean SPL (the environment's own episode figures, under the oracles' rules);
 - baselines on the same held-out worlds: random actions, :class:`GapHeuristic` (observation only) and

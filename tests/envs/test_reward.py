@@ -69,18 +69,19 @@ def away(env):
 def test_driving_away_earns_less_than_standing_still_and_both_less_than_the_reference_path(preset, generator, params, seed):
     from worldgen.envs.policies import PathFollower
 
-    sums = {}
-    for name in ("along", "still", "away"):
-        env = sweep_env(preset, generator, params, lidar_beams=36)
-        env.reset(seed=seed)
-        f = PathFollower.for_env(env)
-        policy = {"along": lambda e: f.action(*e.robot_pose), "still": lambda e: [0.0, 0.0], "away": away}[name]
-        sums[name], rewards = run(env, policy, 60)
-        if name == "still":
-            # Standing still: (1 - gamma) k G - c every step, G the geodesic distance at the spawn.
-            G = env.geodesic.distance(*env.robot_pose[:2])
-            assert rewards == pytest.approx([0.01 * 10.0 * G - 0.05] * len(rewards), abs=1e-6)
-    assert sums["away"] < sums["still"] < sums["along"], sums
+    for gamma in (1.0, 0.99):  # the default, and the learner's discount
+        sums = {}
+        for name in ("along", "still", "away"):
+            env = sweep_env(preset, generator, params, lidar_beams=36, reward_discount=gamma)
+            env.reset(seed=seed)
+            f = PathFollower.for_env(env)
+            policy = {"along": lambda e: f.action(*e.robot_pose), "still": lambda e: [0.0, 0.0], "away": away}[name]
+            sums[name], rewards = run(env, policy, 60)
+            if name == "still":
+                # Standing still: (1 - gamma) k G - c every step, G the geodesic distance where it stands.
+                G = env.geodesic.distance(*env.robot_pose[:2])
+                assert rewards == pytest.approx([(1 - gamma) * 10.0 * G - 0.05] * len(rewards), abs=1e-6)
+        assert sums["away"] < sums["still"] < sums["along"], (gamma, sums)
 
 
 def test_the_shaping_telescopes_over_an_episode():

@@ -44,8 +44,9 @@ SETTINGS: tuple[Param, ...] = (
     Param("reward_progress", "float", 10.0, "scale of the progress terms: the potential is -reward_progress x "
           "geodesic distance (geodesic); reward_progress x decrease of the straight-line distance "
           "(euclidean_progress)", 0.0, 1e6, unit="1/m"),
-    Param("reward_discount", "float", 0.99, "gamma of the potential-based shaping gamma * phi(s') - phi(s): set it "
-          "to the learner's discount, which leaves its optimal policy unchanged", 0.0, 1.0),
+    Param("reward_discount", "float", 1.0, "gamma of the potential-based shaping gamma * phi(s') - phi(s) (1: the "
+          "decrease of the geodesic distance, standing still earns -reward_time; the learner's discount: exact "
+          "policy invariance, but standing still earns (1 - gamma) k G - reward_time)", 0.0, 1.0),
     Param("reward_time", "float", 0.05, "time penalty subtracted every step (geodesic, euclidean_progress)",
           0.0, 1e6),
     Param("time_limit_factor", "float", 2.0, "time limit as a multiple of the optimal time L / v_max (L the exact "

@@ -10,18 +10,21 @@ or any callable.
 - ``G(s)``: the geodesic distance from the robot's centre to the goal for the robot's footprint
   (the length of the shortest path the feasibility proof would find from there:
   :class:`~worldgen.envs.geodesic.GeodesicField`), so the potential points round obstacles, not into them;
-- ``k`` = ``reward_progress`` (10 per m), ``gamma`` = ``reward_discount`` (0.99; set it to the learner's
-  discount), ``c`` = ``reward_time`` (0.05 a step).
+- ``k`` = ``reward_progress`` (10 per m), ``gamma`` = ``reward_discount`` (1 by default: the shaping is
+  then the decrease of the geodesic distance, ``k * (G(s) - G(s'))``), ``c`` = ``reward_time`` (0.05 a step).
 
 ``gamma * phi(s') - phi(s)`` is potential-based shaping (Ng, Harada & Russell, "Policy invariance
 under reward transformations: theory and application to reward shaping", ICML 1999): over an
-episode its discounted sum telescopes to ``gamma^T phi(s_T) - phi(s_0)``, so it adds a term that
-depends on the start and end states alone and leaves the optimal policy of the
-``R_terminal - c`` task unchanged, while paying every step for progress along the shortest
-feasible path. A terminal step keeps ``phi(s')`` of where it ended (a collision near the goal costs
-less than one far from it). Per step, driving toward the goal along the shortest path earns about
-``k * v * dt``; standing still earns ``(1 - gamma) * k * G - c``; driving away earns less than
-standing still.
+episode its discounted sum telescopes to ``gamma^T phi(s_T) - phi(s_0)``, a term that depends on
+the start and end states alone, while it pays every step for progress along the shortest
+feasible path. With ``gamma`` equal to the learner's discount the optimal policy of the
+``R_terminal - c`` task is exactly unchanged, but standing still then earns ``(1 - gamma) * k * G - c``
+a step, positive far from the goal: PPO (gamma 0.99) learned to stand still with it
+(``benchmarks/bench_learning.py``: 0 % success after 100,000 steps). The default ``gamma = 1``
+makes standing still cost ``c``; its sum over an episode is ``k * (G(s_0) - G(s_T))``. A terminal
+step keeps ``phi(s')`` of where it ended (a collision near the goal costs less than one far from
+it). Per step, driving toward the goal along the shortest path earns about ``k * v * dt``;
+driving away earns less than standing still.
 
 ``reward="walkthrough"``: the deep-RL navigation walkthrough's reward, as it was the default before:
 ``reward_collision``, else ``reward_goal``, else ``reward_speed * v - reward_turn * |w| -
