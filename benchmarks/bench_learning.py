@@ -122,7 +122,7 @@ def train(reward: str, steps: int, eval_every: int, worlds: int) -> dict:
     venv = VecNormalize(DummyVecEnv([lambda k=k: _make_env(reward, k) for k in range(N_ENVS)]), gamma=PPO_KW["gamma"])
     model = PPO("MlpPolicy", venv, seed=0, verbose=0, device="cpu", **PPO_KW)
     curve: list[dict] = []
-    out = {"reward": reward, "env": ENV_KW, "ppo": PPO_KW, "n_envs": N_ENVS, "eval_every": eval_every,
+    out = {"reward": reward, "label": reward, "env": ENV_KW, "ppo": PPO_KW, "n_envs": N_ENVS, "eval_every": eval_every,
            "eval_worlds": worlds, "held_out_world_seeds": f"{HELD_OUT} + i, i < {worlds}", "curve": curve,
            "steps_target": steps, "python": platform.python_version(), "machine": platform.machine()}
     path = RESULTS / f"learning_{reward}.json"
@@ -160,7 +160,8 @@ def report(worlds: int) -> int:
     runs = {}
     for path in sorted(RESULTS.glob("learning_*.json")):
         data = json.loads(path.read_text())
-        runs[data["reward"]] = data
+        if "curve" in data:  # a training run (learning_baselines.json is not one)
+            runs[data.get("label", data["reward"])] = data
     base_path = RESULTS / "learning_baselines.json"
     base = json.loads(base_path.read_text()) if base_path.exists() else baselines(worlds)
     _write(base_path, base)
@@ -168,10 +169,10 @@ def report(worlds: int) -> int:
     print(f"{'policy':<24} {'steps':>9} {'success':>8} {'SPL':>6}")
     for name, fig in base.items():
         print(f"{name:<24} {'-':>9} {fig['success']:>8.2f} {fig['spl']:>6.3f}")
-    for reward, data in runs.items():
+    for label, data in runs.items():
         last = data["curve"][-1]
         best = max(data["curve"], key=lambda c: (c["success"], c["spl"]))
-        print(f"{'PPO ' + reward:<24} {last['steps']:>9} {last['success']:>8.2f} {last['spl']:>6.3f}   "
+        print(f"{'PPO ' + label:<24} {last['steps']:>9} {last['success']:>8.2f} {last['spl']:>6.3f}   "
               f"(best {best['success']:.2f} / {best['spl']:.3f} at {best['steps']})")
     _write(RESULTS / "learning.json", {"baselines": base, "runs": runs})
     _plot(runs, base)
@@ -184,12 +185,14 @@ def _plot(runs: dict, base: dict) -> None:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))
     for ax, key, label in ((axes[0], "success", "success rate"), (axes[1], "spl", "mean SPL")):
-        for reward, data in runs.items():
+        for name, data in runs.items():
             xs = [c["steps"] for c in data["curve"]]
-            ax.plot(xs, [c[key] for c in data["curve"]], marker="o", ms=3, label=f"PPO, reward={reward}")
+            ax.plot(xs, [c[key] for c in data["curve"]], marker="o", ms=3, label=f"PPO, {name}")
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x / 1000:.0f}k"))
         for (name, fig_), style in zip(base.items(), (":", "--", "-.")):
             ax.axhline(fig_[key], color="grey", ls=style, lw=1, label=name)
         ax.set_xlabel("environment steps")
