@@ -186,7 +186,7 @@ class NavigationEnv(gym.Env):
         self._painter = None
         obs = self._observe()
         #: Seconds the last reset spent getting the world (generating or reading it), adding the robot and
-        #: compiling, and in all (benchmarks/bench_env.py reports them).
+        #: compiling, building the geodesic field, and in all (benchmarks/bench_env.py reports them).
         self.reset_timings = {"world": t1 - t0, "compile": t2 - t1, "geodesic": t3 - t2,
                               "total": time.perf_counter() - t0}
         x, y, _ = sim.pose()
