@@ -112,7 +112,7 @@ def baselines(worlds: int) -> dict:
     return out
 
 
-def train(reward: str, steps: int, eval_every: int, worlds: int) -> dict:
+def train(reward: str, steps: int, eval_every: int, worlds: int, net: tuple = (64, 64), label: str = "") -> dict:
     import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.callbacks import BaseCallback
@@ -120,12 +120,14 @@ def train(reward: str, steps: int, eval_every: int, worlds: int) -> dict:
 
     torch.set_num_threads(1)
     venv = VecNormalize(DummyVecEnv([lambda k=k: _make_env(reward, k) for k in range(N_ENVS)]), gamma=PPO_KW["gamma"])
-    model = PPO("MlpPolicy", venv, seed=0, verbose=0, device="cpu", **PPO_KW)
+    model = PPO("MlpPolicy", venv, seed=0, verbose=0, device="cpu", policy_kwargs={"net_arch": list(net)}, **PPO_KW)
     curve: list[dict] = []
-    out = {"reward": reward, "label": reward, "env": ENV_KW, "ppo": PPO_KW, "n_envs": N_ENVS, "eval_every": eval_every,
-           "eval_worlds": worlds, "held_out_world_seeds": f"{HELD_OUT} + i, i < {worlds}", "curve": curve,
+    label = label or (reward if tuple(net) == (64, 64) else f"{reward}, MLP {' x '.join(map(str, net))}")
+    out = {"reward": reward, "label": label, "net_arch": list(net), "env": ENV_KW, "ppo": PPO_KW, "n_envs": N_ENVS,
+           "eval_every": eval_every, "eval_worlds": worlds, "curve": curve,
+           "held_out_world_seeds": f"{HELD_OUT} + i, i < {worlds}",
            "steps_target": steps, "python": platform.python_version(), "machine": platform.machine()}
-    path = RESULTS / f"learning_{reward}.json"
+    path = RESULTS / f"learning_{label.replace(', ', '_').replace(' ', '')}.json"
     start = time.perf_counter()
 
     def act(obs, env):
@@ -140,7 +142,7 @@ def train(reward: str, steps: int, eval_every: int, worlds: int) -> dict:
         out["steps_done"] = n
         out["steps_per_s"] = round(n / max(curve[-1]["train_seconds"], 1e-9), 1)
         _write(path, out)
-        print(f"{reward:<12} {n:>9} steps  success {figures['success']:.2f}  SPL {figures['spl']:.3f}  "
+        print(f"{label:<12} {n:>9} steps  success {figures['success']:.2f}  SPL {figures['spl']:.3f}  "
               f"({out['steps_per_s']} train steps/s)", flush=True)
 
     class Every(BaseCallback):
@@ -213,6 +215,7 @@ def main(argv=None) -> int:
     ap.add_argument("--steps", type=int, default=1_000_000, help="training steps per reward (default 1,000,000)")
     ap.add_argument("--eval-every", type=int, default=50_000, help="steps between evaluations (default 50,000)")
     ap.add_argument("--eval-worlds", type=int, default=100, help="held-out worlds per evaluation (default 100)")
+    ap.add_argument("--net", type=int, nargs="+", default=[64, 64], help="the MLP's hidden layers (default 64 64)")
     ap.add_argument("--core", type=int, default=None, help="pin to this core (default: the first allowed)")
     ap.add_argument("--report", action="store_true", help="only gather the runs' JSON, run the baselines, print, draw")
     args = ap.parse_args(argv)
@@ -226,7 +229,7 @@ def main(argv=None) -> int:
         return 2
     if not args.report:
         for reward in args.reward or ["geodesic", "walkthrough"]:
-            train(reward, args.steps, args.eval_every, args.eval_worlds)
+            train(reward, args.steps, args.eval_every, args.eval_worlds, tuple(args.net))
     return report(args.eval_worlds)
 
 
