@@ -6,9 +6,10 @@ STAMP  := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 RL_STAMP := $(VENV)/.installed-rl
 ROS_STAMP := $(VENV)/.installed-ros
+TRAIN_STAMP := $(VENV)/.installed-train
 DEMO_OUT ?= demo-worlds
 
-.PHONY: demo test bench fuzz clean
+.PHONY: demo test bench bench-learning fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -25,6 +26,11 @@ $(RL_STAMP): $(STAMP)
 
 $(ROS_STAMP): $(STAMP)
 	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[ros]'
+	touch $@
+
+# stable-baselines3 brings PyTorch (the benchmark runs it on the CPU, one thread).
+$(TRAIN_STAMP): $(RL_STAMP)
+	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[train]'
 	touch $@
 
 ## demo: install, then generate worlds from the cluttered generator's defaults, say where they are
@@ -62,6 +68,13 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	nice -n 10 $(PY) benchmarks/bench_difficulty.py
 	$(PY) benchmarks/bench_leveling.py
 	$(PY) benchmarks/bench_people.py
+
+## bench-learning: PPO (stable-baselines3) on one core learns worldgen/Navigation-v0 with the default
+## reward and with `walkthrough`, against random, heuristic and path-follower baselines on held-out
+## worlds: hours of CPU, not in `make test` or CI (benchmarks/bench_learning.py; JSON in
+## benchmarks/results/, the curves in docs/img/learning.png)
+bench-learning: $(TRAIN_STAMP)
+	$(PY) benchmarks/bench_learning.py
 
 ## fuzz: the long fuzz sweep over every generator's full parameter ranges (a table; reproducers of defects)
 fuzz: $(TEST_STAMP)

@@ -6,21 +6,25 @@ Pinned to one core (os.sched_setaffinity; --all-cores to not pin). Timed with
 time.perf_counter, reported as medians (these machines are shared and noisy):
 
   step         one env.step: 360 lidar beams, 0.1 s control period (50 MuJoCo steps at 0.002 s),
-               uniform random actions; steps/s = 1 / median, and also over the whole run
-               (every step, episode ends included, resets not)
+               uniform random actions, the default reward (geodesic shaping); steps/s = 1 / median, and
+               also over the whole run (every step, episode ends included, resets not)
+  step_walkthrough  the same with reward="walkthrough" (no geodesic field: the step as it was before
+               issue 22), measured in the same run for a like-for-like comparison
   episode_end  the step that ends an episode, which adds the oracles' figures (FCL min_clearance)
   reset        env.reset(): a new world, checked, with the robot added and compiled into MuJoCo, first scan;
                split into  generate   worldgen.generate alone, for the same seeds (the feasibility
                                       planner's cost lives here)
                            export     the world's MJCF tree and its task (world - generate)
                            compile    robot added to the MJCF, MjModel + MjData
+                           geodesic   the geodesic distance field (worldgen.envs.geodesic)
                            rest       everything else (first scan, bookkeeping)
   inject_*     MJCF, robot added, compiled, MjData: through lxml (the environment's way: the
                exporter's tree, a body appended, from_xml_string) and through mujoco.MjSpec (MJCF text,
                the body added through its API, compiled), on the same worlds, alternating which goes
                first: which is faster
 
-Targets (issue 11): >= 1,000 steps/s; reset median <= 25 ms. The table goes to stdout, the figures
+Targets (issue 11): >= 1,000 steps/s; reset median <= 25 ms. Issue 22: a step with the default reward
+within 20 % of the walkthrough reward's. The table goes to stdout, the figures
 to benchmarks/results/env.json.
 """
 
@@ -77,24 +81,26 @@ def bench_resets(env, resets: int) -> dict:
     params = load(PRESET).params
     env.reset(seed=123)  # warm-up
     seeds = [1000 + i for i in range(resets)]
-    total, world, compile_ = [], [], []
+    total, world, compile_, geodesic = [], [], [], []
     for s in seeds:
         env.reset(options={"world_seed": s})
         t = env.unwrapped.reset_timings
         total.append(t["total"])
         world.append(t["world"])
         compile_.append(t["compile"])
+        geodesic.append(t["geodesic"])
     generate = []
     for s in seeds:
         t0 = time.perf_counter()
         worldgen.generate("cluttered", s, **params)
         generate.append(time.perf_counter() - t0)
     med = {k: statistics.median(v) for k, v in
-           (("total", total), ("world", world), ("compile", compile_), ("generate", generate))}
-    rest = [t - w - c for t, w, c in zip(total, world, compile_)]
+           (("total", total), ("world", world), ("compile", compile_), ("generate", generate), ("geodesic", geodesic))}
+    rest = [t - w - c - g for t, w, c, g in zip(total, world, compile_, geodesic)]
     return {"reset_median_ms": _ms(med["total"]), "generate_median_ms": _ms(med["generate"]),
             "export_median_ms": _ms(max(0.0, med["world"] - med["generate"])),
-            "compile_median_ms": _ms(med["compile"]), "rest_median_ms": _ms(statistics.median(rest)),
+            "compile_median_ms": _ms(med["compile"]), "geodesic_median_ms": _ms(med["geodesic"]),
+            "rest_median_ms": _ms(statistics.median(rest)),
             "reset_p90_ms": _ms(float(np.percentile(total, 90))), "resets": resets}
 
 
@@ -179,6 +185,9 @@ def main(argv=None) -> int:
                "machine": platform.machine(), "cpus": os.cpu_count(), "preset": PRESET, "lidar_beams": 360,
                "control_period_s": 0.1, "pinned_to_one_core": not args.all_cores}
     results["step"] = bench_steps(env, args.steps)
+    walk = gymnasium.make("worldgen/Navigation-v0", preset=PRESET, lidar_beams=360, control_period=0.1, reward="walkthrough")
+    results["step_walkthrough"] = bench_steps(walk, args.steps)
+    walk.close()
     results["reset"] = bench_resets(env, args.resets)
     results["injection"] = bench_injection(min(args.resets, 100))
     env.close()
@@ -187,10 +196,15 @@ def main(argv=None) -> int:
           f"{'one core' if not args.all_cores else 'all cores'}")
     print(f"{'step':<12} median {s['step_median_us']:>8.1f} us  -> {s['steps_per_s_median']:>6} steps/s "
           f"(overall {s['steps_per_s_overall']} steps/s over {s['steps']} steps, {s['episodes']} episodes; target >= 1000)")
+    sw = results["step_walkthrough"]
+    ratio = s["step_median_us"] / sw["step_median_us"]
+    print(f"{'  walkthrough':<12} median {sw['step_median_us']:>8.1f} us  -> {sw['steps_per_s_median']:>6} steps/s "
+          f"(default / walkthrough = {ratio:.3f}; target <= 1.2)")
+    results["step_ratio_default_to_walkthrough"] = round(ratio, 4)
     print(f"{'episode_end':<12} median {s['episode_end_median_ms']} ms (the ending step, with the oracles' figures)")
     print(f"{'reset':<12} median {r['reset_median_ms']:>8.2f} ms  (p90 {r['reset_p90_ms']:.2f} ms over {r['resets']}; "
           f"target <= 25 ms)")
-    for part in ("generate", "export", "compile", "rest"):
+    for part in ("generate", "export", "compile", "geodesic", "rest"):
         print(f"  {part:<10} median {r[part + '_median_ms']:>8.2f} ms")
     print(f"{'inject':<12} lxml {i['inject_lxml_median_ms']:.3f} ms, MjSpec {i['inject_mjspec_median_ms']:.3f} ms "
           f"(export + robot + compile, median over {i['worlds']} worlds)")

@@ -68,5 +68,5 @@ def test_a_wall_of_a_door_world_still_ends_the_episode():
         _, reward, terminated, truncated, info = env.step([0.0 if abs(yaw) < 3.0 else 1.0, 1.0 if abs(yaw) < 3.0 else 0.0])
         if terminated or truncated:
             break
-    assert terminated and not info["success"] and reward == -100
+    assert terminated and not info["success"] and reward < -99  # the collision's -100, plus that step's shaping
     assert info["collisions"][0]["entity"].startswith("wall") and info["door_contacts"] == []

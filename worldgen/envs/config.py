@@ -37,6 +37,26 @@ SETTINGS: tuple[Param, ...] = (
     Param("lidar_sectors", "int", None, "bin the beams into this many sectors, each reporting its minimum "
           "(unset: every beam)", 1, 4096, optional=True),
     Param("lidar_noise", "float", 0.0, "standard deviation of Gaussian range noise on every hit", 0.0, 10.0, unit="m"),
+    Param("reward", "choice", "geodesic", "the step reward: geodesic (potential-based shaping by the exact geodesic "
+          "distance to the goal), walkthrough (the deep-RL walkthrough's v/2 - |w|/2 - (1 - r)/2) or "
+          "euclidean_progress (the decrease of the straight-line distance); see worldgen.envs.reward",
+          choices=("geodesic", "walkthrough", "euclidean_progress")),
+    Param("reward_progress", "float", 10.0, "scale of the progress terms: the potential is -reward_progress x "
+          "geodesic distance (geodesic); reward_progress x decrease of the straight-line distance "
+          "(euclidean_progress)", 0.0, 1e6, unit="1/m"),
+    Param("reward_discount", "float", 1.0, "gamma of the potential-based shaping gamma * phi(s') - phi(s) (1: the "
+          "decrease of the geodesic distance, standing still earns -reward_time; the learner's discount: exact "
+          "policy invariance, but standing still earns (1 - gamma) k G - reward_time)", 0.0, 1.0),
+    Param("reward_time", "float", 0.05, "time penalty subtracted every step (geodesic, euclidean_progress)",
+          0.0, 1e6),
+    Param("time_limit_factor", "float", 2.0, "time limit as a multiple of the optimal time L / v_max (L the exact "
+          "shortest path's length), plus a half turn pi / w_max; unset: the task's own time_limit (world.json)",
+          0.1, 1000.0, optional=True),
+    Param("geodesic_spacing", "float", 0.1, "grid spacing of the geodesic distance field built at each reset "
+          "(see worldgen.envs.geodesic for its error bound)", 0.01, 10.0, unit="m"),
+    Param("goal_distance_max", "float", None, "upper bound of the observed goal distance (unset: the diagonal of "
+          "the largest world the source can make; see NavigationEnv); larger distances are clipped to it",
+          0.01, 1e6, optional=True, unit="m"),
     Param("reward_goal", "float", 100.0, "reward on reaching the goal", -1e6, 1e6),
     Param("reward_collision", "float", -100.0, "reward on a collision", -1e6, 1e6),
     Param("reward_speed", "float", 0.5, "weight of the forward speed v in the step reward", -1e6, 1e6),
@@ -65,6 +85,13 @@ class EnvConfig:
     lidar_height: Optional[float]
     lidar_sectors: Optional[int]
     lidar_noise: float
+    reward: str
+    reward_progress: float
+    reward_discount: float
+    reward_time: float
+    time_limit_factor: Optional[float]
+    geodesic_spacing: float
+    goal_distance_max: Optional[float]
     reward_goal: float
     reward_collision: float
     reward_speed: float

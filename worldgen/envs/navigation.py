@@ -21,21 +21,30 @@ Values outside the box are clipped to it.
 Observation: ``Box`` of float32, length ``S + 4``:
 ``[scan[0..S-1], goal_distance, goal_angle, last_v, last_w]`` where ``scan`` is the
 lidar (``lidar_beams`` ranges, or ``lidar_sectors`` minima) in m within
-``[lidar_range_min, lidar_range_max]``; ``goal_distance`` (m, >= 0) and
+``[lidar_range_min, lidar_range_max]``; ``goal_distance`` (m, in ``[0, D]``) and
 ``goal_angle`` (rad in [-pi, pi], counter-clockwise from the heading) are the
 goal in the robot's frame (polar); ``last_v``, ``last_w`` the action applied in
-the previous step (0 after a reset).
+the previous step (0 after a reset). Every bound is finite and fixed at
+construction: ``D`` is ``goal_distance_max`` when set, else the diagonal of the
+largest world the source makes (a generator's ``size``; a pack's largest
+``bounds``; for a generator without ``size``, the seed-0 world's diagonal), and
+a longer distance is clipped to it.
 
 Reward, termination, truncation: :mod:`worldgen.envs.reward` (by default +100 at
-the goal, -100 on a collision, else ``v/2 - |w|/2 - (1 - r)/2`` near obstacles);
-an episode terminates when the robot's centre is within the task's
-``goal_tolerance`` of the goal at the end of a step, or at its first contact
-with anything but the floor (MuJoCo contacts, checked every physics step;
-movers count; door leaves do not: the robot may push a leaf open, and those
-contacts are reported apart, ``door_contacts``); it is truncated at the task's ``time_limit``.
+the goal, -100 on a collision, plus potential-based shaping by the geodesic
+distance to the goal, minus a time penalty; ``reward="walkthrough"`` for the
+walkthrough's ``v/2 - |w|/2 - (1 - r)/2``); an episode terminates when the
+robot's centre is within the task's ``goal_tolerance`` of the goal at the end
+of a step, or at its first contact with anything but the floor (MuJoCo
+contacts, checked every physics step; movers count; door leaves do not: the
+robot may push a leaf open, and those contacts are reported apart,
+``door_contacts``); it is truncated at the time limit: ``time_limit_factor`` x
+the optimal time ``L / v_max`` plus a half turn ``pi / w_max`` (default factor
+2), or the task's own ``time_limit`` (world.json) when ``time_limit_factor`` is None.
 
 Info: at reset ``world_id``, ``task``, ``reference_path_length`` (the optimal
-path length, world.json ``tasks[].path.length``), ``time_limit``, and
+path length, world.json ``tasks[].path.length``), ``time_limit`` (the one in force),
+``geodesic_distance`` (the field's value at the spawn, when it is built), and
 ``world_seed`` (generated worlds) or ``world_index`` (packs); every step
 ``time``; at an episode's end also the figures of
 :meth:`worldgen.envs.episode.Episode.figures`, under the oracles' names:
@@ -60,6 +69,7 @@ import numpy as np
 from worldgen.envs.config import resolve
 from worldgen.envs.deps import require_gymnasium
 from worldgen.envs.episode import Episode
+from worldgen.envs.geodesic import GeodesicField
 from worldgen.envs.lidar import Lidar
 from worldgen.envs.movers import MoverScript
 from worldgen.envs.reward import StepOutcome, reward
@@ -94,8 +104,18 @@ class NavigationEnv(gym.Env):
         self._act_hi = np.array([v_hi, w], dtype=np.float32)
         self.action_space = gym.spaces.Box(self._act_lo, self._act_hi, dtype=np.float32)
         n = self.lidar.size
+        if cfg.goal_distance_max is not None:
+            self.goal_distance_max, self.goal_distance_bound_exact = float(cfg.goal_distance_max), False
+        else:
+            self.goal_distance_max, self.goal_distance_bound_exact = self.source.distance_bound()
+        # The float32 bound rounded up, so that a float64 distance within it never lands above it.
+        self._distance_cap = float(np.nextafter(np.float32(self.goal_distance_max), np.float32(np.inf)))
         low = np.concatenate([np.full(n, cfg.lidar_range_min), [0.0, -math.pi], self._act_lo]).astype(np.float32)
-        high = np.concatenate([np.full(n, cfg.lidar_range_max), [np.inf, math.pi], self._act_hi]).astype(np.float32)
+        high = np.concatenate([np.full(n, cfg.lidar_range_max), [self._distance_cap, math.pi],
+                               self._act_hi]).astype(np.float32)
+        # The geodesic field is built at each reset only where a reward can read it.
+        self._needs_geodesic = cfg.reward == "geodesic" or cfg.reward_fn is not None
+        self.geodesic: Optional[GeodesicField] = None
         self.observation_space = gym.spaces.Box(low, high, dtype=np.float32)
         self._world_rng: Optional[np.random.Generator] = None
         self._noise_rng: Optional[np.random.Generator] = None
@@ -146,25 +166,38 @@ class NavigationEnv(gym.Env):
         self._substeps = cfg.substeps(float(sim.model.opt.timestep))
         self._sim = sim
         t2 = time.perf_counter()
+        self._goal = np.array(world.task["goal"][:2], dtype=float)
+        self.geodesic = None
+        if self._needs_geodesic:
+            self.geodesic = GeodesicField.for_scene(world.scene(), world.robot, self._goal, cfg.geodesic_spacing)
+        t3 = time.perf_counter()
         self._movers = movers
         if len(movers):
             movers.place(sim.data, sim.mocap, movers.positions([0.0])[0])
         import mujoco
         mujoco.mj_forward(sim.model, sim.data)
         self.world = world
-        self._goal = np.array(world.task["goal"][:2], dtype=float)
         self._tolerance = float(world.task["goal_tolerance"])
-        self._time_limit = float(world.task["time_limit"])
+        if cfg.time_limit_factor is None:
+            self._time_limit = float(world.task["time_limit"])
+        else:
+            v_max, w_max = float(self._act_hi[0]), float(self._act_hi[1])
+            self._time_limit = cfg.time_limit_factor * world.reference_path_length / v_max + math.pi / w_max
         self._lidar_height = cfg.lidar_height if cfg.lidar_height is not None else world.lidar_height
         self._last_action = np.zeros(2)
         self.episode = Episode(world, *sim.pose())
         self._painter = None
         obs = self._observe()
         #: Seconds the last reset spent getting the world (generating or reading it), adding the robot and
-        #: compiling, and in all (benchmarks/bench_env.py reports them).
-        self.reset_timings = {"world": t1 - t0, "compile": t2 - t1, "total": time.perf_counter() - t0}
+        #: compiling, building the geodesic field, and in all (benchmarks/bench_env.py reports them).
+        self.reset_timings = {"world": t1 - t0, "compile": t2 - t1, "geodesic": t3 - t2,
+                              "total": time.perf_counter() - t0}
+        x, y, _ = sim.pose()
+        self._geodesic_now = self.geodesic.distance(x, y) if self.geodesic is not None else math.nan
         info = {"world_id": world.world_id, "task": str(world.task["id"]),
                 "reference_path_length": world.reference_path_length, "time_limit": self._time_limit, **where}
+        if self.geodesic is not None:
+            info["geodesic_distance"] = self._geodesic_now
         return obs, info
 
     @property
@@ -198,10 +231,13 @@ class NavigationEnv(gym.Env):
         ep.record(float(data.time), x, y, yaw)
         self._last_action = np.array([v, w])
         obs = self._observe()
-        distance, angle = float(obs[-4]), float(obs[-3])
-        reached = math.hypot(x - self._goal[0], y - self._goal[1]) <= self._tolerance
+        distance, angle = self._goal_polar(x, y, yaw)
+        reached = distance <= self._tolerance
+        geodesic_before = self._geodesic_now
+        if self.geodesic is not None:
+            self._geodesic_now = self.geodesic.distance(x, y)
         outcome = StepOutcome(float(v), float(w), reached, collided, float(self._ranges.min()), distance,
-                              previous, angle, float(data.time))
+                              previous, angle, float(data.time), self._geodesic_now, geodesic_before)
         r = reward(outcome, self.config)
         terminated = bool(reached or (collided and self.config.terminate_on_collision))
         truncated = bool(not terminated and data.time >= self._time_limit - 1e-9)
@@ -258,7 +294,7 @@ class NavigationEnv(gym.Env):
         distance, angle = self._goal_polar(x, y, yaw)
         obs = np.empty(self.lidar.size + 4, dtype=np.float32)
         obs[:-4] = scan
-        obs[-4:] = (distance, angle, self._last_action[0], self._last_action[1])
+        obs[-4:] = (min(distance, self._distance_cap), angle, self._last_action[0], self._last_action[1])
         return obs
 
     # -- drawing --------------------------------------------------------------------------------------------

@@ -1,4 +1,5 @@
-"""Scripted baselines for the navigation environment: a reference-path follower and a random policy.
+"""Scripted baselines for the navigation environment: a reference-path follower, a reactive heuristic
+and a random policy.
 
 :class:`PathFollower` is pure pursuit on the task's reference path (world.json
 ``tasks[].path.waypoints``, the exact shortest path for the footprint): it steers
@@ -7,7 +8,10 @@ projection on it, turning on the spot while that point lies more than
 ``turn_in_place`` radians off the heading. It reads the robot's true pose (an
 oracle baseline, not a learned policy) and scores SPL close to 1: an upper bound
 a learned policy can be compared with. :class:`RandomPolicy` samples the action
-space from its own seeded generator: the floor.
+space from its own seeded generator: the floor. :class:`GapHeuristic` reads only
+the observation (as a learned policy does): it heads for the free lidar sector
+nearest the goal's bearing, turning on the spot while that sector lies well off
+the heading; the bar a learned policy has to clear.
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ from typing import Sequence
 
 import numpy as np
 
-__all__ = ["PathFollower", "RandomPolicy"]
+__all__ = ["GapHeuristic", "PathFollower", "RandomPolicy"]
 
 
 class PathFollower:
@@ -84,3 +88,46 @@ class RandomPolicy:
 
     def action(self, *_ignored) -> np.ndarray:
         return self.rng.uniform(self.low, self.high).astype(np.float32)
+
+
+class GapHeuristic:
+    """Turn toward the goal and drive into the free sector nearest its bearing (observation only).
+
+    A sector is free when it and both its neighbours reach beyond ``free`` m (the robot is wider
+    than a ray), or the goal is nearer than its range; the
+    sectors' bearings are those of their beams (``angles``, rad, the env's ``lidar.angles``).
+    """
+
+    def __init__(self, angles, sectors: int, v_max: float, w_max: float, free: float = 0.8, gain: float = 2.0,
+                 turn_in_place: float = 0.6, slow: float = 0.25, cone: float = math.pi / 3):
+        a = np.asarray(angles, dtype=float).reshape(sectors, -1)
+        self.bearing = np.arctan2(np.sin(a).mean(axis=1), np.cos(a).mean(axis=1))
+        self.v_max, self.w_max = float(v_max), float(w_max)
+        self.free, self.gain, self.turn_in_place, self.slow = float(free), float(gain), float(turn_in_place), float(slow)
+        self.cone = float(cone)
+
+    @classmethod
+    def for_env(cls, env, **kwargs) -> "GapHeuristic":
+        env = env.unwrapped
+        lidar = env.lidar
+        return cls(lidar.angles, lidar.size, float(env.action_space.high[0]), float(env.action_space.high[1]), **kwargs)
+
+    def action(self, obs) -> np.ndarray:
+        """(v, w) as float32 for the observation ``obs`` (scan, goal distance, goal angle, last v, last w)."""
+        obs = np.asarray(obs, dtype=float)
+        n = len(self.bearing)
+        scan, distance, goal = obs[:n], obs[n], obs[n + 1]
+        off = np.abs((self.bearing - goal + math.pi) % (2.0 * math.pi) - math.pi)
+        wide = np.minimum(scan, np.minimum(np.roll(scan, 1), np.roll(scan, -1)))  # the robot is wider than a ray
+        ok = (wide > self.free) | (scan > distance)
+        target = self.bearing[int(np.argmin(np.where(ok, off, np.inf)))] if ok.any() else goal
+        # Anything within `cone` of the heading closer than `free` (a box beside the robot's path too) slows
+        # the robot and pushes its heading away, the harder the closer.
+        fwd = np.abs(self.bearing) < self.cone
+        push = np.clip((self.free - scan[fwd]) / self.free, 0.0, 1.0)
+        w = float(np.clip(self.gain * target - self.gain * float(np.sum(push * np.sign(self.bearing[fwd]))),
+                          -self.w_max, self.w_max))
+        front = float(scan[fwd].min(initial=np.inf))
+        room = min(1.0, max(0.0, (front - self.slow) / max(self.free - self.slow, 1e-9)))
+        v = 0.0 if abs(target) > self.turn_in_place else self.v_max * math.cos(target) * room
+        return np.array([max(v, 0.0), w], dtype=np.float32)

@@ -16,6 +16,7 @@ oracles' :class:`~worldgen.testing.oracles.Ground` and to world.json (for drawin
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping, Optional
@@ -35,7 +36,8 @@ class EpisodeWorld:
     ``time_limit``); ``movers`` world.json's ``dynamic_obstacles[]`` shape;
     ``floor`` the names of the floor geoms (contacts with them are no collision);
     ``door_leaves`` the names of the door leaves (world.json ``doors[].name``, each
-    a hinged body the robot may push open: touching one is a door contact, not a collision).
+    a hinged body the robot may push open: touching one is a door contact, not a collision);
+    ``bounds`` ((x0, y0), (x1, y1)) where the robot may be; :meth:`scene` the world's scene (for the geodesic field).
     """
 
     world_id: str
@@ -50,6 +52,8 @@ class EpisodeWorld:
     _metadata: Callable[[], dict] = field(repr=False)
     _cache: dict = field(default_factory=dict, repr=False)
     door_leaves: frozenset = frozenset()
+    _scene: Optional[Callable[[], Any]] = field(default=None, repr=False)
+    bounds: Optional[tuple] = None
 
     @property
     def reference_path_length(self) -> float:
@@ -61,6 +65,14 @@ class EpisodeWorld:
         if "ground" not in self._cache:
             self._cache["ground"] = self._ground()
         return self._cache["ground"]
+
+    def scene(self):
+        """The world's :class:`~worldgen.scene.Scene` (a pack's world is regenerated for it, once)."""
+        if "scene" not in self._cache:
+            if self._scene is None:
+                raise ParameterError(f"world {self.world_id} carries no scene to build the geodesic distance from")
+            self._cache["scene"] = self._scene()
+        return self._cache["scene"]
 
     def metadata(self) -> dict:
         """world.json as a dict (for drawing), built once; costly for a generated world (it renders every file)."""
@@ -102,7 +114,7 @@ def episode_world(world) -> EpisodeWorld:
         task=task, movers=movers, floor=frozenset(n.name for n in world.scene.nodes if n.role == "floor"),
         lidar_height=float(world.params.get("lidar_height", 0.3)), params=dict(world.params),
         _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}),
-        door_leaves=leaves)
+        door_leaves=leaves, _scene=lambda: world.scene, bounds=tuple(map(tuple, world.scene.bounds)))
 
 
 class GeneratorSource:
@@ -127,7 +139,7 @@ class GeneratorSource:
             raise ParameterError(f"parameter 'generator' must be a generator's name, got {quoted(generator)}")
         self.generator = generator
         self.params = params
-        get(generator).resolve(params)  # bad parameters fail now, not at the first reset
+        self.resolved = get(generator).resolve(params)  # bad parameters fail now, not at the first reset
         #: A difficulty level every world is drawn at ("7/10", worldgen.leveling), or None.
         self.difficulty = difficulty
         if difficulty is not None:
@@ -137,6 +149,16 @@ class GeneratorSource:
 
     def __len__(self) -> int:
         return 0  # unbounded: any seed
+
+    def distance_bound(self) -> tuple[float, bool]:
+        """(bound, exact): the longest straight line inside any world of this source. Exact from the
+        generator's ``size`` (its worlds' extents) where it has one; else the diagonal of the seed-0 world
+        (a corridor's extents follow its parameters), not proven for every seed."""
+        size = self.resolved.get("size")
+        if size is not None:
+            return math.hypot(*size), True
+        (x0, y0), (x1, y1) = self.world(0).bounds
+        return math.hypot(x1 - x0, y1 - y0), False
 
     def world(self, seed: int) -> EpisodeWorld:
         from worldgen.api import generate
@@ -163,6 +185,14 @@ class PackSource:
     def __len__(self) -> int:
         return len(self.pack)
 
+    def distance_bound(self) -> tuple[float, bool]:
+        """(bound, exact): the longest diagonal of the pack's worlds' bounds (world.json ``bounds``)."""
+        longest = 0.0
+        for pw in self.pack:
+            b = pw.metadata["bounds"]
+            longest = max(longest, math.hypot(b["max"][0] - b["min"][0], b["max"][1] - b["min"][1]))
+        return longest, True
+
     def world(self, index: int) -> EpisodeWorld:
         from lxml import etree
 
@@ -184,20 +214,28 @@ class PackSource:
             task=task, movers=list(meta.get("dynamic_obstacles") or []),
             floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
             lidar_height=float(params.get("lidar_height", 0.3)), params=params,
-            _ground=lambda: ground_of(pw), _metadata=lambda: meta,
+            _ground=lambda: ground_of(pw), _metadata=lambda: meta, _scene=lambda: self._regenerated(pw, meta).scene,
+            bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
             door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []))
 
     @staticmethod
-    def _regenerated_mjcf(pw, meta):
+    def _regenerated(pw, meta):
+        """The pack world regenerated from its recorded generator, seed and parameters (same content_hash)."""
         from worldgen.api import generate
-        from worldgen.export.xml import parse_bytes
 
         world = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
                          **meta["params"])
         if world.content_hash != meta["content_hash"]:
-            raise ParameterError(f"pack world {pw.world_id} has no MJCF and does not regenerate with this worldgen "
-                                 f"version ({world.content_hash} != {meta['content_hash']}); build the pack with mjcf")
-        return parse_bytes(world.to_mjcf().encode()).getroot()
+            raise ParameterError(f"pack world {pw.world_id} does not regenerate with this worldgen version "
+                                 f"({world.content_hash} != {meta['content_hash']}); the environment needs its MJCF "
+                                 "and, for the geodesic reward, its scene")
+        return world
+
+    @classmethod
+    def _regenerated_mjcf(cls, pw, meta):
+        from worldgen.export.xml import parse_bytes
+
+        return parse_bytes(cls._regenerated(pw, meta).to_mjcf().encode()).getroot()
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):
