@@ -84,3 +84,10 @@ def test_generators_doc_holds_every_parameter_as_worldgen_list_prints_it():
     block = re.search(r"<!-- begin: worldgen list --markdown -->\n(.*)<!-- end: worldgen list --markdown -->", text, re.S)
     assert block, "docs/generators.md lost its parameter tables"
     assert block.group(1) == parameter_tables(all_specs()), "run `worldgen list --markdown` and paste it into docs/generators.md"
+
+
+def test_the_docs_name_test_files_that_exist():
+    """A page that says which test checks a claim names a file the suite has (tests moved into folders)."""
+    for page in sorted((REPO / "docs").glob("*.md")) + [REPO / "README.md"]:
+        for named in re.findall(r"\btests/[\w/]+\.py\b", page.read_text()):
+            assert (REPO / named).exists(), f"{page.name} names {named}, which the suite does not have"
