@@ -186,7 +186,7 @@ def test_new_criteria_forms_and_their_mistakes():
              "scoring: {barn_k: 9}": "scoring.barn_k must be in (0, 8]",
              "scoring: {reference_speed: 0}": "scoring.reference_speed must be > 0",
              "scoring: {speed: 1}": "unknown key scoring.speed; allowed in scoring: barn_k, reference_speed",
-             "comfort: {x: 1}": "allowed: navigation, safety, performance, scoring"}
+             "comfort: {x: 1}": "allowed: navigation, safety, performance, social, scoring"}
     for text, words in cases.items():
         with pytest.raises(ParameterError) as exc:
             load_criteria(text)

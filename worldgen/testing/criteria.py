@@ -7,6 +7,9 @@
                  from movers), collision_tolerance (<=, total contacts), max_velocity (<=, m/s)
     performance: max_time (<=, s, slowest successful run), avg_time_to_goal (<=, s, mean over
                  successes), barn_score (>=, mean BARN Challenge score over all runs, failures 0)
+    social:      with people (worldgen.testing.social): min_person_distance (>=, m, smallest gap over
+                 all runs), personal_space_time (<=, s, the longest of a run), min_time_to_collision
+                 (>=, s, smallest over all runs); each holds in a world without people
     scoring:     settings, not criteria: barn_k (the BARN score's lower clip, optimal times) and
                  reference_speed (m/s, optimal time = reference path length / reference_speed)
 
@@ -36,6 +39,9 @@ CRITERIA: dict[str, dict[str, tuple[str, str]]] = {
     "performance": {"max_time": ("<=", "slowest time to goal of a successful run (s)"),
                     "avg_time_to_goal": ("<=", "mean time to goal of successful runs (s)"),
                     "barn_score": (">=", "mean BARN Challenge score of all runs (failed runs score 0)")},
+    "social": {"min_person_distance": (">=", "smallest footprint-to-person gap (m)"),
+               "personal_space_time": ("<=", "longest time of a run within a person's personal space (s)"),
+               "min_time_to_collision": (">=", "smallest time to collision with a person (s)")},
 }
 
 #: The settings section: key -> (default, what it sets).

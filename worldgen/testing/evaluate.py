@@ -49,6 +49,8 @@ AVERAGED_OVER = {
     "barn_score": "all runs (failed runs score 0; runs without a reference path are left out)",
     "min_clearance": "all runs (smallest)", "collision_count": "all runs (total)",
     "max_velocity": "all runs (largest)", "min_separation": "all runs (smallest)",
+    "min_person_distance": "all runs (smallest)", "personal_space_time": "all runs (largest)",
+    "min_time_to_collision": "all runs (smallest)",
 }
 
 
@@ -258,6 +260,11 @@ def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
     if not judged:
         raise ParameterError("parameter 'runs' must hold at least one run, got none")
     seps = [r.min_separation for r, _, _ in judged if r.min_separation is not None]
+
+    def extreme(pick, key):  # over the runs that have the figure (worlds with people); None without any
+        values = [getattr(r, key) for r, _, _ in judged if getattr(r, key) is not None]
+        return pick(values) if values else None
+
     by_world: dict[str, list] = {}
     for item in judged:
         by_world.setdefault(item[0].world_id, []).append(item)
@@ -265,6 +272,9 @@ def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
         "collision_count": sum(len(r.collisions) for r, _, _ in judged),
         "min_separation": min(seps) if seps else None,
         "max_velocity": max(r.max_velocity for r, _, _ in judged),
+        "min_person_distance": extreme(min, "min_person_distance"),
+        "personal_space_time": extreme(max, "personal_space_time"),
+        "min_time_to_collision": extreme(min, "min_time_to_collision"),
         "worlds": len(by_world),
         "per_world": {w: _figures(items) for w, items in sorted(by_world.items())},
         "averaged_over": AVERAGED_OVER, "barn": {"k": k, "reference_speed": speed},
@@ -273,7 +283,9 @@ def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
                 "obstacle_clearance": summary["min_clearance"], "min_obstacle_distance": summary["min_separation"],
                 "collision_tolerance": float(summary["collision_count"]), "max_velocity": summary["max_velocity"],
                 "max_time": summary["max_time_to_goal"], "avg_time_to_goal": summary["mean_time_to_goal"],
-                "barn_score": summary["mean_barn_score"]}
+                "barn_score": summary["mean_barn_score"], "min_person_distance": summary["min_person_distance"],
+                "personal_space_time": summary["personal_space_time"],
+                "min_time_to_collision": summary["min_time_to_collision"]}
     verdicts = []
     for section in CRITERIA:  # a fixed order, whatever order the YAML had
         for key, (op, _) in CRITERIA[section].items():
@@ -284,8 +296,10 @@ def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
                 verdicts.append(_bound_verdict(section, key, op, need, summary["successes"], summary["runs"]))
                 continue
             if got is None:
-                # No movers means nothing can come near: that criterion holds; no success means no time: it fails.
-                passed = key == "min_obstacle_distance"
+                # No movers or people means nothing can come near (nor a collision course): those criteria
+                # hold; no success means no time: it fails.
+                passed = key in ("min_obstacle_distance", "min_person_distance", "personal_space_time",
+                                 "min_time_to_collision")
                 verdicts.append(Criterion(section, key, op, need, None, passed, None))
                 continue
             margin = got - need if op == ">=" else need - got

@@ -24,10 +24,18 @@ from typing import Any, Optional
 import numpy as np
 
 from worldgen.errors import ParameterError
-from worldgen.testing.ground import Ground, leaves_of, load
+from worldgen.testing.ground import Ground, as_trajectory, leaves_of, load
+from worldgen.testing.social import (
+    disc_gaps,
+    discs,
+    min_person_distance,
+    min_time_to_collision,
+    personal_space_time,
+    timed_samples,
+)
 
 __all__ = [
-    "Contact", "Run", "as_trajectory",
+    "Contact", "Run",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
     "collisions", "door_contacts", "min_separation", "run", "BARN_K", "BARN_REFERENCE_SPEED", "barn_score",
 ]
@@ -39,22 +47,6 @@ class Contact:
 
     time: float
     entity: str
-
-
-def as_trajectory(trajectory) -> np.ndarray:
-    """(n, 3) float array ``t, x, y`` of a recorded run; ParameterError with one line otherwise."""
-    try:
-        a = np.asarray(trajectory, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError("parameter 'trajectory' must be an (n, 3) or (n, 4) array of numbers (t, x, y[, yaw])") from None
-    if a.ndim != 2 or a.shape[1] not in (3, 4) or len(a) < 1:
-        raise ParameterError(f"parameter 'trajectory' must be an (n, 3) or (n, 4) array (t, x, y[, yaw]) with n >= 1, "
-                             f"got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ParameterError("parameter 'trajectory' must hold finite numbers only, got NaN or inf")
-    if np.any(np.diff(a[:, 0]) < 0):
-        raise ParameterError("parameter 'trajectory' must have non-decreasing times (column 0)")
-    return a[:, :3].copy()
 
 
 # -- figures -------------------------------------------------------------------
@@ -104,7 +96,13 @@ def _dense(traj: np.ndarray, spacing: float) -> np.ndarray:
 
 
 def _samples(traj: np.ndarray, ground: Ground) -> np.ndarray:
-    return _dense(traj, ground.robot.radius / 4.0)
+    """The run at least every quarter robot radius of its path, and, where movers or people walk, at least
+    every PEOPLE_DT s too (a robot standing still while a person walks into it has few samples in space)."""
+    pts = _dense(traj, ground.robot.radius / 4.0)
+    if ground.meta.get("dynamic_obstacles") or ground.meta.get("people"):
+        both = np.vstack([pts, timed_samples(traj)])
+        pts = both[np.unique(both[:, 0], return_index=True)[1]]
+    return pts
 
 
 def min_clearance(trajectory, world) -> float:
@@ -147,28 +145,15 @@ def _contacts(trajectory, world) -> list[Contact]:
     ground = load(world)
     pts = _samples(as_trajectory(trajectory), ground)
     col = ground.colliders
-    movers = ground.meta.get("dynamic_obstacles") or []
-    names = list(col.names) + [str(m["name"]) for m in movers]
+    names = list(col.names) + discs(ground.meta)[0]  # colliders, then movers and people
     touching = np.zeros((len(pts), len(names)), dtype=bool)
     for p, c, _ in _touching(pts, ground):
         touching[p, c] = True
-    if movers:
-        touching[:, len(col):] = _mover_gaps(pts, ground) <= 0.0
+    if len(names) > len(col):
+        touching[:, len(col):] = disc_gaps(pts, ground) <= 0.0
     starts = touching & ~np.vstack([np.zeros((1, touching.shape[1]), dtype=bool), touching[:-1]])
     out = [Contact(float(pts[p, 0]), names[c]) for p, c in zip(*np.nonzero(starts))]
     return sorted(out, key=lambda k: (k.time, k.entity))
-
-
-def _mover_gaps(pts: np.ndarray, ground: Ground) -> np.ndarray:
-    """(samples, movers) gap (m) between the footprint's edge and each mover's disc at each ``t, x, y`` sample."""
-    from worldgen.scene.motion import mover_positions
-
-    radii = np.array([float(m["radius"]) for m in ground.meta["dynamic_obstacles"]])
-    gaps = np.empty((len(pts), len(radii)))
-    for i, (t, x, y) in enumerate(pts):
-        centres = mover_positions(ground.meta, float(t))
-        gaps[i] = np.hypot(centres[:, 0] - x, centres[:, 1] - y) - radii - ground.robot.radius
-    return gaps
 
 
 def _touching(pts: np.ndarray, ground: Ground, colliders=None):
@@ -188,16 +173,16 @@ def _touching(pts: np.ndarray, ground: Ground, colliders=None):
 
 
 def min_separation(trajectory, world) -> Optional[float]:
-    """Smallest gap (m) between the footprint's edge and any mover's disc over the run's times.
+    """Smallest gap (m) between the footprint's edge and any mover's or person's disc over the run's times.
 
-    Movers are where world.json's ``dynamic_obstacles`` scripts have them at each
-    sample time (:func:`worldgen.scene.motion.mover_positions`); None without movers.
+    Movers and people are where world.json's ``dynamic_obstacles`` scripts and ``people`` tracks have
+    them at each sample time (:func:`worldgen.scene.motion.positions_at`); None without either.
     """
     ground = load(world)
-    if not ground.meta.get("dynamic_obstacles"):
+    if not (ground.meta.get("dynamic_obstacles") or ground.meta.get("people")):
         return None
     # Movers walk at about a metre a second: sample time no coarser than the footprint spacing allows.
-    return float(_mover_gaps(_samples(as_trajectory(trajectory), ground), ground).min())
+    return float(disc_gaps(_samples(as_trajectory(trajectory), ground), ground).min())
 
 
 @dataclass(frozen=True)
@@ -219,6 +204,11 @@ class Run:
     reference_length: Optional[float] = None
     #: Contacts with door leaves (pushed open: not collisions).
     door_contacts: tuple[Contact, ...] = ()
+    #: With people (worldgen.testing.social): the smallest gap to one (m), the seconds spent in a
+    #: person's personal space, the smallest time to collision with one (s; None: never on course).
+    min_person_distance: Optional[float] = None
+    personal_space_time: Optional[float] = None
+    min_time_to_collision: Optional[float] = None
 
     def as_dict(self) -> dict[str, Any]:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
@@ -248,6 +238,8 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
         min_separation=min_separation(traj, ground), max_velocity=vmax,
         reference_length=float(ref) if ref else None,
         door_contacts=tuple(c for c in contacts if c.entity in leaves),
+        min_person_distance=min_person_distance(traj, ground), personal_space_time=personal_space_time(traj, ground),
+        min_time_to_collision=min_time_to_collision(traj, ground),
     )
 
 

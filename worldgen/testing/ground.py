@@ -1,4 +1,5 @@
-"""What the oracles know of one world: its world.json, and FCL colliders built once, on first use.
+"""What the oracles take: a world (its world.json, and FCL colliders built once, on first use) and a
+recorded trajectory, checked (:func:`as_trajectory`).
 
 A world is a :class:`~worldgen.World` (its scene is used), a world of a built pack
 (:class:`~worldgen.PackWorld`, folder or archive) or a written world folder; without a scene the
@@ -16,7 +17,7 @@ import numpy as np
 from worldgen.errors import ParameterError
 from worldgen.files import METADATA_NAME
 
-__all__ = ["Ground", "load", "leaves_of"]
+__all__ = ["Ground", "load", "leaves_of", "as_trajectory"]
 
 
 class Ground:
@@ -133,3 +134,19 @@ def _entity_colliders(meta: dict, read: Callable[[str], bytes]):
         nodes.append(Node(e["name"], e["role"], shape, Pose(*e["pose"])))
     from worldgen.feasibility.collision import Colliders
     return Colliders(Scene(tuple(nodes)))
+
+
+def as_trajectory(trajectory) -> np.ndarray:
+    """(n, 3) float array ``t, x, y`` of a recorded run; ParameterError with one line otherwise."""
+    try:
+        a = np.asarray(trajectory, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError("parameter 'trajectory' must be an (n, 3) or (n, 4) array of numbers (t, x, y[, yaw])") from None
+    if a.ndim != 2 or a.shape[1] not in (3, 4) or len(a) < 1:
+        raise ParameterError(f"parameter 'trajectory' must be an (n, 3) or (n, 4) array (t, x, y[, yaw]) with n >= 1, "
+                             f"got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ParameterError("parameter 'trajectory' must hold finite numbers only, got NaN or inf")
+    if np.any(np.diff(a[:, 0]) < 0):
+        raise ParameterError("parameter 'trajectory' must have non-decreasing times (column 0)")
+    return a[:, :3].copy()

@@ -25,7 +25,6 @@ from worldgen.testing.evaluate import evaluate
 from worldgen.testing.figures import (
     Contact,
     Run,
-    as_trajectory,
     barn_score,
     collisions,
     door_contacts,
@@ -37,7 +36,7 @@ from worldgen.testing.figures import (
     run,
     time_to_goal,
 )
-from worldgen.testing.ground import Ground, load
+from worldgen.testing.ground import Ground, as_trajectory, load
 
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",

@@ -1,0 +1,129 @@
+"""The social-navigation figures of one run: how close the robot came to people, how long it stayed in
+their personal space, and how soon it would have hit one (the figures HuNavSim's evaluator reports).
+
+People are world.json's ``people[]`` (:mod:`worldgen.generators.people`), each a disc walking its
+``t, x, y`` rows and waiting at its last point; scripted movers (``dynamic_obstacles[]``, looping) are
+discs too. Positions come from :func:`worldgen.scene.motion.positions_at`, the same interpolation the
+exports drive MuJoCo's mocap bodies with. Every figure is None in a world without people.
+
+The run is sampled at its recorded rows and at least every :data:`PEOPLE_DT` s between them (robot
+positions interpolated linearly), because people move while a robot stands still.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+
+from worldgen.testing.ground import Ground, as_trajectory, load
+
+__all__ = ["PERSONAL_SPACE", "PEOPLE_DT", "discs", "disc_gaps", "timed_samples", "min_person_distance", "personal_space_time",
+           "min_time_to_collision"]
+
+#: Personal space (m, from the robot's centre to a person's): the outer edge of Hall's personal zone
+#: (1.2 m, "The Hidden Dimension", 1966), the radius social-navigation evaluators commonly use.
+PERSONAL_SPACE = 1.2
+#: The longest time step (s) between the samples the people's figures are measured at.
+PEOPLE_DT = 0.05
+
+
+def discs(meta: dict) -> tuple[list[str], np.ndarray, np.ndarray, list[np.ndarray], list[bool]]:
+    """(names, radii, is_person, tracks, loops) of the movers then the people: mover_positions' order."""
+    rows = [(m, False) for m in meta.get("dynamic_obstacles") or []] + [(p, True) for p in meta.get("people") or []]
+    names = [str(m["name"]) for m, _ in rows]
+    radii = np.array([float(m["radius"]) for m, _ in rows])
+    person = np.array([is_person for _, is_person in rows], dtype=bool)
+    tracks = [np.asarray(m["trajectory"], dtype=float) for m, _ in rows]
+    loops = [bool(m.get("loop", False)) for m, _ in rows]
+    return names, radii, person, tracks, loops
+
+
+def disc_gaps(pts: np.ndarray, ground: Ground) -> np.ndarray:
+    """(samples, discs) gap (m) between the footprint's edge and each mover's or person's disc at each
+    ``t, x, y`` sample; discs in :func:`discs`' order."""
+    from worldgen.scene.motion import positions_at
+
+    _, radii, _, tracks, loops = discs(ground.meta)
+    if not tracks:
+        return np.zeros((len(pts), 0))
+    centres = positions_at(tracks, loops, pts[:, 0])
+    return np.hypot(centres[..., 0] - pts[:, 1:2], centres[..., 1] - pts[:, 2:3]) - radii - ground.robot.radius
+
+
+def timed_samples(trajectory) -> np.ndarray:
+    """The run's rows plus rows every PEOPLE_DT s between them: (m, 3) ``t, x, y``."""
+    traj = as_trajectory(trajectory)
+    t0, t1 = float(traj[0, 0]), float(traj[-1, 0])
+    times = np.union1d(traj[:, 0], np.arange(t0, t1, PEOPLE_DT)) if t1 > t0 else traj[:1, 0]
+    return np.c_[times, np.interp(times, traj[:, 0], traj[:, 1]), np.interp(times, traj[:, 0], traj[:, 2])]
+
+
+def _people(ground: Ground, pts: np.ndarray):
+    """(centres (samples, people, 2), radii (people,)) of the people at each sample, or None without people."""
+    from worldgen.scene.motion import positions_at
+
+    _, radii, person, tracks, loops = discs(ground.meta)
+    if not person.any():
+        return None
+    keep = np.flatnonzero(person)
+    return positions_at([tracks[i] for i in keep], [loops[i] for i in keep], pts[:, 0]), radii[keep]
+
+
+def min_person_distance(trajectory, world) -> Optional[float]:
+    """Smallest gap (m) between the footprint's edge and any person's disc over the run (<= 0: contact)."""
+    ground = load(world)
+    pts = timed_samples(trajectory)
+    people = _people(ground, pts)
+    if people is None:
+        return None
+    centres, radii = people
+    gaps = np.hypot(centres[..., 0] - pts[:, 1:2], centres[..., 1] - pts[:, 2:3]) - radii - ground.robot.radius
+    return float(gaps.min())
+
+
+def personal_space_time(trajectory, world, radius: float = PERSONAL_SPACE) -> Optional[float]:
+    """Seconds the robot's centre spent within ``radius`` m of any person's centre.
+
+    Each step between samples (at most PEOPLE_DT s) counts whole when it starts inside, so the figure is
+    within one step per entry or exit of the exact time.
+    """
+    ground = load(world)
+    pts = timed_samples(trajectory)
+    people = _people(ground, pts)
+    if people is None:
+        return None
+    centres, _ = people
+    inside = (np.hypot(centres[..., 0] - pts[:, 1:2], centres[..., 1] - pts[:, 2:3]) < radius).any(axis=1)
+    return float(np.diff(pts[:, 0])[inside[:-1]].sum())
+
+
+def min_time_to_collision(trajectory, world) -> Optional[float]:
+    """Smallest time to collision (s) with any person over the run; None when never on a collision course.
+
+    At each sample the robot and each person keep their velocities over the next step (finite
+    differences); the time to collision is when the two discs would first touch (0 when they already
+    do). None also in a world without people.
+    """
+    ground = load(world)
+    pts = timed_samples(trajectory)
+    people = _people(ground, pts)
+    if people is None or len(pts) < 2:
+        return None
+    centres, radii = people
+    dt = np.diff(pts[:, 0])[:, None, None]
+    v_robot = np.diff(pts[:, 1:], axis=0)[:, None, :] / dt
+    v_people = np.diff(centres, axis=0) / dt
+    p = centres[:-1] - pts[:-1, None, 1:]
+    v = v_people - v_robot
+    reach = radii[None, :] + ground.robot.radius
+    a = (v * v).sum(axis=-1)
+    b = 2.0 * (p * v).sum(axis=-1)
+    c = (p * p).sum(axis=-1) - reach ** 2
+    disc = b * b - 4.0 * a * c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        first = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)
+    ttc = np.where(c <= 0.0, 0.0, np.where((a > 0) & (disc >= 0) & (b < 0), first, math.inf))
+    best = float(ttc.min())
+    return None if math.isinf(best) else best
