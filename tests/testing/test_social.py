@@ -57,6 +57,7 @@ def test_oracles_take_movers_and_people_together(crowded):
     run = oracles.run(np.c_[np.arange(len(path)) * 2.0, path], crowded)
     assert run.min_separation is not None and run.min_person_distance is not None
     assert run.min_separation <= run.min_person_distance
+    assert oracles.min_person_distance(np.c_[np.arange(len(path)) * 2.0, path], crowded) == run.min_person_distance
 
 
 def test_standing_in_a_persons_way_is_a_collision_with_that_person(crowded):

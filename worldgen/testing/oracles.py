@@ -37,9 +37,11 @@ from worldgen.testing.figures import (
     time_to_goal,
 )
 from worldgen.testing.ground import Ground, as_trajectory, load
+from worldgen.testing.social import PERSONAL_SPACE, min_person_distance, min_time_to_collision, personal_space_time
 
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
     "collisions", "door_contacts", "min_separation", "run", "evaluate", "barn_score",
+    "min_person_distance", "personal_space_time", "min_time_to_collision", "PERSONAL_SPACE",
 ]
