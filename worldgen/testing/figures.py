@@ -25,14 +25,7 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 from worldgen.testing.ground import Ground, as_trajectory, leaves_of, load
-from worldgen.testing.social import (
-    disc_gaps,
-    discs,
-    min_person_distance,
-    min_time_to_collision,
-    personal_space_time,
-    timed_samples,
-)
+from worldgen.testing.social import disc_gaps, discs, social_figures, timed_samples
 
 __all__ = [
     "Contact", "Run",
@@ -229,6 +222,7 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
     moving = dt > 0
     vmax = float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0
     contacts, leaves = _contacts(traj, ground), leaves_of(ground)  # FCL once, split as collisions() and door_contacts()
+    person_gap, personal_time, ttc = social_figures(traj, ground)  # the run among people, sampled once
     return Run(
         world_id=str(ground.meta.get("world_id", "")), task=t["id"],
         reached_goal=reached_goal(traj, ground, task), time_to_goal=time_to_goal(traj, ground, task),
@@ -238,8 +232,7 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
         min_separation=min_separation(traj, ground), max_velocity=vmax,
         reference_length=float(ref) if ref else None,
         door_contacts=tuple(c for c in contacts if c.entity in leaves),
-        min_person_distance=min_person_distance(traj, ground), personal_space_time=personal_space_time(traj, ground),
-        min_time_to_collision=min_time_to_collision(traj, ground),
+        min_person_distance=person_gap, personal_space_time=personal_time, min_time_to_collision=ttc,
     )
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from worldgen.testing.ground import Ground, as_trajectory, load
 
 __all__ = ["PERSONAL_SPACE", "PEOPLE_DT", "discs", "disc_gaps", "timed_samples", "min_person_distance", "personal_space_time",
-           "min_time_to_collision"]
+           "min_time_to_collision", "social_figures"]
 
 #: Personal space (m, from the robot's centre to a person's): the outer edge of Hall's personal zone
 #: (1.2 m, "The Hidden Dimension", 1966), the radius social-navigation evaluators commonly use.
@@ -48,8 +48,7 @@ def disc_gaps(pts: np.ndarray, ground: Ground) -> np.ndarray:
     _, radii, _, tracks, loops = discs(ground.meta)
     if not tracks:
         return np.zeros((len(pts), 0))
-    centres = positions_at(tracks, loops, pts[:, 0])
-    return np.hypot(centres[..., 0] - pts[:, 1:2], centres[..., 1] - pts[:, 2:3]) - radii - ground.robot.radius
+    return _centre_distance(positions_at(tracks, loops, pts[:, 0]), pts) - radii - ground.robot.radius
 
 
 def timed_samples(trajectory) -> np.ndarray:
@@ -60,27 +59,69 @@ def timed_samples(trajectory) -> np.ndarray:
     return np.c_[times, np.interp(times, traj[:, 0], traj[:, 1]), np.interp(times, traj[:, 0], traj[:, 2])]
 
 
-def _people(ground: Ground, pts: np.ndarray):
-    """(centres (samples, people, 2), radii (people,)) of the people at each sample, or None without people."""
-    from worldgen.scene.motion import positions_at
+def _centre_distance(centres: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """(samples, discs) distance from the robot's centre at each ``t, x, y`` sample to each disc's centre."""
+    return np.hypot(centres[..., 0] - pts[:, 1:2], centres[..., 1] - pts[:, 2:3])
 
-    _, radii, person, tracks, loops = discs(ground.meta)
-    if not person.any():
-        return None
-    keep = np.flatnonzero(person)
-    return positions_at([tracks[i] for i in keep], [loops[i] for i in keep], pts[:, 0]), radii[keep]
+
+class _Among:
+    """One run among a world's people, sampled once: the samples, the people's centres and radii there,
+    and the centre distances, shared by every figure below."""
+
+    def __init__(self, trajectory, world):
+        from worldgen.scene.motion import positions_at
+
+        self.ground = load(world)
+        self.pts = timed_samples(trajectory)
+        _, radii, person, tracks, loops = discs(self.ground.meta)
+        keep = np.flatnonzero(person)
+        self.any = len(keep) > 0
+        if self.any:
+            self.centres = positions_at([tracks[i] for i in keep], [loops[i] for i in keep], self.pts[:, 0])
+            self.radii = radii[keep]
+            self.distance = _centre_distance(self.centres, self.pts)
+
+    def min_gap(self) -> Optional[float]:
+        if not self.any:
+            return None
+        return float((self.distance - self.radii - self.ground.robot.radius).min())
+
+    def time_within(self, radius: float) -> Optional[float]:
+        if not self.any:
+            return None
+        inside = (self.distance < radius).any(axis=1)
+        return float(np.diff(self.pts[:, 0])[inside[:-1]].sum())
+
+    def min_ttc(self) -> Optional[float]:
+        pts = self.pts
+        if not self.any or len(pts) < 2:
+            return None
+        dt = np.diff(pts[:, 0])[:, None, None]
+        v_robot = np.diff(pts[:, 1:], axis=0)[:, None, :] / dt
+        v_people = np.diff(self.centres, axis=0) / dt
+        p = self.centres[:-1] - pts[:-1, None, 1:]
+        v = v_people - v_robot
+        reach = self.radii[None, :] + self.ground.robot.radius
+        a = (v * v).sum(axis=-1)
+        b = 2.0 * (p * v).sum(axis=-1)
+        c = (p * p).sum(axis=-1) - reach ** 2
+        disc = b * b - 4.0 * a * c
+        with np.errstate(divide="ignore", invalid="ignore"):
+            first = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)
+        ttc = np.where(c <= 0.0, 0.0, np.where((a > 0) & (disc >= 0) & (b < 0), first, math.inf))
+        best = float(ttc.min())
+        return None if math.isinf(best) else best
+
+
+def social_figures(trajectory, world, radius: float = PERSONAL_SPACE) -> tuple:
+    """(min_person_distance, personal_space_time, min_time_to_collision) of one run, sampled once."""
+    among = _Among(trajectory, world)
+    return among.min_gap(), among.time_within(radius), among.min_ttc()
 
 
 def min_person_distance(trajectory, world) -> Optional[float]:
     """Smallest gap (m) between the footprint's edge and any person's disc over the run (<= 0: contact)."""
-    ground = load(world)
-    pts = timed_samples(trajectory)
-    people = _people(ground, pts)
-    if people is None:
-        return None
-    centres, radii = people
-    gaps = np.hypot(centres[..., 0] - pts[:, 1:2], centres[..., 1] - pts[:, 2:3]) - radii - ground.robot.radius
-    return float(gaps.min())
+    return _Among(trajectory, world).min_gap()
 
 
 def personal_space_time(trajectory, world, radius: float = PERSONAL_SPACE) -> Optional[float]:
@@ -89,14 +130,7 @@ def personal_space_time(trajectory, world, radius: float = PERSONAL_SPACE) -> Op
     Each step between samples (at most PEOPLE_DT s) counts whole when it starts inside, so the figure is
     within one step per entry or exit of the exact time.
     """
-    ground = load(world)
-    pts = timed_samples(trajectory)
-    people = _people(ground, pts)
-    if people is None:
-        return None
-    centres, _ = people
-    inside = (np.hypot(centres[..., 0] - pts[:, 1:2], centres[..., 1] - pts[:, 2:3]) < radius).any(axis=1)
-    return float(np.diff(pts[:, 0])[inside[:-1]].sum())
+    return _Among(trajectory, world).time_within(radius)
 
 
 def min_time_to_collision(trajectory, world) -> Optional[float]:
@@ -106,24 +140,4 @@ def min_time_to_collision(trajectory, world) -> Optional[float]:
     differences); the time to collision is when the two discs would first touch (0 when they already
     do). None also in a world without people.
     """
-    ground = load(world)
-    pts = timed_samples(trajectory)
-    people = _people(ground, pts)
-    if people is None or len(pts) < 2:
-        return None
-    centres, radii = people
-    dt = np.diff(pts[:, 0])[:, None, None]
-    v_robot = np.diff(pts[:, 1:], axis=0)[:, None, :] / dt
-    v_people = np.diff(centres, axis=0) / dt
-    p = centres[:-1] - pts[:-1, None, 1:]
-    v = v_people - v_robot
-    reach = radii[None, :] + ground.robot.radius
-    a = (v * v).sum(axis=-1)
-    b = 2.0 * (p * v).sum(axis=-1)
-    c = (p * p).sum(axis=-1) - reach ** 2
-    disc = b * b - 4.0 * a * c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        first = (-b - np.sqrt(np.maximum(disc, 0.0))) / (2.0 * a)
-    ttc = np.where(c <= 0.0, 0.0, np.where((a > 0) & (disc >= 0) & (b < 0), first, math.inf))
-    best = float(ttc.min())
-    return None if math.isinf(best) else best
+    return _Among(trajectory, world).min_ttc()
