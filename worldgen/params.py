@@ -156,6 +156,9 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
         # people existed keeps its params, content_hash and bytes (docs/people.md).
         for name in PEOPLE_PARAMS:
             resolved.pop(name, None)
+    if resolved.get("group_size") == 1:
+        # Recorded only when people walk in groups: worlds with people alone keep their bytes.
+        resolved.pop("group_size")
     if "lidar_range_min" in resolved and "lidar_range_max" in resolved:
         # The one rule between two common parameters: a lidar needs a non-empty range.
         if resolved["lidar_range_min"] >= resolved["lidar_range_max"]:
@@ -167,7 +170,7 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
 
 
 #: The people's parameters: recorded in a world's params only when it has people (n_people > 0).
-PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration", "people_scenario")
+PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration", "people_scenario", "group_size")
 
 
 def parse_value(p: Param, text: str) -> Any:
@@ -230,9 +233,12 @@ COMMON_PARAMS: tuple[Param, ...] = (
           0.1, 3.0, unit="m/s"),
     Param("people_duration", "float", 60.0, "how long people walk; afterwards each stands where it stopped",
           1.0, 600.0, unit="s"),
-    Param("people_scenario", "choice", "walk", "walk: everyone walks from place to place; head_on / crossing: "
-          "the first person walks toward the robot along its path / across it at right angles (docs/people.md)",
-          choices=("walk", "head_on", "crossing")),
+    Param("people_scenario", "choice", "walk", "walk: everyone walks from place to place; head_on / crossing / "
+          "overtaking / group_passing / doorway: the first person (group) walks that human-encounter scenario "
+          "against the first task (docs/people.md)",
+          choices=("walk", "head_on", "crossing", "overtaking", "group_passing", "doorway")),
+    Param("group_size", "int", 1, "people walk in groups of this many that keep together (Moussaid et al. 2010; "
+          "docs/people.md); 1: alone", 1, 8),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
     # Ground truth written with every world (worldgen.groundtruth).
     Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn",
