@@ -16,8 +16,9 @@ import worldgen
 from worldgen import presets
 from worldgen.errors import InfeasibleError, ParameterError
 
-SHIPPED = ["clutter_50_boxes", "door_crossing", "drl_arena", "empty_room", "lidar_wall", "narrow_corridor",
-           "person_crossing", "person_head_on", "room_5_obstacles"]
+SHIPPED = ["clutter_50_boxes", "door_crossing", "drl_arena", "empty_room", "group_in_corridor", "lidar_wall",
+           "narrow_corridor", "person_crossing", "person_head_on", "person_in_doorway", "person_overtaking",
+           "room_5_obstacles"]
 
 
 def roles(world, role):
@@ -201,7 +202,140 @@ def _must_yield(world):
     return meets and world.feasibility.timed_paths[0].arrival > length / v + 1.0
 
 
+def _people(world):
+    """Every person's rows (k, 3), in order."""
+    return [np.array(m.trajectory) for m in world.scene.movers if m.person]
+
+
+def _lateral(world, rows):
+    """Signed distance (m) of each row to the left of the first task's line."""
+    s, _, _, n, _ = _line(world)
+    return (rows[:, 1:] - s) @ n
+
+
+def _along(world, rows):
+    """Distance (m) of each row along the first task's line from its spawn."""
+    s, _, u, _, _ = _line(world)
+    return (rows[:, 1:] - s) @ u
+
+
+def _overtakes(world):
+    """Behind a robot driving the line at full speed at the start, ahead of it at the end: it passes it."""
+    rows, _ = _walker(world)
+    _, _, _, _, length = _line(world)
+    v = world.params["robot_speed"]
+    t = np.arange(0.0, rows[-1, 0], 0.01)
+    me = np.minimum(v * t, length)
+    them = np.interp(t, rows[:, 0], _along(world, rows))
+    return them[0] < me[0] and them[-1] > me[-1]
+
+
+def _pass_time(world):
+    """When the overtaking person's centre passes a robot driving the line at full speed (s)."""
+    rows, _ = _walker(world)
+    t = np.arange(0.0, rows[-1, 0], 0.01)
+    gap = np.interp(t, rows[:, 0], _along(world, rows)) - np.minimum(world.params["robot_speed"] * t, _line(world)[4])
+    return float(t[np.argmax(gap > 0)])
+
+
+def _top_speed(rows):
+    return float(np.max(np.hypot(*np.diff(rows[:, 1:], axis=0).T) / np.diff(rows[:, 0])))
+
+
+def _passing_speed(world, rows):
+    """Median speed (m/s) of a person's steps while it is between the goal and the spawn."""
+    along = _along(world, rows)
+    inside = (along[:-1] < world.feasibility.paths[0].length) & (along[1:] > 0)
+    speed = np.hypot(*np.diff(rows[:, 1:], axis=0).T) / np.diff(rows[:, 0])
+    return float(np.median(speed[inside]))
+
+
+def _group_spread(world, dt=0.01):
+    """The largest distance (m) of a member from the group's centre, sampled every ``dt`` over the walk."""
+    from worldgen.scene.motion import positions_at
+
+    tracks = _people(world)
+    t = np.arange(0.0, max(r[-1, 0] for r in tracks) + dt, dt)
+    pos = positions_at(tracks, [False] * len(tracks), t)
+    return float(np.hypot(*(pos - pos.mean(axis=1, keepdims=True)).transpose(2, 0, 1)).max())
+
+
+def _passing_headings(world):
+    """Headings (degrees from the robot's) of every member's steps while it walks between the goal and the spawn."""
+    _, _, u, _, length = _line(world)
+    out = []
+    for rows in _people(world):
+        along = _along(world, rows)
+        inside = (along[:-1] < length) & (along[1:] > 0)
+        out.append(_headings(rows[np.r_[inside, False] | np.r_[False, inside]], u))
+    return np.concatenate(out)
+
+
 CLAIMS = {
+    "person_overtaking": [
+        (rf"along its {N} m straight path in an empty {N} x {N} m room",
+         lambda w, length, a, b: _line(w)[4] == pytest.approx(length) and _extent(w) == (a, b)
+         and len(w.feasibility.paths[0].waypoints) == 2),
+        (r"overtaking the robot from behind", _overtakes),
+        (rf"radius {N} m, {N} m/s", lambda w, r, v: _walker(w)[1] == r and _steady_speed(_walker(w)[0], v)),
+        (rf"more than twice the robot's top speed, robot_speed {N} m/s",
+         lambda w, v: w.params["robot_speed"] == v and w.params["person_speed"][0] > 2 * v),
+        (rf"starts {N} m behind the robot's spawn and\s+{N} m to the left of its path",
+         lambda w, back, side: np.allclose(_walker(w)[0][0, 1:], _line(w)[0] - back * _line(w)[2] + side * _line(w)[3],
+                                           atol=1e-6)),
+        (rf"heading {N} degrees from the robot's, within {N} degrees",
+         lambda w, deg, tol: np.all(np.abs(_headings(_walker(w)[0], _line(w)[2]) - deg) <= tol)),
+        (rf"keeps between {N} and {N} m to the left of the path",
+         lambda w, lo, hi: lo - 1e-6 <= _lateral(w, _walker(w)[0]).min() and _lateral(w, _walker(w)[0]).max() <= hi),
+        (rf"to {N} m beyond the goal",
+         # Reached within ARRIVE (0.2 m) of the point beyond the goal, in its lane.
+         lambda w, d: np.hypot(*(_walker(w)[0][-1, 1:] - (_line(w)[1] + d * _line(w)[2]
+                                                         + _lateral(w, _walker(w)[0][:1])[0] * _line(w)[3]))) < 0.2),
+        (rf"passes a robot driving at full speed {N} s after the start",
+         lambda w, t: abs(_pass_time(w) - t) <= 0.05),
+    ],
+    "group_in_corridor": [
+        (rf"group of {N} people", lambda w, k: len(_people(w)) == k == w.params["group_size"]),
+        (rf"along a {N} x {N} m walled corridor", lambda w, a, b: _extent(w) == (a, b) and len(roles(w, "wall")) == 4),
+        (rf"radius {N} m,\s+preferred speed {N} m/s", lambda w, r, v: all(m.radius == r for m in w.scene.movers)
+         and w.params["person_speed"] == [v, v] and all(_top_speed(rows) <= 1.3 * v + 1e-4 for rows in _people(w))),
+        (rf"slow to about {N} m/s", lambda w, v: all(abs(_passing_speed(w, rows) - v) <= 0.02 for rows in _people(w))),
+        (rf"abreast, {N} m apart and centred\s+{N} m to the left of the robot's {N} m straight path",
+         lambda w, gap, side, length: _line(w)[4] == pytest.approx(length)
+         and np.allclose(sorted(_lateral(w, rows[:1])[0] for rows in _people(w)), [side - gap, side, side + gap], atol=1e-6)),
+        (rf"{N} m from its wall", lambda w, d: w.tasks[0].spawn.y - w.scene.bounds[0][1] == pytest.approx(d)
+         == w.tasks[0].goal.y - w.scene.bounds[0][1]),
+        (rf"{N} m short of its goal",
+         lambda w, d: all(_along(w, rows[:1])[0] == pytest.approx(_line(w)[4] - d, abs=1e-6) for rows in _people(w))),
+        (rf"heading {N} degrees from the\s+robot's, within {N} degrees",
+         lambda w, deg, tol: np.all(np.abs(_passing_headings(w) - deg) <= tol)),
+        (rf"to\s+{N} m behind its spawn",
+         # All past the spawn; the group's centre within ARRIVE (0.2 m) of that far behind it along the line.
+         lambda w, d: all(_along(w, rows[-1:])[0] < 0 for rows in _people(w))
+         and abs(np.mean([_along(w, rows[-1:])[0] for rows in _people(w)]) + d) < 0.2),
+        (rf"each within {N} m of the group's centre", lambda w, d: _group_spread(w) <= d),
+        (r"passing it on its left", lambda w: all(_lateral(w, rows).min() > w.robot.inflation + 0.25 for rows in _people(w))),
+    ],
+    "person_in_doorway": [
+        (rf"open {N} m doorway at x = {N} m",
+         lambda w, width, x: w.metadata["doors"][0]["state"] == "open"
+         and w.metadata["doors"][0]["passage"]["width"] == pytest.approx(width)
+         and w.metadata["doors"][0]["passage"]["center"][0] == pytest.approx(x)),
+        (rf"robot's path from \({N}, {N}\) to \({N}, {N}\)",
+         lambda w, sx, sy, gx, gy: (w.tasks[0].spawn.x, w.tasks[0].spawn.y, w.tasks[0].goal.x, w.tasks[0].goal.y)
+         == (sx, sy, gx, gy)),
+        (rf"steps aside after {N} s", lambda w, t: _walker(w)[0][1, 0] == t),
+        (rf"radius {N} m\) stands still in the middle of the doorway for {N} s",
+         lambda w, r, t: _walker(w)[1] == r and _walker(w)[0][1, 0] == t
+         and np.allclose(_walker(w)[0][:2, 1:], [w.metadata["doors"][0]["passage"]["center"]] * 2, atol=1e-6)),
+        (rf"walks at\s+{N} m/s", lambda w, v: w.params["person_speed"] == [v, v]
+         and np.max(np.hypot(*np.diff(_walker(w)[0][:, 1:], axis=0).T) / np.diff(_walker(w)[0][:, 0])) <= 1.3 * v + 1e-4),
+        (rf"to {N} m beyond the doorway and {N} m to the right of the robot's path",
+         lambda w, ahead, side: np.hypot(*(_walker(w)[0][-1, 1:] - (np.array(w.metadata["doors"][0]["passage"]["center"])
+                                                                  + ahead * _line(w)[2] - side * _line(w)[3]))) < 0.2),
+        (rf"\(robot_speed {N} m/s\)", lambda w, v: w.params["robot_speed"] == v),
+        (r"the robot must wait", _must_yield),
+    ],
     "person_head_on": [
         (rf"along its {N} m straight path in an empty {N} x {N} m room",
          lambda w, length, a, b: _line(w)[4] == pytest.approx(length) and _extent(w) == (a, b)
