@@ -122,3 +122,60 @@ def test_people_that_cannot_fit_say_so():
     with pytest.raises(InfeasibleError, match=r"people_placement failed 2x") as err:
         worldgen.generate("minimal", seed=0, n_people=40, person_radius=1.0, max_attempts=2)
     assert "\n" not in str(err.value) and "could not place 40 people" in str(err.value)
+
+
+def test_a_standing_person_stands_still_in_every_format(tmp_path):
+    """person_in_doorway: the person stands in the doorway for 8 s; world.json says so with two rows at
+    the same place (t = 0 and t = 8), the SDF actor with the same two waypoints, and MuJoCo's mocap body,
+    driven by drive_mocap, stays there (within 1 um) at every sampled time of the stay."""
+    world = worldgen.generate_preset("person_in_doorway")
+    meta = world.metadata
+    (person,) = meta["people"]
+    rows = np.array(person["trajectory"])
+    centre = meta["doors"][0]["passage"]["center"]
+    np.testing.assert_array_equal(rows[:2], [[0.0, *centre], [8.0, *centre]])
+    assert np.hypot(*(rows[2, 1:] - rows[1, 1:])) > 0  # and then it moves
+    actor = parse_bytes(world.to_sdf().encode()).getroot().find("world/actor")
+    points = [(float(w.findtext("time")), *map(float, w.findtext("pose").split()[:2]))
+              for w in actor.findall("script/trajectory/waypoint")]
+    np.testing.assert_array_equal(np.array(points), rows)
+    model, data = load_and_step(world.to_mjcf(), steps=1)
+    for t in np.linspace(0.0, 8.0, 17):
+        drive_mocap(model, data, meta, t)
+        mujoco.mj_step(model, data)
+        np.testing.assert_allclose(data.xpos[model.body(person["name"]).id][:2], centre, atol=1e-6)
+
+
+def test_groups_share_speed_and_start_together_and_walk_beside_each_other():
+    from worldgen.generators.people import GROUP_SPACING, GROUP_START
+
+    base = worldgen.generate("cluttered", seed=1, size=[12.0, 12.0], n_obstacles=4)
+    params = dict(base.params, n_people=7, person_radius=0.25, person_speed=[0.8, 1.4], people_duration=30.0,
+                  group_size=3)
+    plan, reason = draw_people(base.scene, base.tasks, base.robot, params, people_rng(1, 0))
+    assert reason is None and plan is not None
+    np.testing.assert_array_equal(plan.groups, [0, 0, 0, 3, 3, 3, -1])  # the last group has one member: alone
+    for lead in (0, 3):
+        members = slice(lead, lead + 3)
+        assert len(set(plan.speeds[members])) == 1
+        assert np.hypot(*(plan.starts[members] - plan.starts[lead]).T).max() <= GROUP_START
+        # Each place of the group: the members side by side across the leg, GROUP_SPACING apart where free
+        # (at least half that, or together, where not).
+        gaps = np.hypot(*(plan.places[lead + 1] - plan.places[lead]).T)
+        assert np.all((np.abs(gaps - GROUP_SPACING) < 1e-5) | (np.abs(gaps - GROUP_SPACING / 2) < 1e-5) | (gaps < 1e-5))
+        assert np.mean(np.abs(gaps - GROUP_SPACING) < 1e-5) > 0.5
+    index = FootprintIndex(people_footprints(base.scene, base.tasks, base.robot))
+    assert not index.blocked(plan.places.reshape(-1, 2), 0.25 + 2 * SLACK).any()
+    # Without groups the draw is what it was: group_size 1 is not even recorded.
+    alone = worldgen.generate("cluttered", seed=1, size=[8.0, 8.0], n_people=2, people_duration=5.0, group_size=1)
+    assert "group_size" not in alone.params and "group_size" not in alone.metadata["params"]
+
+
+def test_group_scenarios_say_what_is_wrong_in_one_line():
+    with pytest.raises(ParameterError, match=r"^people_scenario 'group_passing' needs group_size from 2 to n_people \(1\), "
+                                             r"got 1$"):
+        worldgen.generate("cluttered", seed=0, n_people=1, people_scenario="group_passing")
+    with pytest.raises(ParameterError, match=r"^people_scenario 'doorway' needs a world with a door \(generator 'door'\)$"):
+        worldgen.generate("cluttered", seed=0, n_people=1, people_scenario="doorway")
+    with pytest.raises(ParameterError, match=r"parameter 'group_size' must be in \[1, 8\], got 9"):
+        worldgen.generate("cluttered", seed=0, n_people=9, group_size=9)

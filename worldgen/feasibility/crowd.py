@@ -30,6 +30,9 @@ up to four times, else not taken, and the velocity set to the step actually made
 position, and every point between two rows of the written trajectory, keeps the person's disc off
 every obstacle. People may still touch each other: the model makes it rare, nothing forbids it.
 
+Members of a group (``groups``) feel the group force of Moussaïd et al. (2010) on top
+(:mod:`worldgen.feasibility.groups`).
+
 :func:`simulate` is a pure function of its arguments: no randomness, same inputs, same rows.
 """
 
@@ -43,12 +46,13 @@ import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
+from worldgen.feasibility.groups import GroupForce, group_force
 from worldgen.feasibility.planner import Planner
 from worldgen.floats import round_float
 from worldgen.generators.people import PERSON_HEIGHT, SLACK, draw_people, people_footprints
 from worldgen.scene import Mover, Robot, Scene, Task
 
-__all__ = ["SocialForce", "GroupForce", "group_force", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF", "simulate", "walk_people"]
+__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF", "simulate", "walk_people"]
 
 #: The integration step (s); the trajectories are written at it.
 DT = 0.1
@@ -78,19 +82,6 @@ class SocialForce:
     phi: float = math.radians(100.0)  # half the field of view, rad
     c: float = 0.5  # weight of what is outside the field of view
     v_max_ratio: float = 1.3  # v_max = 1.3 v0
-
-
-@dataclass(frozen=True)
-class GroupForce:
-    """The group terms of Moussaïd, Perozo, Garnier, Helbing & Theraulaz, "The walking behaviour of
-    pedestrian social groups and its impact on crowd dynamics", PLoS ONE 5(4): e10047 (2010), with the
-    paper's values (docs/people.md): gaze ``-beta1 alpha v``, attraction ``beta2`` toward the group's
-    centre beyond ``(N - 1) / 2`` m from it, repulsion ``beta3`` from each member whose disc overlaps."""
-
-    beta1: float = 4.0  # gaze: braking per radian of head turn needed to see the group's centre, 1/s
-    beta2: float = 3.0  # attraction toward the group's centre, m/s^2
-    beta3: float = 1.0  # repulsion from an overlapping member, m/s^2
-    phi: float = math.radians(90.0)  # half the vision field the centre must be in before the head turns, rad
 
 
 class _Walls:
@@ -336,46 +327,6 @@ def _people_force(p: np.ndarray, v: np.ndarray, e: np.ndarray, radius: float, m:
     w = np.where(seen, mag, m.c * mag)
     np.fill_diagonal(w, 0.0)
     return np.column_stack([np.sum(w * (dx / n1 + rx / n2), axis=1), np.sum(w * (dy / n1 + ry / n2), axis=1)])
-
-
-def group_force(p: np.ndarray, v: np.ndarray, e: np.ndarray, groups: np.ndarray, radius: float,
-                m: GroupForce = GroupForce()) -> np.ndarray:
-    """(n, 2) Moussaïd et al.'s (2010) group force on each member of a group of two or more (zero for
-    the others): with ``c`` the group's centre (the mean of its members' positions) and ``N`` its size,
-
-    - gaze ``-beta1 alpha v``: ``alpha`` is how far (rad) the head must turn beyond ``phi`` from the
-      walking direction (the velocity, else ``e`` from rest) to see ``c``; it slows one who walks ahead;
-    - attraction ``beta2`` toward ``c`` when farther from it than ``(N - 1) / 2`` m;
-    - repulsion ``beta3`` away from each other member whose disc overlaps (centres closer than ``2 radius``).
-    """
-    n = len(p)
-    out = np.zeros((n, 2))
-    g = np.asarray(groups, dtype=np.int64)
-    member = g >= 0
-    if n < 2 or not member.any():
-        return out
-    size = np.bincount(g[member], minlength=int(g.max()) + 1).astype(float)
-    cx = np.bincount(g[member], p[member, 0], minlength=len(size)) / np.maximum(size, 1)
-    cy = np.bincount(g[member], p[member, 1], minlength=len(size)) / np.maximum(size, 1)
-    idx = np.flatnonzero(member & (size[np.maximum(g, 0)] >= 2))
-    if not len(idx):
-        return out
-    gi = g[idx]
-    to = np.column_stack([cx[gi], cy[gi]]) - p[idx]
-    dist = np.hypot(to[:, 0], to[:, 1])
-    speed = np.hypot(v[idx, 0], v[idx, 1])
-    heading = np.where(speed[:, None] > 1e-9, v[idx] / np.maximum(speed, 1e-12)[:, None], e[idx])
-    cos_t = np.einsum("ij,ij->i", heading, to) / np.maximum(dist, 1e-12)
-    alpha = np.where(dist > 1e-9, np.maximum(np.arccos(np.clip(cos_t, -1.0, 1.0)) - m.phi, 0.0), 0.0)
-    out[idx] -= m.beta1 * alpha[:, None] * v[idx]
-    far = dist > (size[gi] - 1) / 2
-    out[idx[far]] += m.beta2 * to[far] / dist[far, None]
-    dx = p[idx, None, :] - p[None, idx, :]
-    d = np.hypot(dx[..., 0], dx[..., 1])
-    touch = (gi[:, None] == gi[None, :]) & (d < 2 * radius) & (d > 1e-12)
-    w = np.where(touch, m.beta3 / np.maximum(d, 1e-12), 0.0)
-    out[idx] += np.einsum("ij,ijk->ik", w, dx)
-    return out
 
 
 def _keep_off(walls: _Walls, p: np.ndarray, p_new: np.ndarray, room: np.ndarray, keep: float) -> np.ndarray:
