@@ -139,6 +139,8 @@ def test_a_standing_person_stands_still_in_every_format(tmp_path):
     points = [(float(w.findtext("time")), *map(float, w.findtext("pose").split()[:2]))
               for w in actor.findall("script/trajectory/waypoint")]
     np.testing.assert_array_equal(np.array(points), rows)
+    ok, messages = check_sdf(world.write(tmp_path, preview=False) / "world.sdf")
+    assert ok, "\n".join(messages)
     model, data = load_and_step(world.to_mjcf(), steps=1)
     for t in np.linspace(0.0, 8.0, 17):
         drive_mocap(model, data, meta, t)
