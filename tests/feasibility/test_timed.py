@@ -70,6 +70,14 @@ def test_timed_paths_pass_an_independent_check_from_world_json_alone(generator, 
     assert checked >= 4
 
 
+@pytest.mark.parametrize("preset", ["person_head_on", "person_crossing", "person_overtaking", "group_in_corridor",
+                                    "person_in_doorway"])
+def test_every_encounter_preset_carries_a_timed_path_that_passes_the_independent_check(preset):
+    meta = worldgen.generate_preset(preset).metadata
+    metadata.validate(meta)
+    assert _verify(meta) == 1 and meta["feasibility"]["feasible"]
+
+
 def _straight_wait_case(stand_until: float):
     """A 10 m straight path at 0.5 m/s; a person (r 0.25) stands on it at x = 5 until ``stand_until``,
     then walks straight off sideways at 1 m/s for 3 m."""
