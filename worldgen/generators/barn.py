@@ -52,9 +52,9 @@ PARAMS = (
     # 400 finds a world where 1 draw in 40 can be crossed (5 of 200 at fill 0.3, 2 passes, the default
     # robot) all but 4 times in 100,000 (0.975 ** 400).
     Param("max_attempts", "int", 400, "draws tried (each with a derived seed) before giving up", 1, 10000),
-    Param("grid_cols", "int", 30, "cells across the field (x)", 2, 400),
-    Param("grid_rows", "int", 30, "cells along the field, from the start end to the goal end (y)", 2, 400),
-    Param("cell_size", "float", 0.15, "edge of one cell (BARN: 0.15)", 0.02, 5.0, unit="m"),
+    Param("grid_cols", "int", 30, "cells across the field (x)", 2, 200),
+    Param("grid_rows", "int", 30, "cells along the field, from the start end to the goal end (y)", 2, 200),
+    Param("cell_size", "float", 0.15, "edge of one cell (BARN: 0.15)", 0.02, 2.5, unit="m"),
     Param("fill_fraction", "float", 0.2, "chance that a cell starts filled (BARN: 0.15 to 0.30)", 0.0, 0.9),
     Param("smoothing_passes", "int", 4, "cellular automaton passes after the random fill (BARN: 2 to 4)", 0, 50),
     Param("birth_limit", "int", 5, "a cell with at least this many of its 8 neighbours filled becomes filled "
@@ -62,7 +62,7 @@ PARAMS = (
     Param("death_limit", "int", 2, "a cell with fewer than this many of its 8 neighbours filled becomes empty "
           "(BARN: 2)", 0, 8),
     Param("end_depth", "float", 1.0, "depth of the free strips below (spawns) and above (goals) the field",
-          0.02, 100.0, unit="m"),
+          0.02, 50.0, unit="m"),
     Param("obstacle_height", "float", 1.0, "height of the obstacles", 0.01, 50.0, unit="m"),
     Param("walls", "bool", True, "surround the field and both strips with walls"),
     Param("wall_height", "float", 1.0, "height of the walls", 0.05, 50.0, unit="m"),
@@ -90,7 +90,11 @@ def check(params: Mapping[str, Any]) -> None:
     if width < need:
         raise ParameterError(
             f"parameter 'grid_cols' x cell_size (the field's width, {width:.4g} m) must be at least {need:.4g} m "
-            f"to hold {params['n_tasks']} robots side by side in a strip, got grid_cols={params['grid_cols']!r}")
+            f"to hold {_robots(params['n_tasks'])} side by side in a strip, got grid_cols={params['grid_cols']!r}")
+
+
+def _robots(n: int) -> str:
+    return "the robot" if n == 1 else f"{n} robots"
 
 
 def field_grid(params: Mapping[str, Any], rng: np.random.Generator) -> np.ndarray:
