@@ -4,6 +4,7 @@ its quick refusal against the exact check, and its worlds through the whole pipe
 from __future__ import annotations
 
 import json
+import math
 
 import mujoco
 import numpy as np
@@ -138,6 +139,23 @@ def test_every_draw_the_screen_refuses_the_exact_check_refuses_too():
         report = feasibility.check(field_scene(params, grid), draft.tasks, robot)
         assert not report.feasible, attempt
     assert refused > 4
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(seed=st.integers(0, 2**32), fill=st.sampled_from([0.2, 0.3, 0.4, 0.5]), passes=st.integers(0, 4),
+       cell=st.sampled_from([0.05, 0.1, 0.15, 0.3, 0.6]), cols=st.integers(6, 24), rows=st.integers(3, 20),
+       radius=st.sampled_from([0.05, 0.2, 0.3]), clearance=st.sampled_from([0.0, 0.05]))
+def test_the_screen_refuses_only_fields_the_exact_check_refuses(seed, fill, passes, cell, cols, rows, radius,
+                                                                clearance):
+    spec = get("barn")
+    cols = max(cols, math.ceil((2 * (radius + clearance) + 0.01) / cell))  # room for the robot in the strips
+    params = spec.resolve(dict(fill_fraction=fill, smoothing_passes=passes, cell_size=cell, grid_cols=cols,
+                               grid_rows=rows, robot_radius=radius, clearance=clearance, end_depth=1.5))
+    draft = spec.build(params, attempt_rng(seed, 0))
+    if draft.rejected != "field_blocked":
+        return
+    grid = field_grid(params, attempt_rng(seed, 0).spawn(2)[0])
+    assert not feasibility.check(field_scene(params, grid), draft.tasks, robot_from_params(params)).feasible
 
 
 # -- whole worlds ----------------------------------------------------------------------------------
