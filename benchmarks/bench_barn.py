@@ -6,7 +6,9 @@ Part 1, the comparison: --worlds worlds (default 40) of each generator, seeds 0.
 door with their defaults; corridor with its shape, width (0.8 to 2 m), obstacles and side openings
 varied by the index (its defaults, one straight empty corridor, are one world whatever the seed);
 minimal with its target kind, distance, bearing and walls varied by the index (its seed draws
-nothing). For each world, the ratio BARN / worldgen of every metric, BARN's computed by
+nothing); barn cycling through BARN's own 12 settings (fill 0.15 to 0.30, 2 to 4 smoothing passes)
+by the index. For each world, the milliseconds worldgen.generate took (generate_ms: generator,
+refused draws and the exact check, no files), and the ratio BARN / worldgen of every metric, BARN's computed by
 worldgen.groundtruth.barn_metrics (equal to BARN's own code, tests/groundtruth/test_barn.py) in
 metres (cells x map_resolution), on two kinds of input:
 
@@ -38,7 +40,7 @@ import time
 from pathlib import Path
 
 RESULTS = Path(__file__).resolve().parent / "results" / "barn.json"
-GENERATORS = ("cluttered", "corridor", "door", "minimal")
+GENERATORS = ("cluttered", "corridor", "door", "minimal", "barn")
 #: worldgen's name of each BARN metric, and whether it is a length (cells -> m).
 PAIRS = {"closest_wall": ("closest_obstacle_distance_mean", True),
          "average_visibility": ("average_visibility", True),
@@ -60,12 +62,20 @@ def corridor_params(i: int) -> dict:
             "n_obstacles": (0, 2, 4)[i % 3], "side_openings": i % 2}
 
 
+def barn_params(i: int) -> dict:
+    """BARN's 12 settings in turn: fill fraction 0.15 to 0.30 by 0.05, 2 to 4 smoothing passes."""
+    return {"fill_fraction": (0.15, 0.2, 0.25, 0.3)[i % 4], "smoothing_passes": (2, 3, 4)[(i // 4) % 3]}
+
+
 def compare(generator: str, seed: int) -> dict:
     import worldgen
     from worldgen.groundtruth import barn, truth
 
-    params = {"minimal": minimal_params, "corridor": corridor_params}.get(generator, lambda i: {})(seed)
+    params = {"minimal": minimal_params, "corridor": corridor_params, "barn": barn_params}.get(
+        generator, lambda i: {})(seed)
+    t0 = time.perf_counter()
     world = worldgen.generate(generator, seed=seed, **params)
+    generate_ms = (time.perf_counter() - t0) * 1e3
     meta = world.metadata
     ours = meta["metrics"]
     grid = truth.occupancy_map(world)
@@ -77,7 +87,8 @@ def compare(generator: str, seed: int) -> dict:
     cs, cells = barn.world_inputs(grid.occupied, grid.origin, res, world.robot.radius, waypoints)
     inside = float(cs[cells[:, 0], cells[:, 1]].mean())
     out: dict = {"generator": generator, "seed": seed, "params": params, "cells_in_cspace_walls": inside,
-                 "closest_difference_m": float(user["closest_wall"] or 0.0) * res - ours["closest_obstacle_distance_mean"]}
+                 "closest_difference_m": float(user["closest_wall"] or 0.0) * res - ours["closest_obstacle_distance_mean"],
+                 "generate_ms": generate_ms}
     for kind, values in (("user", user), ("barn", meta["metrics"]["barn"])):
         for name, (mine, length) in PAIRS.items():
             got = values[name]
@@ -92,7 +103,7 @@ def summarise(rows: list[dict]) -> dict:
     for generator in GENERATORS:
         mine = [r for r in rows if r["generator"] == generator]
         stats = {}
-        for key in [k for k in mine[0] if ":" in k] + ["closest_difference_m", "cells_in_cspace_walls"]:
+        for key in [k for k in mine[0] if ":" in k] + ["closest_difference_m", "cells_in_cspace_walls", "generate_ms"]:
             vals = [r[key] for r in mine if r[key] is not None]
             stats[key] = {"median": statistics.median(vals), "min": min(vals), "max": max(vals), "n": len(vals)}
         out[generator] = stats
@@ -142,7 +153,7 @@ def main(argv=None) -> int:
     print("user = uninflated map, chain, radius 4 inflation radii; barn = world.json metrics.barn (C-space, radius 3)")
     keys = [k for k in rows[0] if ":" in k]
     print(f"{'metric':<34}" + "".join(f"{g:>26}" for g in GENERATORS))
-    for key in keys + ["closest_difference_m", "cells_in_cspace_walls"]:
+    for key in keys + ["closest_difference_m", "cells_in_cspace_walls", "generate_ms"]:
         cells = [summary[g][key] for g in GENERATORS]
         print(f"{key:<34}" + "".join(f"{c['median']:>9.3f} [{c['min']:6.3f},{c['max']:6.3f}]" for c in cells))
     print(f"\nbarn_metrics, {speed['cspace_cells'][0]} x {speed['cspace_cells'][1]} C-space of a "

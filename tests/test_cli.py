@@ -315,9 +315,9 @@ def test_list_some_parameters_of_one_generator_and_its_json():
 
 @pytest.mark.parametrize("args, line", [
     (["list", "clutterd"],
-     "error: unknown generator 'clutterd' (did you mean 'cluttered'?); available: cluttered, corridor, door, minimal"),
+     "error: unknown generator 'clutterd' (did you mean 'cluttered'?); available: barn, cluttered, corridor, door, minimal"),
     (["generate", "coridor", "--out", "x"],
-     "error: unknown generator 'coridor' (did you mean 'corridor'?); available: cluttered, corridor, door, minimal"),
+     "error: unknown generator 'coridor' (did you mean 'corridor'?); available: barn, cluttered, corridor, door, minimal"),
     (["list", "cluttered", "n_obstacle"],
      "error: unknown parameter 'n_obstacle' for generator 'cluttered' (did you mean 'n_obstacles'?); known parameters: "
      "box_size, clearance, "),

@@ -71,7 +71,7 @@ RECIPES = EXAMPLES[0].parent / "recipes"
 
 def test_the_readme_uses_the_shipped_recipes():
     readme = (RECIPES.parent.parent / "README.md").read_text()
-    for name in ("ci_smoke.yaml", "barn_like.yaml"):
+    for name in ("ci_smoke.yaml", "barn_like.yaml", "barn.yaml"):
         assert f"examples/recipes/{name}" in readme
     assert "Not built yet" not in readme
 
@@ -108,3 +108,16 @@ def test_barn_like_recipe_is_300_worlds_spanning_difficulty():
         visibility.append(meta["metrics"]["average_visibility"])
     assert min(passage) < 0.7 and max(passage) > 1.2
     assert max(visibility) / min(visibility) > 1.5
+
+
+def test_barn_recipe_is_barn_s_300_worlds_and_each_setting_can_be_crossed():
+    import worldgen
+    from worldgen.pack.recipe import load_recipe
+
+    recipe = load_recipe(RECIPES / "barn.yaml")
+    assert len(recipe) == 300 and {j.generator for j in recipe.jobs} == {"barn"}
+    settings = {(j.param_dict["fill_fraction"], j.param_dict["smoothing_passes"]) for j in recipe.jobs}
+    assert settings == {(f, p) for f in (0.15, 0.2, 0.25, 0.3) for p in (2, 3, 4)}
+    for job in recipe.jobs[::25]:  # the first seed of each setting
+        world = worldgen.generate(job.generator, job.seed, **job.param_dict)
+        assert world.feasibility.feasible and (world.params["grid_cols"], world.params["cell_size"]) == (30, 0.15)

@@ -1,4 +1,4 @@
-"""The same worlds, byte for byte: every file of 48 worlds across generators, presets, movers and SDF
+"""The same worlds, byte for byte: every file of 49 worlds across generators, presets, movers and SDF
 versions, pinned by digest. A refactor must leave them alone; a change that alters a world on purpose
 updates the pins in the same commit, saying why (``WORLDGEN_UPDATE_GOLDEN=1 pytest tests/test_golden_bytes.py``)."""
 
@@ -31,6 +31,7 @@ CASES += [
     ("corridor-zigzag", "corridor", 7, {"shape": "zigzag"}, {}),
     ("minimal-cylinder", "minimal", 0, {"target": "cylinder"}, {}),
     ("cluttered-many", "cluttered", 11, {"n_obstacles": 40}, {}),
+    ("barn-s0", "barn", 0, {}, {}),
 ]
 
 

@@ -42,7 +42,7 @@ import numpy as np
 CI_CAPS = {
     "size": 30.0, "length": 30.0, "segments": 30.0, "n_obstacles": 60, "density": 0.6,
     "lidar_samples": 2000, "max_attempts": 5, "n_tasks": 3, "n_movers": 3, "n_doors": 4,
-    "side_openings": 4, "task_region": 30.0, "mover_waypoints": 8,
+    "side_openings": 4, "task_region": 30.0, "mover_waypoints": 8, "grid_cols": 60, "grid_rows": 60,
 }
 #: Floor for parameters whose lower end only makes the occupancy map huge.
 CI_FLOORS = {"map_resolution": 0.05}

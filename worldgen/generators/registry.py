@@ -31,12 +31,13 @@ def register(spec: GeneratorSpec) -> GeneratorSpec:
 def _load_builtins() -> None:
     # Imported on first lookup, not with the package: each generator pulls in shapely and its
     # geometry. The modules only define their SPEC; registering them is this module's job.
+    from worldgen.generators.barn import SPEC as BARN
     from worldgen.generators.cluttered import SPEC as CLUTTERED
     from worldgen.generators.corridor import SPEC as CORRIDOR
     from worldgen.generators.door import SPEC as DOOR
     from worldgen.generators.minimal import SPEC as MINIMAL
 
-    for spec in (CLUTTERED, DOOR, MINIMAL, CORRIDOR):
+    for spec in (CLUTTERED, DOOR, MINIMAL, CORRIDOR, BARN):
         register(spec)
 
 
