@@ -16,9 +16,11 @@ swings away from it, but not pull one that swings towards it. The ``doors`` sett
 The motor is a MuJoCo actuator on the hinge, added to the world's MJCF by the environment: an integrator
 (its activation, the target angle, ramps at ``door_speed`` and stops at the limits) feeding a stiff,
 critically damped position servo (natural frequency :data:`OPENER_OMEGA`, scaled by the leaf's inertia about
-the hinge). Its torque is bounded by the hinge's own effort limit (world.json's joint, MJCF
-``actuatorfrcrange``), so a leaf opening onto the robot presses on it (a door contact, not a collision)
-rather than shoving it aside. Before it is triggered the motor is off (zero gains): the leaf is passive.
+the hinge; the leaf trails the ramp by about ``2 door_speed / OPENER_OMEGA``, 0.2 rad at the defaults, and
+settles on the open limit). Its torque is bounded by the hinge's own effort limit (the scene joint's
+``effort``, MJCF ``actuatorfrcrange``: 100 N m in the door generator's worlds), so a leaf opening onto
+the robot presses on it (a door contact, not a collision) rather than shoving it aside. Before it is
+triggered the motor is off (zero gains): the leaf is passive.
 The trigger is tested at the start of every env step.
 """
 
@@ -36,7 +38,7 @@ __all__ = ["DOOR_MODES", "OPENER_OMEGA", "opener_name", "add_openers", "Openers"
 
 #: The values of the environment's ``doors`` setting.
 DOOR_MODES = ("auto", "automatic", "push")
-#: Natural frequency (rad/s) of the opener's position servo: the leaf follows the ramp within a few hundredths.
+#: Natural frequency (rad/s) of the opener's position servo (critically damped, whatever the leaf's inertia).
 OPENER_OMEGA = 20.0
 
 
