@@ -179,4 +179,72 @@ def test_an_infeasible_on_purpose_world_reproduces(tmp_path):
 
 
 def test_the_checks_are_named_in_order():
-    assert CHECKS == ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "reproduce")
+    assert CHECKS == ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "timed", "reproduce")
+
+
+# -- timed: the certificate among people, re-proved from world.json ------------------------------------
+
+@pytest.fixture(scope="module")
+def among_people(tmp_path_factory):
+    """The person_head_on preset's world (a person walks the robot's 9 m line towards it: the timed path
+    waits for it) and a cluttered world with six people, whose path bends."""
+    from worldgen.presets import load
+
+    out = tmp_path_factory.mktemp("people")
+    head_on = load("person_head_on")
+    return (worldgen.generate(head_on.generator, 0, **head_on.merged({})).write(out),
+            worldgen.generate("cluttered", 0, size=[8.0, 8.0], n_obstacles=10, n_people=6,
+                              people_duration=20.0).write(out))
+
+
+@pytest.fixture
+def head_on(among_people, tmp_path) -> Path:
+    return Path(shutil.copytree(among_people[0], tmp_path / among_people[0].name))
+
+
+def test_worlds_among_people_pass_timed(among_people, capsys):
+    assert _check(capsys, *among_people) == (0, [f"OK {f}" for f in among_people])
+
+
+def _timed(folder: Path, rows) -> None:
+    def change(meta):
+        meta["tasks"][0]["timed_path"] = rows
+        meta["tasks"][0]["arrival_time"] = rows[-1][0]
+    _edit_json(folder, change)
+
+
+def test_driving_the_line_through_the_person_fails_timed(head_on, capsys):
+    """On the path and under max_speed (0.4995 of 0.5 m/s), but straight through the person walking it."""
+    task = json.loads((head_on / "world.json").read_text())["tasks"][0]
+    assert task["arrival_time"] == 23.65  # the certificate waits: 9 m at 0.5 m/s would take 18 s
+    _timed(head_on, [[0.0, *task["spawn"][:2]], [round(9.0 / 0.4995, 6), *task["goal"][:2]]])
+    _fails(capsys, head_on, "timed", "task_0 timed_path at t = ", "from person_0's centre", "0.5000 m")
+
+
+def test_a_timed_path_faster_than_max_speed_fails_timed(head_on, capsys):
+    rows = json.loads((head_on / "world.json").read_text())["tasks"][0]["timed_path"]
+    _timed(head_on, [[round(t * 0.9, 6), x, y] for t, x, y in rows])
+    _fails(capsys, head_on, "timed", "above robot.max_speed 0.5 m/s")
+
+
+def test_a_row_off_the_path_fails_timed(head_on, capsys):
+    rows = json.loads((head_on / "world.json").read_text())["tasks"][0]["timed_path"]
+    rows[2][2] += 0.01
+    _timed(head_on, rows)
+    _fails(capsys, head_on, "timed", "row 2", "off the recorded path")
+
+
+def test_a_timed_path_that_cuts_a_corner_fails_timed(among_people, tmp_path, capsys):
+    folder = Path(shutil.copytree(among_people[1], tmp_path / among_people[1].name))
+    task = json.loads((folder / "world.json").read_text())["tasks"][0]
+    corner = task["path"]["waypoints"][3]
+    rows = [r for r in task["timed_path"] if r[1:] != corner]  # the row at the path's third corner dropped
+    assert len(rows) == len(task["timed_path"]) - 1
+    _timed(folder, rows)
+    _fails(capsys, folder, "timed", "leaves the recorded path", "cuts a corner")
+
+
+def test_a_timed_path_that_does_not_start_at_the_spawn_fails_timed(head_on, capsys):
+    rows = json.loads((head_on / "world.json").read_text())["tasks"][0]["timed_path"]
+    _timed(head_on, [[t + 1.0, x, y] for t, x, y in rows])
+    _fails(capsys, head_on, "timed", "not at t = 0 at the spawn")

@@ -14,6 +14,17 @@ ones would only repeat it in other words):
                  robot, spawns and goals, each path length within 1e-6 m, and
                  the recorded waypoints kept clear by FCL in the regenerated scene
                  (doors at their open limit, as the reference paths assume);
+``timed``        with people, every ``tasks[].timed_path`` is re-proved from
+                 world.json's own data (not by re-running the certificate's
+                 search): rows from the spawn at t = 0 to the goal at
+                 ``arrival_time``, times increasing, no faster than
+                 ``robot.max_speed``, on the recorded path (consecutive rows on
+                 one leg of it), kept clear by FCL in the regenerated scene, and,
+                 sampled every 2 ms against every person's
+                 ``trajectory`` (straight between rows, standing after the last),
+                 never closer than ``robot.radius + robot.clearance + radius``
+                 plus what the two could close between samples
+                 (:mod:`worldgen.verify_timed`);
 ``reproduce``    when this worldgen version wrote the world: a fresh export gives
                  world.json and every listed file byte for byte (another version
                  may format files differently, so there this check is skipped and
@@ -37,7 +48,7 @@ from worldgen.files import METADATA_NAME
 
 __all__ = ["CHECKS", "Outcome", "check_folder", "LENGTH_TOLERANCE"]
 
-CHECKS = ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "reproduce")
+CHECKS = ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "timed", "reproduce")
 #: Recorded and re-run path lengths may differ by this much (m): the 1e-6 of the
 #: contract plus half a unit in the 6th decimal that world.json rounds to.
 LENGTH_TOLERANCE = 1e-6 + 5e-7
@@ -75,6 +86,7 @@ def check_folder(folder) -> Outcome:
         _schema(meta)
         world = _regenerate(meta)
         _feasibility(meta, world)
+        _timed(meta, world)
         note = _reproduce(folder, meta, world, entries)
     except _Fail as f:
         return Outcome(folder, False, f.check, f.detail)
@@ -203,6 +215,15 @@ def _feasibility(meta: dict, world) -> None:
         if report.feasible and nearest.distance < robot.clearance - 1e-6:
             raise _Fail("feasibility", f"{task['id']} recorded path comes {nearest.distance:.6f} m from "
                                        f"{nearest.name}, under the clearance {robot.clearance} m")
+
+
+def _timed(meta: dict, world) -> None:
+    from worldgen.verify_timed import TimedPathError, check_timed
+
+    try:
+        check_timed(meta, world)
+    except TimedPathError as exc:
+        raise _Fail("timed", str(exc)) from None
 
 
 def _reproduce(folder: Path, meta: dict, world, entries) -> str:

@@ -242,3 +242,18 @@ def test_a_run_through_a_closed_door_keeps_its_clearance_to_everything_but_the_l
         assert oracles.collisions(trajectory, where) == []
         assert [c.entity for c in oracles.door_contacts(trajectory, where)] == ["door_0"]
         assert oracles.min_clearance(trajectory, where) == pytest.approx(task["path"]["min_clearance"], abs=1e-4)
+
+
+def test_a_leaf_touched_again_within_the_debounce_is_one_door_contact():
+    """The footprint (0.2 m) touches the closed leaf (near face x = 0.01) from x = -0.19 on; the oracles
+    sample every 0.05 m, so a leg from x = -1 to -0.1 in 1 s first touches it 17/18 of the way."""
+    world = worldgen.generate("door", 0, size=[8, 4], door_x=0.0, door_y=0.0, hinge_side="left", swing="push",
+                              state="closed", spawn=[-2.0, 0.0, 0.0], goal=[3.0, 0.0])
+    assert oracles.DOOR_DEBOUNCE == 2.0
+    back_soon = [(0, -1, 0), (1, -0.1, 0), (2, -1, 0), (3, -0.1, 0)]  # away from 1 + 1/18 s to 2 + 17/18 s
+    back_late = [(0, -1, 0), (1, -0.1, 0), (2, -1, 0), (4, -1, 0), (5, -0.1, 0)]  # away until 4 + 17/18 s
+    assert oracles.door_contacts(back_soon, world) == [oracles.Contact(17 / 18, "door_0")]
+    assert oracles.door_contacts(back_late, world) == [oracles.Contact(17 / 18, "door_0"),
+                                                       oracles.Contact(4 + 17 / 18, "door_0")]
+    assert oracles.collisions(back_late, world) == []
+    assert oracles.run(back_late, world).door_contacts == tuple(oracles.door_contacts(back_late, world))

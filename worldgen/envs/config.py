@@ -12,6 +12,7 @@ import math
 from dataclasses import dataclass, fields
 from typing import Any, Callable, Mapping, Optional
 
+from worldgen.envs.doors import DOOR_MODES
 from worldgen.errors import ParameterError, quoted
 from worldgen.params import Param, validate_params
 
@@ -67,6 +68,13 @@ SETTINGS: tuple[Param, ...] = (
           0.0, 1000.0, unit="m"),
     Param("terminate_on_collision", "bool", True, "end the episode at the first contact (else count contacts "
           "and drive on)"),
+    Param("doors", "choice", "auto", "how door leaves open (worldgen.envs.doors): auto (a door the robot comes to "
+          "from the side its leaf swings into opens by itself; from the other side the robot pushes it), "
+          "automatic (every door opens by itself as the robot comes near), push (leaves are only pushed: a pull "
+          "door stays shut)", choices=DOOR_MODES),
+    Param("door_trigger", "float", 2.0, "distance from a doorway's centre within which its automatic door opens",
+          0.0, 1000.0, unit="m"),
+    Param("door_speed", "float", 2.0, "opening speed of an automatic door's leaf", 0.01, 100.0, unit="rad/s"),
 )
 
 
@@ -99,6 +107,9 @@ class EnvConfig:
     reward_obstacle: float
     obstacle_distance: float
     terminate_on_collision: bool
+    doors: str
+    door_trigger: float
+    door_speed: float
     reward_fn: Optional[Callable[..., float]] = None
 
     @property

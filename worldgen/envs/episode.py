@@ -21,7 +21,11 @@ episode.
 A door leaf (the world's ``door_leaves``) is a hinged body the robot may push
 open, as the world's truth plans through doors at their open limit: a contact
 with a leaf is no collision; it goes to ``door_contacts`` instead (the same
-``{time, entity}`` records), and it neither ends the episode nor fails it.
+``{time, entity}`` records), and it neither ends the episode nor fails it. One push is one door contact:
+MuJoCo makes and breaks the contact many times while a leaf gives way, so a touch of a leaf that begins
+within :data:`~worldgen.testing.figures.DOOR_DEBOUNCE` (2 s of simulated time) of the last physics step
+touching that leaf continues the same door contact, as the oracles count them. ``doors_opened`` lists the
+automatic doors the robot triggered (:mod:`worldgen.envs.doors`), ``{time, entity}`` with the leaf's name.
 """
 
 from __future__ import annotations
@@ -30,7 +34,7 @@ from typing import Optional
 
 import numpy as np
 
-from worldgen.testing.figures import Contact
+from worldgen.testing.figures import DOOR_DEBOUNCE, Contact
 
 __all__ = ["Episode", "spl"]
 
@@ -53,6 +57,12 @@ class Episode:
         #: Contacts with door leaves (pushed open, not collisions).
         self.door_contacts: list[Contact] = []
         self._leaves: frozenset = getattr(world, "door_leaves", frozenset())
+        #: When each leaf was last touched (s): a touch soon after continues the same door contact.
+        self._leaf_last: dict[str, float] = {}
+        #: Whether the robot touched a door leaf since :meth:`new_step` (the env's per-step ``door_contact``).
+        self.door_touched = False
+        #: The automatic doors triggered, when (the leaf's name).
+        self.door_openings: list[Contact] = []
         #: The entities the robot touched at the last physics step checked.
         self.touching: frozenset = frozenset()
         self.done = False
@@ -66,8 +76,17 @@ class Episode:
         self.touching = entities
         hits = [name for name in new if name not in self._leaves]
         self.contacts.extend(Contact(float(t), name) for name in hits)
-        self.door_contacts.extend(Contact(float(t), name) for name in new if name in self._leaves)
+        for name in new:
+            if name in self._leaves and t - self._leaf_last.get(name, -np.inf) > DOOR_DEBOUNCE:
+                self.door_contacts.append(Contact(float(t), name))
+        for name in entities & self._leaves:
+            self._leaf_last[name] = float(t)
+            self.door_touched = True
         return bool(hits)
+
+    def new_step(self) -> None:
+        """Start an env step: clear the per-step door flag."""
+        self.door_touched = False
 
     @property
     def trajectory(self) -> np.ndarray:
@@ -99,6 +118,7 @@ class Episode:
         # evaluate's rule (worldgen.testing.evaluate): the goal, within the scenario's max_time, and no collision.
         ok = bool(run.reached_goal and not run.collisions and (limit is None or run.time_to_goal <= limit))
         out = run.as_dict()
-        out.update(success=ok, spl=spl(ok, ref, length), reference_path_length=ref)
+        out.update(success=ok, spl=spl(ok, ref, length), reference_path_length=ref,
+                   doors_opened=[{"time": c.time, "entity": c.entity} for c in self.door_openings])
         return out
 

@@ -38,7 +38,9 @@ robot's centre is within the task's ``goal_tolerance`` of the goal at the end
 of a step, or at its first contact with anything but the floor (MuJoCo
 contacts, checked every physics step; movers count; door leaves do not: the
 robot may push a leaf open, and those contacts are reported apart,
-``door_contacts``); it is truncated at the time limit: ``time_limit_factor`` x
+``door_contacts``, one per push; by default a door whose leaf swings towards
+the robot opens by itself as it comes near: the ``doors`` setting,
+:mod:`worldgen.envs.doors`); it is truncated at the time limit: ``time_limit_factor`` x
 the optimal time ``L / v_max`` plus a half turn ``pi / w_max`` (default factor
 2), or the task's own ``time_limit`` (world.json) when ``time_limit_factor`` is None.
 
@@ -46,9 +48,9 @@ Info: at reset ``world_id``, ``task``, ``reference_path_length`` (the optimal
 path length, world.json ``tasks[].path.length``), ``time_limit`` (the one in force),
 ``geodesic_distance`` (the field's value at the spawn, when it is built), and
 ``world_seed`` (generated worlds) or ``world_index`` (packs); every step
-``time``; at an episode's end also the figures of
+``time`` and ``door_contact`` (the robot touched a door leaf during the step); at an episode's end also the figures of
 :meth:`worldgen.envs.episode.Episode.figures`, under the oracles' names:
-``success``, ``spl``, ``path_length``, ``collisions``, ``door_contacts``, ``min_clearance``,
+``success``, ``spl``, ``path_length``, ``collisions``, ``door_contacts``, ``doors_opened``, ``min_clearance``,
 ``duration``, ``time_to_goal``, ``reached_goal``, ...
 
 Seeding: ``reset(seed=s)`` reseeds two independent streams derived from s (one
@@ -68,6 +70,7 @@ import numpy as np
 
 from worldgen.envs.config import resolve
 from worldgen.envs.deps import require_gymnasium
+from worldgen.envs.doors import Openers, add_openers
 from worldgen.envs.episode import Episode
 from worldgen.envs.geodesic import GeodesicField
 from worldgen.envs.lidar import Lidar
@@ -77,6 +80,7 @@ from worldgen.envs.robot import add_robot, compile_world
 from worldgen.envs.source import PackSource, make_source
 from worldgen.errors import ParameterError
 from worldgen.seeding import check_seed, draw_seed, env_rngs
+from worldgen.testing.figures import Contact
 
 gym = require_gymnasium()
 
@@ -160,6 +164,7 @@ class NavigationEnv(gym.Env):
         spawn = world.task["spawn"]
         movers = MoverScript(world.movers)
         add_robot(world.mjcf, world.robot.radius, world.robot.height, cfg.linear_velocity, cfg.angular_velocity)
+        add_openers(world.mjcf, world.doors, cfg.doors)
         sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), sorted(world.floor),
                             [m["name"] for m in world.movers])
         world.mjcf = None  # the tree is compiled: let it go
@@ -176,6 +181,7 @@ class NavigationEnv(gym.Env):
             movers.place(sim.data, sim.mocap, movers.positions([0.0])[0])
         import mujoco
         mujoco.mj_forward(sim.model, sim.data)
+        self._openers = Openers(sim.model, sim.data, world.doors, cfg.doors, cfg.door_trigger, cfg.door_speed)
         self.world = world
         self._tolerance = float(world.task["goal_tolerance"])
         if cfg.time_limit_factor is None:
@@ -226,6 +232,9 @@ class NavigationEnv(gym.Env):
         data = sim.data
         data.ctrl[sim.ctrl] = (v, 0.0, w)
         previous = self._goal_polar(*sim.pose())[0]
+        ep.new_step()
+        if len(self._openers):
+            ep.door_openings.extend(Contact(float(data.time), name) for name in self._openers.update(*sim.pose()[:2]))
         collided = self._simulate()
         x, y, yaw = sim.pose()
         ep.record(float(data.time), x, y, yaw)
@@ -241,7 +250,7 @@ class NavigationEnv(gym.Env):
         r = reward(outcome, self.config)
         terminated = bool(reached or (collided and self.config.terminate_on_collision))
         truncated = bool(not terminated and data.time >= self._time_limit - 1e-9)
-        info = {"time": float(data.time)}
+        info = {"time": float(data.time), "door_contact": ep.door_touched}
         if terminated or truncated:
             ep.done = True
             info.update(ep.figures())

@@ -37,7 +37,8 @@ class EpisodeWorld:
     ``floor`` the names of the floor geoms (contacts with them are no collision);
     ``door_leaves`` the names of the door leaves (world.json ``doors[].name``, each
     a hinged body the robot may push open: touching one is a door contact, not a collision);
-    ``bounds`` ((x0, y0), (x1, y1)) where the robot may be; :meth:`scene` the world's scene (for the geodesic field).
+    ``bounds`` ((x0, y0), (x1, y1)) where the robot may be; :meth:`scene` the world's scene (for the geodesic field);
+    ``doors`` world.json's ``doors[]`` (hinge joint, limits, doorway: what an automatic door opens by).
     """
 
     world_id: str
@@ -54,6 +55,7 @@ class EpisodeWorld:
     door_leaves: frozenset = frozenset()
     _scene: Optional[Callable[[], Any]] = field(default=None, repr=False)
     bounds: Optional[tuple] = None
+    doors: tuple = ()
 
     @property
     def reference_path_length(self) -> float:
@@ -100,6 +102,7 @@ def episode_world(world) -> EpisodeWorld:
     """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
     from worldgen.export.metadata import mover_entry
     from worldgen.export.xml import parse_bytes
+    from worldgen.scene.doors import door_records
     from worldgen.testing.ground import Ground
 
     task = _task_of_world(world)
@@ -114,7 +117,8 @@ def episode_world(world) -> EpisodeWorld:
         task=task, movers=movers, floor=frozenset(n.name for n in world.scene.nodes if n.role == "floor"),
         lidar_height=float(world.params.get("lidar_height", 0.3)), params=dict(world.params),
         _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}),
-        door_leaves=leaves, _scene=lambda: world.scene, bounds=tuple(map(tuple, world.scene.bounds)))
+        door_leaves=leaves, _scene=lambda: world.scene, bounds=tuple(map(tuple, world.scene.bounds)),
+        doors=tuple(door_records(world.scene)) if leaves else ())
 
 
 class GeneratorSource:
@@ -216,7 +220,7 @@ class PackSource:
             lidar_height=float(params.get("lidar_height", 0.3)), params=params,
             _ground=lambda: ground_of(pw), _metadata=lambda: meta, _scene=lambda: self._regenerated(pw, meta).scene,
             bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
-            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []))
+            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
 
     @staticmethod
     def _regenerated(pw, meta):

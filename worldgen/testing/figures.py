@@ -30,7 +30,7 @@ from worldgen.testing.social import disc_gaps, discs, social_figures, timed_samp
 __all__ = [
     "Contact", "Run",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "door_contacts", "min_separation", "run", "BARN_K", "BARN_REFERENCE_SPEED", "barn_score",
+    "collisions", "door_contacts", "DOOR_DEBOUNCE", "min_separation", "run", "BARN_K", "BARN_REFERENCE_SPEED", "barn_score",
 ]
 
 
@@ -40,6 +40,12 @@ class Contact:
 
     time: float
     entity: str
+
+
+#: Seconds (of the run's time): a touch of a door leaf that begins within this of the last touch of the same
+#: leaf ending is the same door contact (one push, whose contact MuJoCo makes and breaks many times as the
+#: leaf gives way), not a new one. The environment counts door contacts by the same rule.
+DOOR_DEBOUNCE = 2.0
 
 
 # -- figures -------------------------------------------------------------------
@@ -129,7 +135,11 @@ def collisions(trajectory, world) -> list[Contact]:
 
 
 def door_contacts(trajectory, world) -> list[Contact]:
-    """The contacts of :func:`collisions`' kind with door leaves, each leaf where it starts (pushed, not hit)."""
+    """The contacts of :func:`collisions`' kind with door leaves, each leaf where it starts (pushed, not hit).
+
+    One per push: a touch of a leaf beginning within :data:`DOOR_DEBOUNCE` s of the last sample touching
+    that leaf continues the same door contact.
+    """
     leaves = leaves_of(load(world))
     return [c for c in _contacts(trajectory, world) if c.entity in leaves] if leaves else []
 
@@ -145,6 +155,12 @@ def _contacts(trajectory, world) -> list[Contact]:
     if len(names) > len(col):
         touching[:, len(col):] = disc_gaps(pts, ground) <= 0.0
     starts = touching & ~np.vstack([np.zeros((1, touching.shape[1]), dtype=bool), touching[:-1]])
+    leaves = leaves_of(ground)
+    for c in (c for c, name in enumerate(names) if name in leaves):
+        on = np.nonzero(touching[:, c])[0]
+        # A leaf touched again soon after is the same push (DOOR_DEBOUNCE): no new contact.
+        again = on[1:][(np.diff(on) > 1) & (np.diff(pts[on, 0]) <= DOOR_DEBOUNCE)]
+        starts[again, c] = False
     out = [Contact(float(pts[p, 0]), names[c]) for p, c in zip(*np.nonzero(starts))]
     return sorted(out, key=lambda k: (k.time, k.entity))
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from worldgen.testing.evaluate import evaluate
 from worldgen.testing.figures import (
+    DOOR_DEBOUNCE,
     Contact,
     Run,
     barn_score,
@@ -42,6 +43,6 @@ from worldgen.testing.social import PERSONAL_SPACE, min_person_distance, min_tim
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
-    "collisions", "door_contacts", "min_separation", "run", "evaluate", "barn_score",
+    "collisions", "door_contacts", "DOOR_DEBOUNCE", "min_separation", "run", "evaluate", "barn_score",
     "min_person_distance", "personal_space_time", "min_time_to_collision", "PERSONAL_SPACE",
 ]
