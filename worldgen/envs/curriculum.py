@@ -24,7 +24,7 @@ import numpy as np
 from worldgen.errors import ParameterError, quoted
 from worldgen.seeding import curriculum_rng, draw_seed
 
-__all__ = ["LevelCurriculum", "make_curriculum", "CURRICULA", "check_generator_source"]
+__all__ = ["LevelCurriculum", "make_curriculum", "CURRICULA"]
 
 #: The names ``curriculum=`` takes.
 CURRICULA = ("levels", "replay")
@@ -37,15 +37,6 @@ def _number(name: str, value: Any, lo: float, hi: float, integer: bool = False):
         kind = "an integer" if integer else "a number"
         raise ParameterError(f"parameter '{name}' must be {kind} in [{lo:g}, {hi:g}], got {quoted(value)}")
     return int(value) if integer else float(value)
-
-
-def check_generator_source(source, what: str) -> None:
-    """One-line ParameterError unless ``source`` makes worlds from a generator (a curriculum makes its own)."""
-    from worldgen.envs.source import GeneratorSource
-
-    if not isinstance(source, GeneratorSource):
-        raise ParameterError(f"parameter 'curriculum' ({what}) needs worlds from a generator or preset, "
-                             "not a pack (a pack's worlds are fixed)")
 
 
 class LevelCurriculum:
@@ -125,6 +116,7 @@ class LevelCurriculum:
     # -- in the environment ---------------------------------------------------------------------------------
     def check(self, source) -> None:
         """ParameterError unless the source can be asked for levels (:func:`worldgen.leveling.check_request`)."""
+        from worldgen.envs.replay import check_generator_source
         from worldgen.leveling import check_request
 
         check_generator_source(source, "levels")

@@ -217,7 +217,15 @@ class NavigationEnv(gym.Env):
             raise ParameterError("report_score needs an environment made with curriculum='replay'")
         self.curriculum.report_score(value)
 
-    level_score = property(None, report_score, doc="Set to report this episode's level's score (see report_score).")
+    @property
+    def level_score(self) -> float:
+        """This episode's level's score (``curriculum="replay"``; NaN before one); set it to report one."""
+        current = getattr(self.curriculum, "current", None)
+        return float(current.score) if current is not None else math.nan
+
+    @level_score.setter
+    def level_score(self, value: float) -> None:
+        self.report_score(value)
 
     def curriculum_stats(self) -> dict:
         """The curriculum's figures for logging (per-level success, or the replay buffer's); {} without one."""

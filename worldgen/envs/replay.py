@@ -17,11 +17,11 @@ each episode, from the environment's curriculum stream (:func:`worldgen.seeding.
 The score is the signal the learner reports for the level just played (``env.unwrapped.report_score(v)``,
 e.g. PLR's mean absolute GAE or a regret estimate; the last report stands), else its *learnability*
 ``p (1 - p)`` with ``p = (successes + 1) / (plays + 2)`` (the success rate with one success and one
-failure added, so a level played once is not scored 0). A finished level enters the buffer; when it is
-full, in place of the lowest-scored level (the first of equals) if it scores higher. Only proven worlds
-are ever made (generated or edited, then checked): every buffered level has a certificate and a
-reference path. The bookkeeping (:meth:`LevelReplay.probabilities`, :meth:`LevelReplay.admit`) needs no
-environment.
+failure added, so a level played once is not scored 0). A finished level enters the buffer at the next
+reset (after any score reported for it); when the buffer is full, in place of the lowest-scored level
+(the first of equals) if it scores higher. Only proven worlds are ever made (generated or edited, then
+checked): every buffered level has a certificate and a reference path. The bookkeeping
+(:meth:`LevelReplay.probabilities`, :meth:`LevelReplay.admit`) needs no environment.
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ from worldgen.editing import EDITS, edit_world, replay_edits
 from worldgen.errors import ParameterError, quoted
 from worldgen.seeding import curriculum_rng, draw_seed
 
-__all__ = ["LevelReplay", "LevelRecord", "learnability"]
+__all__ = ["LevelReplay", "LevelRecord", "learnability", "check_generator_source"]
 
 
 def learnability(successes: int, plays: int) -> float:
@@ -96,6 +96,15 @@ class LevelRecord:
         return replay_edits(world, self.edits) if self.edits else world
 
 
+def check_generator_source(source, what: str) -> None:
+    """One-line ParameterError unless ``source`` makes worlds from a generator (a curriculum makes its own)."""
+    from worldgen.envs.source import GeneratorSource
+
+    if not isinstance(source, GeneratorSource):
+        raise ParameterError(f"parameter 'curriculum' ({what}) needs worlds from a generator or preset, "
+                             "not a pack (a pack's worlds are fixed)")
+
+
 def _probability(name: str, value: Any, lo: float = 0.0, hi: float = 1.0, low_open: bool = False) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) \
             or not (lo < value if low_open else lo <= value) or not value <= hi:
@@ -135,6 +144,11 @@ class LevelReplay:
                 f"holding {len(self.buffer)} levels")
 
     # -- bookkeeping ----------------------------------------------------------------------------------------
+    @property
+    def current(self) -> Optional[LevelRecord]:
+        """The level of the episode under way or just finished (None before the first)."""
+        return self._current
+
     def reseed(self, entropy: int) -> None:
         """Take the curriculum stream of a reset's seed (the buffer stays)."""
         self._rng = curriculum_rng(entropy)
@@ -176,13 +190,13 @@ class LevelReplay:
         return False
 
     def finish(self, record: LevelRecord, success: bool) -> None:
-        """Count a finished episode on ``record``, score it (unless the learner reported) and admit it."""
+        """Count a finished episode on ``record`` and score it (unless the learner reported); it is admitted
+        at the next reset (:meth:`next_world`), so that a score reported after the episode's end counts."""
         record.plays += 1
         record.successes += bool(success)
         record.finished = True
         if not record.reported:
             record.score = learnability(record.successes, record.plays)
-        self.admit(record)
 
     def report_score(self, value: float) -> None:
         """The learner's score for the level of the episode under way or just finished (it replaces any
@@ -192,8 +206,6 @@ class LevelReplay:
         if self._current is None:
             raise ParameterError("report_score needs a level: call reset() first")
         self._current.score, self._current.reported = float(value), True
-        if self._current.finished:
-            self.admit(self._current)
 
     def stats(self) -> dict:
         """For logging: episodes, levels made by kind, the buffer's size, scores and success counts."""
@@ -203,8 +215,6 @@ class LevelReplay:
 
     # -- in the environment ---------------------------------------------------------------------------------
     def check(self, source) -> None:
-        from worldgen.envs.curriculum import check_generator_source
-
         check_generator_source(source, "replay")
 
     def choose(self, source, world_rng: np.random.Generator) -> LevelRecord:
@@ -224,6 +234,8 @@ class LevelReplay:
     def next_world(self, source, world_rng: np.random.Generator):
         from worldgen.envs.source import episode_world
 
+        if self._current is not None and self._current.finished:
+            self.admit(self._current)  # the level just played, with its final score
         record = self.choose(source, world_rng)
         self.kinds[record.kind] += 1
         record.last_played = self.clock
@@ -235,6 +247,8 @@ class LevelReplay:
             "level_score": record.score, "buffer_size": len(self.buffer)}
 
     def leave(self) -> None:
+        if self._current is not None and self._current.finished:
+            self.admit(self._current)
         self._current = None
 
     def episode_end(self, figures: dict) -> dict:
