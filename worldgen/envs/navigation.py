@@ -12,6 +12,9 @@ Worlds: ``generator`` and ``params`` (any registered generator), or ``preset``
 ``pack`` (a :class:`~worldgen.Pack` or its folder or archive), its worlds in
 order, again from the first after the last: a fixed benchmark set. Default:
 the ``drl_arena`` preset. Each episode drives the world's first task.
+``curriculum`` (``"levels"``, ``"replay"`` or an instance of
+:class:`~worldgen.envs.curriculum.LevelCurriculum` or :class:`~worldgen.envs.replay.LevelReplay`)
+picks each episode's world from how the learner did (docs/rl.md, Curricula).
 
 Action: ``Box([v_min, -w_max], [v_max, w_max])``, float32: forward speed v (m/s)
 and turn rate w (rad/s, counter-clockwise), held for one control period
