@@ -107,7 +107,9 @@ def test_bad_settings_are_one_line_errors(kwargs, message):
 @pytest.mark.parametrize("kwargs, message", [
     ({"generator": "cluttered", "curriculum": "ladder"}, "parameter 'curriculum' must be one of levels, replay"),
     ({"generator": "cluttered", "difficulty": "3/10", "curriculum": "levels"}, "leave out 'difficulty'"),
-    ({"generator": "door", "curriculum": "levels"}, "parameter 'difficulty' is offered by the generators"),
+    ({"generator": "door", "curriculum": "levels"},
+     "parameter 'curriculum' draws worlds at a level: parameter 'difficulty' is offered by the generators"),
+    ({"preset": "drl_arena", "curriculum": "levels"}, "draws worlds at a level: .* leave out 'n_obstacles'"),
 ])
 def test_a_bad_curriculum_fails_when_the_env_is_made(kwargs, message):
     with pytest.raises(ParameterError, match=message):
@@ -132,9 +134,11 @@ def test_in_the_environment_info_reports_the_level_and_the_follower_climbs():
         assert first["world_id"] == world.world_id  # the world is the generator's at that level
         assert world.metadata["metrics"]["difficulty_level"] == first["curriculum_level"]
         assert last["success"] and last["curriculum_level"] == first["curriculum_level"]
-        levels.append((first["curriculum_level"], last["curriculum_next_level"], last["curriculum_level_changed"]))
-    # Two successes per level: promoted after the 2nd and the 4th episode.
-    assert levels == [(1, 1, False), (1, 2, True), (2, 2, False), (2, 3, True), (3, 3, False)]
+        levels.append((first["curriculum_level"], first["curriculum_level_changed"], last["curriculum_next_level"],
+                       last["curriculum_level_changed"]))
+    # Two successes per level: promoted after the 2nd and the 4th episode; the next reset says so once.
+    assert levels == [(1, False, 1, False), (1, False, 2, True), (2, True, 2, False), (2, False, 3, True),
+                      (3, True, 3, False)]
     assert env.curriculum_stats()["episodes"][:3] == [2, 2, 1]
 
 

@@ -123,7 +123,10 @@ class LevelCurriculum:
         if source.difficulty is not None:
             raise ParameterError("parameter 'curriculum' sets each episode's level itself; leave out 'difficulty' "
                                  f"(got difficulty={quoted(source.difficulty)})")
-        check_request(source.generator, self.start, source.params)
+        try:
+            check_request(source.generator, self.start, source.params)
+        except ParameterError as e:  # said for curriculum='levels', which sets the difficulty of every episode
+            raise ParameterError(f"parameter 'curriculum' draws worlds at a level: {e}") from None
 
     def next_world(self, source, world_rng: np.random.Generator):
         """The next episode's world at the current level: (EpisodeWorld, what reset's ``info`` adds)."""
@@ -132,7 +135,8 @@ class LevelCurriculum:
         seed = draw_seed(world_rng)
         world = episode_world(source.generated(seed, difficulty=self.level))
         self._playing = self.level
-        return world, {"world_seed": seed, "curriculum_level": self.level, "curriculum_level_changed": self._changed}
+        changed, self._changed = self._changed, False  # said once, at the first reset at the new level
+        return world, {"world_seed": seed, "curriculum_level": self.level, "curriculum_level_changed": changed}
 
     def leave(self) -> None:
         """The environment picked this episode's world itself (reset's ``world_seed``): it does not count."""
