@@ -181,3 +181,10 @@ def test_vector_environments_keep_one_curriculum_each(vector):
         assert [sum(s["episodes"]) for s in stats] == [sum(e[0] == i for e in ended) for i in (0, 1)]
         runs.append(ended)
     assert runs[0] == runs[1]
+
+
+@pytest.mark.parametrize("curriculum", ["levels", "replay"])
+def test_an_environment_with_a_curriculum_passes_gymnasium_s_checker(curriculum):
+    from gymnasium.utils.env_checker import check_env
+
+    check_env(gymnasium.make(ENV_ID, curriculum=curriculum, generator="cluttered", lidar_beams=16).unwrapped, skip_render_check=True)
