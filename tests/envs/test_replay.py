@@ -178,3 +178,29 @@ def test_a_world_from_the_sampler_is_the_generator_s_world_when_new():
     _, info = env.reset(seed=3)
     assert info["level_kind"] == "new"
     assert info["world_id"] == worldgen.generate("cluttered", info["world_seed"]).world_id
+
+
+def test_sync_and_async_vector_environments_play_the_same_levels():
+    """The async workers are other processes: the same seeds and scores give the same levels there."""
+    def one():
+        return gymnasium.make(ENV_ID, curriculum=LevelReplay(replay_prob=0.4, edit_prob=0.6), **SETTINGS)
+
+    def levels(cls):
+        envs = cls([one, one])
+        try:
+            _, info = envs.reset(seed=[7, 8])
+            seen = [(i, str(info["world_id"][i]), str(info["level_kind"][i])) for i in (0, 1)]
+            for step in range(200):
+                _, _, terminated, truncated, info = envs.step(np.zeros((2, 2), dtype=np.float32))
+                if (terminated | truncated).any():
+                    envs.set_attr("level_score", [float(step % 5), float(step % 3)])
+                if "_world_id" in info:
+                    seen += [(int(i), str(info["world_id"][i]), str(info["level_kind"][i]))
+                             for i in np.flatnonzero(info["_world_id"])]
+        finally:
+            envs.close()
+        return seen
+
+    sync, asynchronous = levels(gymnasium.vector.SyncVectorEnv), levels(gymnasium.vector.AsyncVectorEnv)
+    assert len(sync) > 6 and sync == asynchronous
+    assert {kind for _, _, kind in sync} == {"new", "replay", "edit"}, sync
