@@ -33,6 +33,8 @@ def test_a_thousand_edits_each_accepted_one_proven_and_rechecked_independently()
         assert [c.name for c in report.checks] == list(REQUIRED_CHECKS) and all(c.ok for c in report.checks)
         assert all(p is not None and p.length > 0 for p in report.paths)
         recheck(edited)  # shares no code with the checker: the footprint's distance along the whole path
+        for task in edited.tasks:
+            assert math.hypot(task.goal.x - task.spawn.x, task.goal.y - task.spawn.y) >= base.params["min_spawn_goal_distance"]
         for node in edited.scene.nodes:  # every obstacle still on the floor
             if node.role == "obstacle":
                 (x0, y0), (x1, y1) = edited.scene.bounds

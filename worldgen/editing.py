@@ -7,7 +7,8 @@ An edit changes one thing of a world's scene or tasks:
 ``add``        a new box or cylinder, sized from the generator's own ranges where it has them
                (``box_size``, ``cylinder_radius``, ``obstacle_height``), anywhere on the floor;
 ``remove``     an obstacle goes;
-``move_goal``  a task's goal slides by up to :data:`STEP` m (its tolerance and yaw kept).
+``move_goal``  a task's goal slides by up to :data:`STEP` m (its tolerance and yaw kept; never nearer the
+               spawn than the generator's ``min_spawn_goal_distance``).
 
 Only the root nodes whose role is ``obstacle`` and whose shape is a box or a cylinder are edited (walls,
 doors, frames and floors never); an edited obstacle stays inside the scene's bounds. Worlds with movers
@@ -172,8 +173,11 @@ def _propose(world: World, op: str, rng: np.random.Generator) -> Optional[dict]:
     if op == "move_goal":
         k = int(rng.integers(len(world.tasks)))
         dx, dy = _slide(rng)
-        goal = world.tasks[k].goal
-        return {"op": op, "task": k, "x": round_float(goal.x + dx), "y": round_float(goal.y + dy)}
+        task = world.tasks[k]
+        x, y = round_float(task.goal.x + dx), round_float(task.goal.y + dy)
+        if math.hypot(x - task.spawn.x, y - task.spawn.y) < float(world.params.get("min_spawn_goal_distance") or 0.0):
+            return None  # the generator's own floor on the task's length holds for edits too
+        return {"op": op, "task": k, "x": x, "y": y}
     if op == "add":
         (x0, y0), (x1, y1) = scene.bounds
         ranges = {k: tuple(world.params.get(k) or v) for k, v in _DEFAULT_RANGES.items()}
