@@ -12,6 +12,8 @@ its people                      ``(k, PEOPLE_STREAM)``        ``generators.peopl
 an environment's worlds         ``(WORLD_STREAM,)``           ``envs.navigation`` (reset's seed)
 an environment's sensor noise   ``(NOISE_STREAM,)``           ``envs.navigation`` (reset's seed)
 draw ``k`` towards a level      ``(LEVEL_STREAM, k)``         ``leveling`` (a world asked for at a level)
+an environment's curriculum     ``(CURRICULUM_STREAM,)``      ``envs.curriculum``, ``envs.replay`` (reset's seed)
+an edit of a level              ``(EDIT_STREAM,)``            ``editing`` (the edit's own seed)
 a recipe's sampled parameter    ``[seed, entry, tag(name)]``  ``pack.recipe`` (entropy, no key)
 ==============================  ============================  =====================================
 
@@ -32,7 +34,8 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 
-__all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "level_seed",
+__all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "CURRICULUM_STREAM",
+           "EDIT_STREAM", "level_seed", "curriculum_rng", "edit_rng",
            "check_seed", "attempt_rng", "mover_rng", "people_rng", "env_rngs", "draw_seed", "recipe_rng"]
 
 #: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
@@ -46,6 +49,11 @@ PEOPLE_STREAM = 0x706570
 WORLD_STREAM, NOISE_STREAM = 0, 1
 #: Key of the seeds of the draws towards a difficulty level ("lvl").
 LEVEL_STREAM = 0x6C766C
+#: Key of an environment's curriculum stream (levels it jumps to, levels it replays or edits), beside the
+#: world and noise streams of a reset's seed: a curriculum never moves a plain environment's worlds.
+CURRICULUM_STREAM = 2
+#: Key of an edit's stream ("edt"), beside the edit's own seed (worldgen.editing).
+EDIT_STREAM = 0x656474
 
 
 def check_seed(seed: Any, what: str = "parameter 'seed'") -> int:
@@ -78,6 +86,16 @@ def people_rng(seed: int, attempt: int) -> np.random.Generator:
 def env_rngs(entropy: int) -> tuple[np.random.Generator, np.random.Generator]:
     """An environment's (world seeds, sensor noise) streams for a reset's seed."""
     return _stream(entropy, WORLD_STREAM), _stream(entropy, NOISE_STREAM)
+
+
+def curriculum_rng(entropy: int) -> np.random.Generator:
+    """An environment's curriculum stream for a reset's seed (independent of its worlds and noise)."""
+    return _stream(entropy, CURRICULUM_STREAM)
+
+
+def edit_rng(seed: int) -> np.random.Generator:
+    """The stream of one edit of a level, from the edit's seed (worldgen.editing)."""
+    return _stream(seed, EDIT_STREAM)
 
 
 def level_seed(seed: int, draw: int) -> int:

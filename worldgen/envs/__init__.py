@@ -13,7 +13,8 @@ path. Modules, one concern each: :mod:`~worldgen.envs.config` (settings),
 :mod:`~worldgen.envs.source` (worlds), :mod:`~worldgen.envs.robot` (the robot in
 the MJCF), :mod:`~worldgen.envs.lidar`, :mod:`~worldgen.envs.movers`,
 :mod:`~worldgen.envs.reward`, :mod:`~worldgen.envs.episode` (the run and its
-figures), :mod:`~worldgen.envs.policies` and :mod:`~worldgen.envs.probes` (scripted baselines and the
+figures), :mod:`~worldgen.envs.curriculum` and :mod:`~worldgen.envs.replay` (curricula),
+:mod:`~worldgen.envs.policies` and :mod:`~worldgen.envs.probes` (scripted baselines and the
 difficulty probes), :mod:`~worldgen.envs.render`, :mod:`~worldgen.envs.navigation` (the
 environment), :mod:`~worldgen.envs.registration`.
 

@@ -12,6 +12,9 @@ Worlds: ``generator`` and ``params`` (any registered generator), or ``preset``
 ``pack`` (a :class:`~worldgen.Pack` or its folder or archive), its worlds in
 order, again from the first after the last: a fixed benchmark set. Default:
 the ``drl_arena`` preset. Each episode drives the world's first task.
+``curriculum`` (``"levels"``, ``"replay"`` or an instance of
+:class:`~worldgen.envs.curriculum.LevelCurriculum` or :class:`~worldgen.envs.replay.LevelReplay`)
+picks each episode's world from how the learner did (docs/rl.md, Curricula).
 
 Action: ``Box([v_min, -w_max], [v_max, w_max])``, float32: forward speed v (m/s)
 and turn rate w (rad/s, counter-clockwise), held for one control period
@@ -69,6 +72,7 @@ from typing import Any, Optional
 import numpy as np
 
 from worldgen.envs.config import resolve
+from worldgen.envs.curriculum import make_curriculum
 from worldgen.envs.deps import require_gymnasium
 from worldgen.envs.doors import Openers, add_openers
 from worldgen.envs.episode import Episode
@@ -93,12 +97,15 @@ class NavigationEnv(gym.Env):
     metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
 
     def __init__(self, generator: Optional[str] = None, params: Optional[dict] = None, preset: Optional[str] = None,
-                 pack=None, render_mode: Optional[str] = None, difficulty: Optional[str] = None, **settings: Any):
+                 pack=None, render_mode: Optional[str] = None, difficulty: Optional[str] = None, curriculum: Any = None,
+                 **settings: Any):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ParameterError(f"parameter 'render_mode' must be one of None, "
                                  f"{', '.join(self.metadata['render_modes'])}, got {render_mode!r}")
         self.config = cfg = resolve(settings)
         self.source = make_source(generator, params, preset, pack, difficulty)  # difficulty: "7/10" (worldgen.leveling)
+        #: This environment's own curriculum (worldgen.envs.curriculum, docs/rl.md#curricula), or None.
+        self.curriculum = make_curriculum(curriculum, self.source)
         self.render_mode = render_mode
         self.metadata = dict(self.metadata, render_fps=1.0 / cfg.control_period)
         self.lidar = Lidar(cfg.lidar_beams, cfg.lidar_fov, cfg.lidar_angle_min, cfg.lidar_range_min,
@@ -134,6 +141,8 @@ class NavigationEnv(gym.Env):
     def _reseed(self, seed: Optional[int]) -> None:
         entropy = seed if seed is not None else draw_seed(self.np_random)
         self._world_rng, self._noise_rng = env_rngs(entropy)
+        if self.curriculum is not None:
+            self.curriculum.reseed(entropy)
 
     def _next_world(self, options: dict):
         if isinstance(self.source, PackSource):
@@ -144,6 +153,10 @@ class NavigationEnv(gym.Env):
             self._next_index = (int(index) + 1) % len(self.source)
             return self.source.world(int(index)), {"world_index": int(index)}
         seed = options.get("world_seed")
+        if self.curriculum is not None:
+            if seed is None:
+                return self.curriculum.next_world(self.source, self._world_rng)
+            self.curriculum.leave()  # a world the caller chose: not the curriculum's episode
         seed = draw_seed(self._world_rng) if seed is None else check_seed(seed, "option 'world_seed'")
         return self.source.world(seed), {"world_seed": seed}
 
@@ -206,6 +219,27 @@ class NavigationEnv(gym.Env):
             info["geodesic_distance"] = self._geodesic_now
         return obs, info
 
+    def report_score(self, value: float) -> None:
+        """The learner's score for this episode's level (``curriculum="replay"``: e.g. its mean absolute
+        advantage); in a vector env ``envs.call("report_score", v)`` or ``envs.set_attr("level_score", [...])``."""
+        if self.curriculum is None:
+            raise ParameterError("report_score needs an environment made with curriculum='replay'")
+        self.curriculum.report_score(value)
+
+    @property
+    def level_score(self) -> float:
+        """This episode's level's score (``curriculum="replay"``; NaN before one); set it to report one."""
+        current = getattr(self.curriculum, "current", None)
+        return float(current.score) if current is not None else math.nan
+
+    @level_score.setter
+    def level_score(self, value: float) -> None:
+        self.report_score(value)
+
+    def curriculum_stats(self) -> dict:
+        """The curriculum's figures for logging (per-level success, or the replay buffer's); {} without one."""
+        return self.curriculum.stats() if self.curriculum is not None else {}
+
     @property
     def task(self) -> dict:
         """The current episode's task, as world.json ``tasks[]`` has it (spawn, goal, path, time_limit, ...)."""
@@ -254,6 +288,8 @@ class NavigationEnv(gym.Env):
         if terminated or truncated:
             ep.done = True
             info.update(ep.figures())
+            if self.curriculum is not None:
+                info.update(self.curriculum.episode_end(info))
         return obs, r, terminated, truncated, info
 
     def _simulate(self) -> bool:

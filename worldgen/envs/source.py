@@ -165,11 +165,17 @@ class GeneratorSource:
         return math.hypot(x1 - x0, y1 - y0), False
 
     def world(self, seed: int) -> EpisodeWorld:
+        return episode_world(self.generated(seed))
+
+    def generated(self, seed: int, difficulty: Any = None):
+        """The :class:`~worldgen.World` of ``seed`` (at ``difficulty`` when given, else the source's own; the
+        curricula of :mod:`worldgen.envs.curriculum` and :mod:`worldgen.envs.replay` keep and change it)."""
         from worldgen.api import generate
 
-        world = generate(self.generator, seed, difficulty=self.difficulty, **self.params)
+        world = generate(self.generator, seed, difficulty=self.difficulty if difficulty is None else difficulty,
+                         **self.params)
         world.preset = self.preset
-        return episode_world(world)
+        return world
 
 
 class PackSource:
