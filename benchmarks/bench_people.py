@@ -6,7 +6,8 @@ and certified (docs/people.md).
 For N = 10, 20 and 50 people and --worlds seeds (default 15): the whole of worldgen.generate (every draw
 it took, each drawing obstacles, walking the people and certifying the task), then, on the world it
 returned, its stages timed again on their own: the static world and its feasibility check without
-people, the people drawn and walked (generators.people + feasibility.crowd), the certificate
+people, the people drawn and walked (generators.people + feasibility.crowd) and, within that walk, the
+people's exact route queries (feasibility.planner, timed call by call), the certificate
 (feasibility.timed). Medians over the worlds; the draws a world took and its arrival time beside them.
 Pinned to one core (--all-cores to not pin). Target (issue 20): the whole, 20 people, median <= 150 ms.
 
@@ -35,6 +36,30 @@ def _ms(fn) -> tuple[float, object]:
     return (time.perf_counter() - t) * 1e3, out
 
 
+class _Routing:
+    """Times every exact route query (``Planner.shortest``) made inside the ``with`` block."""
+
+    def __enter__(self):
+        from worldgen.feasibility.planner import Planner
+        self.ms, self.calls, self._orig = 0.0, 0, Planner.shortest
+        outer = self
+
+        def timed(planner, start, goal):
+            t = time.perf_counter()
+            try:
+                return outer._orig(planner, start, goal)
+            finally:
+                outer.ms += (time.perf_counter() - t) * 1e3
+                outer.calls += 1
+        Planner.shortest = timed  # type: ignore[method-assign]
+        return self
+
+    def __exit__(self, *exc):
+        from worldgen.feasibility.planner import Planner
+        Planner.shortest = self._orig  # type: ignore[method-assign]
+        return False
+
+
 def measure(n_people: int, seeds: range) -> dict:
     import worldgen
     from worldgen.feasibility import check
@@ -48,14 +73,16 @@ def measure(n_people: int, seeds: range) -> dict:
         attempt = world.attempts - 1
         static = world.scene.with_movers(())
         base, _ = _ms(lambda: worldgen.generate("cluttered", seed, **WORLD))
-        walk, _ = _ms(lambda: walk_people(static, world.tasks, world.robot, world.params, people_rng(seed, attempt)))
+        with _Routing() as routing:
+            walk, _ = _ms(lambda: walk_people(static, world.tasks, world.robot, world.params, people_rng(seed, attempt)))
         report = check(static, world.tasks, world.robot)
         cert, _ = _ms(lambda: certify(report, world.scene, world.tasks, world.robot, world.params["robot_speed"]))
         rows.append({"seed": seed, "whole_ms": whole, "draws": world.attempts, "static_world_ms": base,
-                     "walk_ms": walk, "certify_ms": cert,
+                     "walk_ms": walk, "routing_ms": routing.ms, "queries": routing.calls, "certify_ms": cert,
                      "arrival_s": world.feasibility.check("timed_path").value})
     med = {key: statistics.median(r[key] for r in rows)
-           for key in ("whole_ms", "draws", "static_world_ms", "walk_ms", "certify_ms", "arrival_s")}
+           for key in ("whole_ms", "draws", "static_world_ms", "walk_ms", "routing_ms", "queries", "certify_ms",
+                       "arrival_s")}
     first_draw = [r["whole_ms"] for r in rows if r["draws"] == 1]
     med["whole_first_draw_ms"] = statistics.median(first_draw) if first_draw else None
     return {"n_people": n_people, "median": med, "worlds": rows}
@@ -71,15 +98,17 @@ def main() -> None:
     import worldgen
     worldgen.generate("cluttered", 0, n_people=2, size=[6.0, 6.0], n_obstacles=4, people_duration=5.0)  # warm up
     results = [measure(n, range(args.worlds)) for n in COUNTS]
-    head = "| people | whole | whole, first-draw worlds | draws | static world | walk | certify | arrival |"
+    head = ("| people | whole | whole, first-draw worlds | draws | static world | walk | of which routing (queries) "
+            "| certify | arrival |")
     print(f"20 x 20 m, 50 obstacles, 60 s of walking; medians over {args.worlds} seeds, ms (arrival s)")
     print(head)
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     for r in results:
         m = r["median"]
         first = "-" if m["whole_first_draw_ms"] is None else f"{m['whole_first_draw_ms']:.0f}"
         print(f"| {r['n_people']} | {m['whole_ms']:.0f} | {first} | {m['draws']:g} | {m['static_world_ms']:.1f} | "
-              f"{m['walk_ms']:.0f} | {m['certify_ms']:.1f} | {m['arrival_s']:.1f} |")
+              f"{m['walk_ms']:.0f} | {m['routing_ms']:.0f} ({m['queries']:g}) | {m['certify_ms']:.1f} | "
+              f"{m['arrival_s']:.1f} |")
     twenty = next(r for r in results if r["n_people"] == 20)["median"]["whole_ms"]
     print(f"target: 20 people, whole <= {TARGET_MS:g} ms median: {twenty:.0f} ms, "
           f"{'met' if twenty <= TARGET_MS else 'missed'}")

@@ -85,14 +85,15 @@ def dump_sdf(path) -> dict:
     "models": {name: {"static", "pose"}}, "links": {"m::l": {"pose", "mass", "inertia"}},
     "collisions"/"visuals": {"m::l::c": (kind, [numbers or uri...])},
     "friction": {"m::l::c": (mu, mu2)}, "materials": {"m::l::v": (ambient, diffuse)},
-    "joints": {"m::j": {"type", "parent", "child", "axis", "limits", "damping"}}}``.
+    "joints": {"m::j": {"type", "parent", "child", "axis", "limits", "damping"}},
+    "actors": {name: {"loop", "trajectories": {id: {"tension", "waypoints": [[t, x, y, z, roll, pitch, yaw]]}}}}}``.
     Link poses are in their model's frame, as libsdformat resolved them.
     """
     done = _run(path, "--dump")
     if done.returncode != 0:
         raise AssertionError(f"{path} fails the strict SDF check:\n{done.stderr}")
     out: dict = {"lights": [], "models": {}, "links": {}, "collisions": {}, "visuals": {},
-                 "friction": {}, "materials": {}, "joints": {}}
+                 "friction": {}, "materials": {}, "joints": {}, "actors": {}}
     for line in done.stdout.splitlines():
         kind, *rest = line.split()
         if kind == "world":
@@ -128,4 +129,10 @@ def dump_sdf(path) -> dict:
                 joint["limits"] = [float(v) for v in rest[j + 1:j + 3]]
                 joint["damping"] = float(rest[rest.index("damping") + 1])
             out["joints"][rest[0]] = joint
+        elif kind == "actor":
+            out["actors"][rest[0]] = {"loop": rest[2] == "1", "trajectories": {}}
+        elif kind == "trajectory":
+            out["actors"][rest[0]]["trajectories"][int(rest[1])] = {"tension": float(rest[3]), "waypoints": []}
+        elif kind == "waypoint":
+            out["actors"][rest[0]]["trajectories"][int(rest[1])]["waypoints"].append([float(v) for v in rest[2:9]])
     return out

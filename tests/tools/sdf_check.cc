@@ -260,6 +260,26 @@ void Dump(const sdf::Root &_root)
         std::cout << "\n";
       }
     }
+    // Actors: each script as libsdformat read it, for the trajectory tests.
+    for (uint64_t a = 0; a < world->ActorCount(); ++a)
+    {
+      const sdf::Actor *actor = world->ActorByIndex(a);
+      std::cout << "actor " << actor->Name() << " loop " << actor->ScriptLoop() << "\n";
+      for (uint64_t t = 0; t < actor->TrajectoryCount(); ++t)
+      {
+        const sdf::Trajectory *traj = actor->TrajectoryByIndex(t);
+        std::cout << "trajectory " << actor->Name() << " " << traj->Id()
+                  << " tension " << traj->Tension() << "\n";
+        std::cout.precision(12);
+        for (uint64_t k = 0; k < traj->WaypointCount(); ++k)
+        {
+          const sdf::Waypoint *wp = traj->WaypointByIndex(k);
+          std::cout << "waypoint " << actor->Name() << " " << traj->Id() << " "
+                    << wp->Time() << " " << PoseText(wp->Pose()) << "\n";
+        }
+        std::cout.precision(9);
+      }
+    }
   }
 }
 }  // namespace

@@ -98,60 +98,67 @@ class _Walls:
         (self.x0, self.y0), (self.x1, self.y1) = bounds
 
     def refresh(self, p: np.ndarray, reach: float) -> None:
-        """Take as candidates, per person, the discs and polygons whose boxes lie within ``reach`` of it."""
+        """Take as candidates, per person, the discs and polygons whose boxes lie within ``reach`` of it;
+        everything :meth:`push` needs that does not move (the candidates' geometry gathered, the groups'
+        offsets) is laid out here once, not at every step."""
         obs = self.obstacles
         nd = obs.n_discs
         near = obs.near(p, p, reach) if len(obs) else np.zeros((len(p), 0), dtype=bool)
-        self.d_person, self.d_disc = np.nonzero(near[:, :nd])
+        self.d_person, d_disc = np.nonzero(near[:, :nd])
+        self.d_xy, self.d_r = self.disc_xy[d_disc], self.disc_r[d_disc]
+        self.d_first, self.d_owner = _runs(self.d_person)
         person, poly = np.nonzero(near[:, nd:])
         counts = obs.edge_start[poly + 1] - obs.edge_start[poly]
         self.g_person, self.g_count = person, counts
         self.g_start = (np.cumsum(counts) - counts).astype(np.int64)
+        self.g_first, self.g_owner = _runs(person)
         self.e_person = np.repeat(person, counts)
-        self.e_edge = np.repeat(obs.edge_start[poly], counts) + (np.arange(counts.sum()) - np.repeat(self.g_start, counts))
+        e = np.repeat(obs.edge_start[poly], counts) + (np.arange(counts.sum()) - np.repeat(self.g_start, counts))
+        self.e_a, self.e_ab, self.e_ab2 = self.ea[e], self.ab[e], self.ab2[e]
 
     def push(self, p: np.ndarray, radius: float, u0: float, rr: float, cutoff: float) -> tuple[np.ndarray, np.ndarray]:
         """(acceleration (n, 2) ``(u0 / rr) exp(-d / rr)`` away from each candidate footprint and each floor
         edge, ``d`` the exact distance from the centre; clearance (n,): the exact gap from the disc's edge
         to the nearest, at most ``cutoff - radius`` (candidates hold everything closer than ``cutoff``))."""
         n = len(p)
-        acc = np.zeros((n, 2))
+        ax = np.zeros(n)
+        ay = np.zeros(n)
         room = np.full(n, cutoff - radius)
         k = u0 / rr
         if len(self.d_person):
             who = self.d_person
-            d = p[who] - self.disc_xy[self.d_disc]
+            d = p[who] - self.d_xy
             dist = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-12)
-            centre_gap = dist - self.disc_r[self.d_disc]
+            centre_gap = dist - self.d_r
             mag = k * np.exp(-centre_gap / rr) / dist
-            acc[:, 0] += np.bincount(who, mag * d[:, 0], minlength=n)
-            acc[:, 1] += np.bincount(who, mag * d[:, 1], minlength=n)
-            _lower(room, who, centre_gap - radius)
+            ax += np.bincount(who, mag * d[:, 0], minlength=n)
+            ay += np.bincount(who, mag * d[:, 1], minlength=n)
+            room[self.d_owner] = np.minimum(room[self.d_owner], np.minimum.reduceat(centre_gap - radius, self.d_first))
         if len(self.g_person):
-            e, who = self.e_edge, self.e_person
-            ap = p[who] - self.ea[e]
-            t = np.clip((ap[:, 0] * self.ab[e, 0] + ap[:, 1] * self.ab[e, 1]) / self.ab2[e], 0.0, 1.0)
-            q = self.ea[e] + t[:, None] * self.ab[e]
-            dist = np.hypot(p[who, 0] - q[:, 0], p[who, 1] - q[:, 1])
-            best = np.minimum.reduceat(dist, self.g_start)
+            who, ab, starts = self.e_person, self.e_ab, self.g_start
+            pw = p[who]
+            ap = pw - self.e_a
+            t = np.clip((ap[:, 0] * ab[:, 0] + ap[:, 1] * ab[:, 1]) / self.e_ab2, 0.0, 1.0)
+            q = self.e_a + t[:, None] * ab
+            dist = np.hypot(pw[:, 0] - q[:, 0], pw[:, 1] - q[:, 1])
+            best = np.minimum.reduceat(dist, starts)
             # The nearest point of each polygon: of the edges that reach the minimum (two at a corner,
             # which share it), their nearest points averaged.
             hit = (dist <= np.repeat(best, self.g_count) + 1e-12).astype(float)
-            share = np.add.reduceat(hit, self.g_start)
-            qx = np.add.reduceat(q[:, 0] * hit, self.g_start) / share
-            qy = np.add.reduceat(q[:, 1] * hit, self.g_start) / share
+            share = np.add.reduceat(hit, starts)
+            qx = np.add.reduceat(q[:, 0] * hit, starts) / share
+            qy = np.add.reduceat(q[:, 1] * hit, starts) / share
             g = self.g_person
-            safe = np.maximum(best, 1e-12)
-            mag = k * np.exp(-best / rr) / safe
-            acc[:, 0] += np.bincount(g, mag * (p[g, 0] - qx), minlength=n)
-            acc[:, 1] += np.bincount(g, mag * (p[g, 1] - qy), minlength=n)
-            _lower(room, g, best - radius)
+            mag = k * np.exp(-best / rr) / np.maximum(best, 1e-12)
+            ax += np.bincount(g, mag * (p[g, 0] - qx), minlength=n)
+            ay += np.bincount(g, mag * (p[g, 1] - qy), minlength=n)
+            room[self.g_owner] = np.minimum(room[self.g_owner], np.minimum.reduceat(best - radius, self.g_first))
         x, y = p[:, 0], p[:, 1]
         edges = np.stack([x - self.x0, self.x1 - x, y - self.y0, self.y1 - y], axis=1)
         mag = k * np.exp(-edges / rr)
-        acc[:, 0] += mag[:, 0] - mag[:, 1]
-        acc[:, 1] += mag[:, 2] - mag[:, 3]
-        return acc, np.minimum(room, edges.min(axis=1) - radius)
+        ax += mag[:, 0] - mag[:, 1]
+        ay += mag[:, 2] - mag[:, 3]
+        return np.column_stack([ax, ay]), np.minimum(room, edges.min(axis=1) - radius)
 
     def segments_keep(self, a: np.ndarray, b: np.ndarray, keep: float) -> np.ndarray:
         """(m,) bool: every point of segment a[i]b[i] is at least ``keep`` from every footprint and the floor's edge."""
@@ -161,11 +168,11 @@ class _Walls:
         return inside & (d >= keep)
 
 
-def _lower(room: np.ndarray, who: np.ndarray, values: np.ndarray) -> None:
-    """room[i] = min(room[i], values of i) for ``who`` sorted (np.nonzero's row order), in one pass."""
-    first = np.flatnonzero(np.r_[True, who[1:] != who[:-1]])
-    owner = who[first]
-    room[owner] = np.minimum(room[owner], np.minimum.reduceat(values, first))
+def _runs(who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(first index of each run, its value) of ``who`` sorted (np.nonzero's row order): per person, where
+    its candidates start, for one ``np.minimum.reduceat`` over all of them."""
+    first = np.flatnonzero(np.r_[True, who[1:] != who[:-1]]) if len(who) else np.zeros(0, dtype=np.int64)
+    return first, who[first]
 
 
 class _Router:

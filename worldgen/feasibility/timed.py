@@ -43,6 +43,8 @@ MARGIN = 0.01
 SPARE = 1e-3
 #: Time (s) the sweep goes on after the last person stops, beyond the time the path takes.
 AFTER = 5.0
+#: Steps whose free cells are worked out at once (6.4 s): the sweep rarely needs all of them.
+FREE_CHUNK = 128
 
 
 @dataclass(frozen=True, eq=False)
@@ -86,11 +88,19 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     steps = math.ceil((end + length / max_speed + AFTER) / DT)
     times = np.arange(steps + 1) * DT
     reach = np.asarray(radii, dtype=float) + inflation + MARGIN + (max_speed + person_speed(tracks)) * DT / 2
-    free = _free_cells(w, cum, s, tracks, reach, times)
+    # Which cells are free at which step, worked out a chunk of steps at a time as the sweep gets there:
+    # the sweep usually stops long before the last person stops (each row depends on its step alone).
+    free = np.zeros((steps + 1, n_cells + 1), dtype=bool)
+    known = 0
     sets = np.zeros((steps + 1, n_cells + 1), dtype=bool)
-    sets[0, 0] = free[0, 0]
     k_goal = None
-    for k in range(1, steps + 1):
+    for k in range(0, steps + 1):
+        if k == known:
+            known = min(k + FREE_CHUNK, steps + 1)
+            free[k:known] = _free_cells(w, cum, s, tracks, reach, times[k:known])
+        if k == 0:
+            sets[0, 0] = free[0, 0]
+            continue
         prev = sets[k - 1]
         if not prev.any():
             return None
