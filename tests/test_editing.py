@@ -94,3 +94,23 @@ def test_worlds_with_movers_are_not_edited_and_bad_operators_are_one_line_errors
 def test_the_same_seed_gives_the_same_edit():
     world = worldgen.generate("cluttered", 5)
     assert [edit_world(world, s).edits for s in range(5)] == [edit_world(world, s).edits for s in range(5)]
+
+
+def test_an_edited_level_written_to_disk_passes_worldgen_check_and_a_tampered_edit_fails(tmp_path):
+    """world.json records the edits; `worldgen check` regenerates the world, replays them (each re-proved)
+    and gets the recorded content_hash; an edit changed by hand is caught at `regenerate`."""
+    import json
+
+    from worldgen.verify import check_folder
+
+    edited = next(e for s in range(20) if (e := edit_world(worldgen.generate("cluttered", 4), seed=s)) is not None)
+    folder = edited.write(tmp_path, preview=False)
+    meta = json.loads((folder / "world.json").read_text())
+    assert meta["edits"] == [dict(e) for e in edited.edits]
+    outcome = check_folder(folder)
+    assert outcome.ok, outcome.line()
+    assert "edits" not in worldgen.generate("cluttered", 4).metadata  # plain worlds keep their bytes
+    meta["edits"][0] = {"op": "remove", "node": "no_such_obstacle"}
+    (folder / "world.json").write_text(json.dumps(meta))
+    outcome = check_folder(folder)
+    assert not outcome.ok and outcome.check == "regenerate" and "edits" in outcome.line(), outcome.line()

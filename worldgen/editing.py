@@ -119,7 +119,7 @@ def replay_edits(world: World, edits: Sequence[dict]) -> EditedWorld:
 def _proven(world: World, edit: dict) -> Optional[EditedWorld]:
     try:
         scene, tasks = apply_edit(world.scene, world.tasks, edit)
-    except (KeyError, ValueError):
+    except (KeyError, ValueError, IndexError, TypeError):  # a record that names nothing here, or a bad value
         return None
     report = feasibility.check(scene, tasks, world.robot)
     if not report.feasible or any(p is None for p in report.paths):
@@ -144,7 +144,9 @@ def apply_edit(scene: Scene, tasks: Sequence[Task], edit: dict) -> tuple[Scene, 
                      Material(*edit["material"]))
         _inside(node, scene.bounds)
         return scene.with_nodes(nodes + [node]), tasks
-    index = next(i for i, n in enumerate(nodes) if n.name == edit["node"] and _obstacle(n))
+    index = next((i for i, n in enumerate(nodes) if n.name == edit["node"] and _obstacle(n)), None)
+    if index is None:
+        raise ValueError(f"no obstacle named {edit['node']!r}")
     old = nodes[index]
     if op == "remove":
         return scene.with_nodes(nodes[:index] + nodes[index + 1:]), tasks

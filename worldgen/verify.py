@@ -9,7 +9,8 @@ ones would only repeat it in other words):
 ``files``        every listed file exists and its SHA-256 is the recorded one;
 ``schema``       world.json follows the shipped JSON Schema (jsonschema, a core
                  dependency for this reason);
-``regenerate``   generator + params + seed give the recorded ``content_hash``;
+``regenerate``   generator + params + seed (then ``edits``, each re-proved, for
+                 a curriculum's edited level) give the recorded ``content_hash``;
 ``feasibility``  the feasibility re-run agrees: the same verdict, the same
                  robot, spawns and goals, each path length within 1e-6 m, and
                  the recorded waypoints kept clear by FCL in the regenerated scene
@@ -162,6 +163,13 @@ def _regenerate(meta: dict):
                                   allow_infeasible=meta["feasibility"]["allow_infeasible"], **meta["params"])
     except WorldgenError as exc:
         raise _Fail("regenerate", f"{meta['generator']} seed {meta['seed']} with the recorded params: {exc}") from None
+    if meta.get("edits"):  # a curriculum's edited level: the generated world, then its edits, each re-proved
+        from worldgen.editing import replay_edits
+
+        try:
+            world = replay_edits(world, meta["edits"])
+        except WorldgenError as exc:
+            raise _Fail("regenerate", f"edits: {exc}") from None
     world.preset = meta.get("preset")  # not a parameter: where the world came from (world.json and folder name)
     request = meta.get("difficulty_request")  # not a parameter either: how a world at a level was drawn
     if request:

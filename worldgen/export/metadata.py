@@ -91,6 +91,8 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         meta["preset"] = world.preset
     if getattr(world, "difficulty_request", None):
         meta["difficulty_request"] = world.difficulty_request
+    if getattr(world, "edits", None):  # a curriculum's edited level: generator, params and seed, then these
+        meta["edits"] = list(world.edits)
     people = [m for m in scene.movers if m.person]
     if people:  # only then, so that every world without people keeps its bytes
         _add_people(meta, world, people)
