@@ -66,7 +66,7 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_barn.py
 	$(PY) benchmarks/bench_judge.py
 	nice -n 10 $(PY) benchmarks/bench_difficulty.py
-	$(PY) benchmarks/bench_leveling.py
+	nice -n 10 $(PY) benchmarks/bench_leveling.py
 	nice -n 10 $(PY) benchmarks/bench_ladder.py
 	$(PY) benchmarks/bench_people.py
 
