@@ -14,11 +14,15 @@ from worldgen.envs.ladder import ladder_figures, success_by_level
 #: The room of examples/recipes/barn_like.yaml.
 BARN_ROOM = {"size": [5, 5], "box_size": [0.2, 0.6], "cylinder_radius": [0.1, 0.25], "min_spawn_goal_distance": 3.0}
 SEEDS = 16
+#: The generators on the ladder and what is asked of them. Corridors are not here: the reactive probe succeeds
+#: in every corridor of levels 1-7 (docs/metrics.md). ``barn`` joins once it has a leveling.KNOBS row.
+LADDERS = {"cluttered": BARN_ROOM}
 
 
-@pytest.fixture(scope="module")
-def ladder():
-    return ladder_figures(success_by_level("cluttered", range(1, 11), range(SEEDS), BARN_ROOM))
+@pytest.fixture(scope="module", params=sorted(LADDERS))
+def ladder(request):
+    name = request.param
+    return ladder_figures(success_by_level(name, range(1, 11), range(SEEDS), LADDERS[name]))
 
 
 def _disjoint(a, b) -> bool:
