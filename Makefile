@@ -56,8 +56,9 @@ test: $(TEST_STAMP)
 ## with --jobs 2, the RL environment's steps/s and reset split, BARN's metrics against worldgen's
 ## (ratios over 40 worlds per generator) and barn_metrics' speed, `worldgen judge` on a 60 s bag and
 ## its peak memory over batches of 10 to 1,000 bags, the difficulty score against the probes' failures
-## over 1,600 worlds, worlds made to a level, a curriculum reset against a plain one, and worlds with
-## people (10, 20, 50) generated and certified; tables on stdout with each target met or missed,
+## over 1,600 worlds, worlds made to a level, the reactive probe's success per level, a curriculum
+## reset against a plain one, and worlds with people (10, 20, 50) generated and certified; tables on
+## stdout with each target met or missed,
 ## JSON in benchmarks/results/
 bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_pipeline.py
@@ -66,7 +67,8 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_barn.py
 	$(PY) benchmarks/bench_judge.py
 	nice -n 10 $(PY) benchmarks/bench_difficulty.py
-	$(PY) benchmarks/bench_leveling.py
+	nice -n 10 $(PY) benchmarks/bench_leveling.py
+	nice -n 10 $(PY) benchmarks/bench_ladder.py
 	$(PY) benchmarks/bench_curriculum.py
 	$(PY) benchmarks/bench_people.py
 

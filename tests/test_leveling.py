@@ -10,6 +10,8 @@ from support.cli import run, world_dirs
 import worldgen
 from worldgen.errors import ParameterError
 from worldgen.export import metadata
+from worldgen.generators.registry import all_specs
+from worldgen.leveling import KNOBS, NO_LEVELS, reachable
 from worldgen.seeding import level_seed
 
 
@@ -52,7 +54,12 @@ def test_the_same_request_gives_the_same_world_from_the_cli_in_another_process(t
     ("cluttered", {"difficulty": "11/10"}, "parameter 'difficulty' must be a level 'k/10' with k in 1..10 (or the integer k), got '11/10'"),
     ("cluttered", {"difficulty": "3/5"}, "parameter 'difficulty' must be a level 'k/10'"),
     ("cluttered", {"difficulty": "7/10", "n_obstacles": 5}, "parameter 'difficulty' sets n_obstacles itself; leave out 'n_obstacles'"),
-    ("corridor", {"difficulty": "2/10"}, "parameter 'difficulty' is offered by the generators cluttered, not by 'corridor'"),
+    ("minimal", {"difficulty": "2/10"}, "parameter 'difficulty' is offered by the generators cluttered, corridor, door, "
+     "not by 'minimal' (it has no random draws"),
+    ("door", {"difficulty": "1/10"}, "parameter 'difficulty' 1/10 is out of reach of 'door': it reaches levels 2-10"),
+    ("corridor", {"difficulty": "7/10", "shape": "U"}, "parameter 'difficulty' sets n_obstacles and shape itself; "
+     "leave out 'shape'"),
+    ("door", {"difficulty": "7/10", "state": "open"}, "parameter 'difficulty' sets n_doors and state itself"),
 ])
 def test_bad_requests_are_one_line(generator, params, message):
     with pytest.raises(ParameterError) as err:
@@ -64,3 +71,34 @@ def test_the_cli_refuses_a_bad_level_with_exit_2(tmp_path):
     done = run("generate", "cluttered", "--difficulty", "0/10", "--out", tmp_path)
     assert done.returncode == 2 and done.stderr.strip().splitlines()[-1].startswith("error: parameter 'difficulty'")
     assert world_dirs(tmp_path) == []
+
+
+@pytest.mark.parametrize("generator, level, knob, sets", [
+    ("corridor", 2, "n_obstacles", {"shape": "straight"}),
+    ("corridor", 7, "n_obstacles", {"shape": "L"}),
+    ("corridor", 10, "n_obstacles", {"shape": "U"}),
+    ("door", 3, "n_doors", {"state": "open"}),
+    ("door", 10, "n_doors", {"state": "closed"}),
+])
+def test_other_generators_land_in_the_level_with_what_the_level_sets(generator, level, knob, sets):
+    world = worldgen.generate(generator, seed=1, difficulty=level)
+    assert world.metadata["metrics"]["difficulty_level"] == level
+    assert world.difficulty_request["knob"] == knob and world.params[knob] == world.difficulty_request["draws"][-1][knob]
+    assert {k: world.params[k] for k in sets} == sets
+
+
+def test_every_generator_has_its_levels_or_says_why_not():
+    for spec in all_specs():
+        assert (spec.name in KNOBS) != (spec.name in NO_LEVELS), spec.name
+    assert reachable("cluttered") == tuple(range(1, 11)) and reachable("door") == tuple(range(2, 11))
+    assert reachable("minimal") == ()
+
+
+@pytest.mark.parametrize("generator, line", [
+    ("cluttered", "difficulty: levels 1-10 of 10 (--difficulty K/10 turns n_obstacles)"),
+    ("door", "difficulty: levels 2-10 of 10 (--difficulty K/10 turns n_doors; sets state by level)"),
+    ("minimal", "difficulty: no levels (it has no random draws"),
+])
+def test_list_says_which_levels_a_generator_reaches(generator, line):
+    done = run("list", generator)
+    assert done.returncode == 0 and line in " ".join(done.stdout.split())  # wrapped to the terminal

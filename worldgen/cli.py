@@ -113,7 +113,8 @@ def _parameter_text(spec, names: Sequence[str], width: int) -> list[str]:
     chosen = [p for p in spec.all_params if not names or p.name in names]
     column = max(len(p.name) for p in chosen) + 4
     indent = " " * column
-    lines = textwrap.wrap(f"{spec.name}: {spec.summary}", width)
+    from worldgen.leveling import describe_levels as levels  # the levels --difficulty can ask of it, or why none
+    lines = textwrap.wrap(f"{spec.name}: {spec.summary}", width) + ([] if names else textwrap.wrap(levels(spec.name), width))
     for title, group in ((f"Parameters of {spec.name} (--set NAME=VALUE):", [p for p in chosen if p.name not in common]),
                          ("Parameters every generator takes:", [p for p in chosen if p.name in common])):
         if not group:
@@ -170,8 +171,7 @@ def parameter_tables(specs) -> str:
 @click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
               help="Number of worlds, one per consecutive seed.")
 @click.option("--difficulty", "level", default=None, metavar="K/10",
-              help="A world at difficulty level K of 10 (world.json metrics.difficulty_level; the cluttered "
-                   "generator), e.g. --difficulty 7/10; world.json's difficulty_request says how it was reached.")
+              help="A world at difficulty level K/10, e.g. 7/10 ('worldgen list GENERATOR' names its levels).")
 @click.option("--allow-infeasible", is_flag=True,
               help="For negative tests: where no draw passes, write the last checked one; "
                    "its world.json says feasible false and which checks failed.")

@@ -5,14 +5,17 @@ of :mod:`worldgen.groundtruth.difficulty`). A request draws worlds until one
 lands in the level, each draw a whole world of its own:
 
 - draw ``k``'s seed is :func:`worldgen.seeding.level_seed` ``(seed, k)``;
-- its knob (the cluttered generator's ``n_obstacles``, scaled by the floor
-  area: :data:`START` obstacles per 100 m^2 for each level) starts at the
-  level's calibrated count and moves after every draw by :data:`STEP` times
-  the levels it missed by (up for too easy, down for too hard), within
-  ``[0, MAX_KNOB * area / 100]``;
+- its knob (:data:`KNOBS`: a parameter per generator, e.g. the cluttered
+  generator's ``n_obstacles`` scaled by the floor area, the corridor's
+  ``n_obstacles`` with its ``shape`` set by level, the door world's ``n_doors``
+  with its doors' ``state`` set by level) starts at the level's calibrated
+  value and moves after every draw by the knob's step times the levels it
+  missed by (up for too easy, down for too hard), within the knob's bounds;
 - the first draw whose level is the one asked for is the world; after
   :data:`MAX_DRAWS` misses the request is an InfeasibleError naming the levels
-  reached.
+  reached. A level a generator cannot reach (:func:`reachable`; ``worldgen list
+GENERATOR`` prints it) and a generator without a knob (:data:`NO_LEVELS`) are
+refused up front in one line.
 
 The world is an ordinary one: its ``seed`` and ``params`` (with the knob's
 value) regenerate it without any of this. world.json's ``difficulty_request``
@@ -24,29 +27,118 @@ any process.
 from __future__ import annotations
 
 import re
-from typing import Any, Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, Callable, Mapping, Optional
 
 from worldgen.errors import InfeasibleError, ParameterError, quoted
 from worldgen.floats import finite_or_none
 from worldgen.groundtruth import difficulty, truth
 from worldgen.seeding import level_seed
 
-__all__ = ["LEVELS", "MAX_DRAWS", "STEP", "START", "MAX_KNOB", "KNOBS", "parse_level", "check_request", "score",
-           "generate_at_level"]
+__all__ = ["LEVELS", "MAX_DRAWS", "STEP", "START", "MAX_KNOB", "Knob", "KNOBS", "NO_LEVELS", "reachable",
+           "describe_levels", "parse_level", "check_request", "score", "generate_at_level"]
 
 #: Levels of world.json's ``difficulty_level``.
 LEVELS = 10
 #: Draws a request may make before it gives up.
 MAX_DRAWS = 40
-#: Obstacles (per 100 m^2) the knob moves per level missed.
+#: Obstacles (per 100 m^2) the cluttered knob moves per level missed.
 STEP = 4.0
-#: Most obstacles per 100 m^2 a draw may ask for.
+#: Most obstacles per 100 m^2 a cluttered draw may ask for.
 MAX_KNOB = 120.0
-#: Obstacles per 100 m^2 of floor the first draw for each level asks for (levels 1..10). Calibrated on
-#: default 10 x 10 m cluttered rooms (seeds 0-7 at 0-80 obstacles): the median level reached.
-START = (0.0, 10.0, 20.0, 30.0, 35.0, 40.0, 45.0, 55.0, 65.0, 75.0)
-#: The generators that can be asked for a level, and the parameter each turns.
-KNOBS = {"cluttered": "n_obstacles"}
+#: Obstacles per 100 m^2 of floor the first cluttered draw for each level asks for (levels 1..10). Calibrated on
+#: default 10 x 10 m cluttered rooms: about the median obstacle count of the worlds that landed in each level
+#: (requests with seeds 100-111; the first calibration, 0, 10, 20, 30, 35, 40, 45, 55, 65, 75, left level 9
+#: at a median of 77 obstacles, above level 10's 75).
+START = (0.0, 8.0, 17.0, 23.0, 31.0, 36.0, 41.0, 50.0, 70.0, 78.0)
+
+
+@dataclass(frozen=True)
+class Knob:
+    """How one generator is turned towards a level: the parameter a request sets draw by draw.
+
+    ``start[level - 1]`` is the first draw's value for that level, None where the generator cannot reach the
+    level (a request for it is refused up front). After a draw that misses, the value moves by ``step`` per
+    level missed (up for a world too easy), within [``low``, ``high``]; a draw the generator cannot build
+    (InfeasibleError: too crowded) moves it ``step`` down. ``per_area``: ``start``, ``step`` and ``high`` are
+    per 100 m^2 of the request's ``size``. ``fixed`` sets further parameters by level: (first level, last
+    level, {parameter: value}). The request sets the knob, every ``fixed`` parameter and ``excludes``; the
+    caller leaves them out.
+    """
+
+    param: str
+    start: tuple[Optional[float], ...]
+    step: float
+    high: float
+    low: float = 0.0
+    per_area: bool = False
+    fixed: tuple[tuple[int, int, Mapping[str, Any]], ...] = ()
+    excludes: tuple[str, ...] = ()
+    integer: bool = True
+
+    def value(self, x: float):
+        """The parameter's value for the knob's position ``x``: a whole number for an integer knob."""
+        return int(round(x)) if self.integer else round(float(x), 6)
+
+    def sets(self, level: int) -> dict:
+        """The parameters besides the knob a request for ``level`` sets."""
+        return {k: v for lo, hi, values in self.fixed if lo <= level <= hi for k, v in values.items()}
+
+    def owned(self) -> tuple[str, ...]:
+        """Every parameter a request sets (the caller must leave them out)."""
+        names = [self.param, *(k for _, _, values in self.fixed for k in values), *self.excludes]
+        return tuple(dict.fromkeys(names))
+
+
+#: The generators that can be asked for a level, and how each is turned. Calibrations (``start``): the
+#: value whose worlds' median level is the level, measured with seeds the tests do not use (docs/metrics.md).
+#: Every registered generator is a row here or in :data:`NO_LEVELS` (tests/test_leveling.py holds it). A new
+#: generator adds a row: ``barn`` (the cellular automaton's fill fraction) is wired by the lead, as
+#: ``"barn": Knob("fill", <start per level, measured>, <step>, <high>, integer=False)``.
+KNOBS: dict[str, Knob] = {
+    "cluttered": Knob("n_obstacles", START, STEP, MAX_KNOB, per_area=True, excludes=("density",)),
+    # Straight corridors with more and more obstacles, then an L, then a U bend (two turns).
+    "corridor": Knob("n_obstacles", (0, 3, 4, 5, 6, 0, 1, 4, 0, 2), 1.0, 6.0,
+                     fixed=((1, 5, {"shape": "straight"}), (6, 8, {"shape": "L"}), (9, 10, {"shape": "U"}))),
+    # Open doors (rooms in a row) up to level 5, closed leaves to push from level 6.
+    "door": Knob("n_doors", (None, 1, 1, 1, 1, 1, 1, 1, 2, 4), 1.0, 5.0, low=1.0,
+                 fixed=((1, 5, {"state": "open"}), (6, 10, {"state": "closed"}))),
+}
+#: Generators without a level, and why (a request for one is refused in one line saying so).
+NO_LEVELS: dict[str, str] = {
+    "minimal": "it has no random draws: one target at an exact distance for a sensor test",
+}
+
+
+def reachable(name: str) -> tuple[int, ...]:
+    """The levels generator ``name`` can be asked for (none for a generator without a knob)."""
+    knob = KNOBS.get(name)
+    return () if knob is None else tuple(i + 1 for i, v in enumerate(knob.start) if v is not None)
+
+
+def describe_levels(name: str) -> str:
+    """One line on the levels generator ``name`` can be asked for (``worldgen list GENERATOR`` prints it)."""
+    levels = reachable(name)
+    if not levels:
+        why = NO_LEVELS.get(name, "no knob is calibrated for it")
+        return f"difficulty: no levels ({why})"
+    knob = KNOBS[name]
+    also = sorted({k for k in knob.owned() if k != knob.param})
+    sets = f"; sets {', '.join(also)} by level" if knob.fixed else ""
+    return f"difficulty: levels {_ranges(levels)} of {LEVELS} (--difficulty K/{LEVELS} turns {knob.param}{sets})"
+
+
+def _ranges(levels) -> str:
+    """"1-3, 5, 7-10" for (1, 2, 3, 5, 7, 8, 9, 10)."""
+    out, run = [], [levels[0]]
+    for v in levels[1:]:
+        if v == run[-1] + 1:
+            run.append(v)
+            continue
+        out.append(f"{run[0]}-{run[-1]}" if len(run) > 1 else str(run[0]))
+        run = [v]
+    out.append(f"{run[0]}-{run[-1]}" if len(run) > 1 else str(run[0]))
+    return ", ".join(out)
 
 _LEVEL = re.compile(r"^\s*(\d+)\s*/\s*(\d+)\s*$")
 
@@ -84,45 +176,56 @@ def score(world) -> dict:
 
 
 def check_request(name: str, level_value: Any, params: Mapping[str, Any]) -> tuple[int, str]:
-    """(level, knob) of a request for ``level_value`` from generator ``name`` with ``params``; one-line
-    ParameterError for a bad level, a generator without a knob, or a knob the caller also set."""
+    """(level, knob parameter) of a request for ``level_value`` from generator ``name`` with ``params``; one-line
+    ParameterError for a bad level, a generator without levels or without that level, or a parameter the
+    request sets that the caller also set."""
     level = parse_level(level_value)
     knob = KNOBS.get(name)
     if knob is None:
+        why = f" ({NO_LEVELS[name]})" if name in NO_LEVELS else ""
         raise ParameterError(f"parameter 'difficulty' is offered by the generators {', '.join(sorted(KNOBS))}, "
-                             f"not by {name!r}")
-    for fixed in (knob, "density"):
+                             f"not by {name!r}{why}")
+    levels = reachable(name)
+    if level not in levels:
+        raise ParameterError(f"parameter 'difficulty' {level}/{LEVELS} is out of reach of {name!r}: it reaches "
+                             f"levels {_ranges(levels)}")
+    for fixed in knob.owned():
         if params.get(fixed) is not None:
-            raise ParameterError(f"parameter 'difficulty' sets {knob} itself; leave out {fixed!r} "
+            owned = [knob.param, *sorted(k for k in knob.owned() if k != knob.param and k not in knob.excludes)]
+            raise ParameterError(f"parameter 'difficulty' sets {' and '.join(owned)} itself; leave out {fixed!r} "
                                  f"(got {fixed}={quoted(params[fixed])})")
-    return level, knob
+    return level, knob.param
 
 
 def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any]):
     """A world of generator ``name`` at the level ``level_value`` asks for (see the module); ``generate`` is
     :func:`worldgen.generate`."""
-    level, knob = check_request(name, level_value, params)
-    size = params.get("size", (10.0, 10.0))
-    area = float(size[0]) * float(size[1]) if isinstance(size, (list, tuple)) and len(size) == 2 else 100.0
-    scale = area / 100.0
-    count = START[level - 1] * scale
+    level, param = check_request(name, level_value, params)
+    knob = KNOBS[name]
+    scale = 1.0
+    if knob.per_area:
+        size = params.get("size", (10.0, 10.0))
+        scale = float(size[0]) * float(size[1]) / 100.0 if isinstance(size, (list, tuple)) and len(size) == 2 else 1.0
+    value = float(knob.start[level - 1] or 0.0) * scale
+    low, high, step = knob.low * scale, knob.high * scale, knob.step * scale
+    fixed = {**params, **knob.sets(level)}
     draws = []
     for k in range(MAX_DRAWS):
         draw_seed = level_seed(seed, k)
-        n = int(round(count))
+        n = knob.value(value)
         try:
-            world = generate(name, draw_seed, **{**params, knob: n})
-        except InfeasibleError:  # too crowded a room to place or drive: ease off
-            draws.append({"seed": draw_seed, knob: n, "difficulty": None, "level": None})
-            count = max(0.0, count - STEP * scale)
+            world = generate(name, draw_seed, **{**fixed, param: n})
+        except InfeasibleError:  # too crowded to place or drive: ease off
+            draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
+            value = max(low, value - step)
             continue
         got = score(world)
-        draws.append({"seed": draw_seed, knob: n, "difficulty": got["difficulty"], "level": got["difficulty_level"]})
+        draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"], "level": got["difficulty_level"]})
         if got["difficulty_level"] == level:
-            world.difficulty_request = {"level": f"{level}/{LEVELS}", "seed": seed, "knob": knob, "draws": draws}
+            world.difficulty_request = {"level": f"{level}/{LEVELS}", "seed": seed, "knob": param, "draws": draws}
             return world
         missed = level - (got["difficulty_level"] or level)
-        count = min(max(count + STEP * scale * missed, 0.0), MAX_KNOB * scale)
+        value = min(max(value + step * missed, low), high)
     reached = sorted({d["level"] for d in draws if d["level"] is not None})
     raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws "
                           f"(levels reached: {', '.join(map(str, reached)) or 'none'}); try another seed or a "

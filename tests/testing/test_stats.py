@@ -218,3 +218,14 @@ def test_without_scipy_the_message_says_what_to_install(monkeypatch):
         stats.clopper_pearson_lower(3, 4)
     assert str(exc.value) == "worldgen's statistics need scipy, which is not installed: pip install 'worldgen[stats]'"
     assert stats.clopper_pearson_lower(0, 4) == 0.0  # needs no quantile, so no scipy
+
+
+def test_wilson_interval_matches_its_closed_forms():
+    # With no successes the upper end is z^2 / (n + z^2); with all, the lower end is n / (n + z^2) (z = 1.959964).
+    zz = 1.959963984540054 ** 2
+    assert stats.wilson_interval(0, 20) == (0.0, pytest.approx(zz / (20 + zz), abs=1e-12))
+    assert stats.wilson_interval(20, 20) == (pytest.approx(20 / (20 + zz), abs=1e-12), 1.0)
+    lo, hi = stats.wilson_interval(7, 12)
+    lo2, hi2 = stats.wilson_interval(5, 12)
+    assert (lo, hi) == (pytest.approx(1 - hi2, abs=1e-12), pytest.approx(1 - lo2, abs=1e-12)) and lo < 7 / 12 < hi
+    assert stats.wilson_interval(0, 0) == (0.0, 1.0)

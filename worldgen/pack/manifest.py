@@ -29,10 +29,11 @@ def build_manifest(recipe, records: Iterable[Mapping[str, Any]], version: str) -
     worlds, rejected = [], []
     for rec in sorted(records, key=lambda r: r["job"]):
         if rec.get("world_id"):
-            worlds.append({k: rec[k] for k in ("world_id", "preset", "generator", "seed", "params", "metrics", "files", "job")
-                           if k in rec})
+            worlds.append({k: rec[k] for k in ("world_id", "preset", "generator", "seed", "level", "request_seed", "params",
+                                               "metrics", "files", "job") if k in rec})
         else:
-            rejected.append({k: rec[k] for k in ("job", "generator", "seed", "params", "reason")})
+            rejected.append({k: rec[k] for k in ("job", "generator", "seed", "level", "params", "reason")
+                             if k in rec})
     return {
         "schema": SCHEMA_ID,
         "name": recipe.name,

@@ -20,9 +20,17 @@ every mistake is one line ``RECIPE:LINE: key 'K': what is wrong``::
         physics:
           friction: [0.5, 1.0]     # physics variations: one more grid axis each
         seeds: {start: 0, count: 4}   # optional per entry
+      - generator: cluttered       # worlds asked for at difficulty levels (worldgen.leveling)
+        difficulty:
+          levels: [1, 5, 10]       # levels 1..10: a list, or {min: 1, max: 10}
+          worlds_per_level: 30     # request seeds 0..29 per level (or give the entry 'seeds' instead)
 
-Jobs are ordered entry by entry, then grid point (axes by sorted name), then seed;
-that order, not the order workers finish in, is the order of the manifest.
+Jobs are ordered entry by entry, then level (an entry with ``difficulty``),
+then grid point (axes by sorted name), then seed; that order, not the order
+workers finish in, is the order of the manifest. A level's world is
+``generate(generator, seed, difficulty=level, **params)``: its parameters must
+leave out what the level sets (the knob), and every level must be one the
+generator reaches (``worldgen list GENERATOR``), else the recipe is refused.
 """
 
 from __future__ import annotations
@@ -42,10 +50,12 @@ from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.floats import round_float
 from worldgen.seeding import MAX_SEED, recipe_rng
 
-__all__ = ["Job", "Recipe", "load_recipe", "parse_recipe", "TOP_KEYS", "ENTRY_KEYS", "PHYSICS_PARAMS"]
+__all__ = ["Job", "Recipe", "load_recipe", "parse_recipe", "TOP_KEYS", "ENTRY_KEYS", "DIFFICULTY_KEYS", "PHYSICS_PARAMS"]
 
 TOP_KEYS = ("name", "formats", "sdf_version", "preview", "ros", "seeds", "worlds")
-ENTRY_KEYS = ("generator", "preset", "params", "physics", "seeds")
+ENTRY_KEYS = ("generator", "preset", "params", "physics", "seeds", "difficulty")
+#: Keys of an entry's ``difficulty`` mapping.
+DIFFICULTY_KEYS = ("levels", "worlds_per_level")
 #: Parameters a recipe may vary under ``physics:`` (every generator has them).
 PHYSICS_PARAMS = ("friction", "step_size", "real_time_factor")
 #: List-valued parameter kinds: for these a list is a value, a list of lists an axis.
@@ -68,6 +78,7 @@ class Job:
     seed: int
     params: tuple  # sorted (name, value) pairs: hashable and order-free
     preset: Optional[str] = None  # the entry's preset: world.json's `preset` and the folder's name
+    level: Optional[int] = None  # the difficulty level asked for (seed is then the request's seed)
 
     @property
     def param_dict(self) -> dict[str, Any]:
@@ -76,6 +87,8 @@ class Job:
     @property
     def key(self) -> str:
         what = [self.generator, self.seed, self.params] + ([self.preset] if self.preset else [])
+        if self.level is not None:  # appended only then, so the keys of packs without levels stay as they were
+            what.append({"level": self.level})
         text = json.dumps(what, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
@@ -156,8 +169,8 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
     jobs: list[Job] = []
     for e, node in enumerate(worlds.value):
         preset = next((Path(str(r.value(v))).stem for k, v in node.value if k.value == "preset"), None)
-        for generator, seed, params in r.entry(node, e, default_seeds):
-            jobs.append(Job(len(jobs), e, generator, seed, params, preset))
+        for generator, seed, params, level in r.entry(node, e, default_seeds):
+            jobs.append(Job(len(jobs), e, generator, seed, params, preset, level))
             if len(jobs) > MAX_WORLDS:
                 r.fail(worlds, "worlds", f"describes more than {MAX_WORLDS} worlds")
     return Recipe(name, tuple(formats), sdf_version, preview, tuple(jobs), r.value(root), ros)
@@ -271,20 +284,56 @@ class _Reader:
                 else:
                     fixed[key] = value
         seeds = self.seeds(m["seeds"]) if "seeds" in m else default_seeds
+        levels: tuple = (None,)
+        if "difficulty" in m:
+            levels, per_level = self.difficulty(m["difficulty"], "seeds" in m)
+            seeds = tuple(range(per_level)) if per_level is not None else seeds
         if seeds is None:
             raise RecipeError(f"{self.source}:{node.start_mark.line + 1}: {where} has no 'seeds' (give them here or at the top)")
         names = sorted(axes)
-        for point in itertools.product(*(axes[n] for n in names)):
-            grid = dict(fixed, **dict(zip(names, point)))
-            # Check the grid point at both ends of every sampled range, before any world is built.
-            for end in (0, 1):
-                trial = dict(grid, **{k: v[end] for k, v in ranges.items()})
-                self._check(spec, trial, lines, m, node)
-            for seed in seeds:
-                params = dict(grid)
-                for k in sorted(ranges):
-                    params[k] = _sample(kinds[k].kind, ranges[k], seed, e, k)
-                yield spec.name, seed, tuple(sorted((k, _freeze(v)) for k, v in params.items()))
+        for level in levels:
+            for point in itertools.product(*(axes[n] for n in names)):
+                grid = dict(fixed, **dict(zip(names, point)))
+                # Check the grid point at both ends of every sampled range, before any world is built.
+                for end in (0, 1):
+                    trial = dict(grid, **{k: v[end] for k, v in ranges.items()})
+                    self._check(spec, trial, lines, m, node)
+                    if level is not None:
+                        self._check_level(spec.name, level, trial, m["difficulty"])
+                for seed in seeds:
+                    params = dict(grid)
+                    for k in sorted(ranges):
+                        params[k] = _sample(kinds[k].kind, ranges[k], seed, e, k)
+                    yield spec.name, seed, tuple(sorted((k, _freeze(v)) for k, v in params.items())), level
+
+    def difficulty(self, node, has_seeds: bool) -> tuple[tuple[int, ...], Optional[int]]:
+        """(levels, worlds per level or None) of an entry's ``difficulty`` mapping."""
+        m = self.mapping(node, "difficulty", DIFFICULTY_KEYS)
+        if "levels" not in m:
+            self.fail(node, "difficulty", "needs 'levels': a list of levels 1..10 or {min, max}")
+        value = self.value(m["levels"])
+        if isinstance(value, dict) and set(value) == {"min", "max"} and _is_int(value["min"]) and _is_int(value["max"]):
+            value = list(range(value["min"], value["max"] + 1))
+        if not (isinstance(value, list) and value and all(_is_int(v) and 1 <= v <= 10 for v in value)
+                and len(set(value)) == len(value)):
+            self.fail(m["levels"], "levels", f"must be distinct levels 1..10 as a list or {{min, max}}, got {quoted(value)}")
+        per_level = None
+        if "worlds_per_level" in m:
+            per_level = self.value(m["worlds_per_level"])
+            if has_seeds:
+                self.fail(m["worlds_per_level"], "worlds_per_level", "the entry gives 'seeds' too; give one or the other")
+            if not (_is_int(per_level) and 1 <= per_level <= MAX_WORLDS):
+                self.fail(m["worlds_per_level"], "worlds_per_level", f"must be an integer in [1, {MAX_WORLDS}], "
+                                                                     f"got {quoted(per_level)}")
+        return tuple(value), per_level
+
+    def _check_level(self, generator: str, level: int, params, node) -> None:
+        from worldgen.leveling import check_request
+
+        try:
+            check_request(generator, level, params)
+        except ParameterError as exc:
+            raise RecipeError(f"{self.source}:{node.start_mark.line + 1}: key 'difficulty': {exc}") from None
 
     def _check(self, spec, params, lines, m, node) -> None:
         try:

@@ -42,14 +42,18 @@ def render_job(job: Job, formats, sdf_version: str, preview: bool, ros=False) ->
     params = {k: _thaw(v) for k, v in job.params}
     rec: dict[str, Any] = {"job": job.index, "key": job.key, "generator": job.generator, "seed": job.seed,
                            "worldgen_version": worldgen.__version__}
+    if job.level is not None:
+        rec["level"] = job.level
     try:
-        world = worldgen.generate(job.generator, seed=job.seed, **params)
+        world = worldgen.generate(job.generator, seed=job.seed, difficulty=job.level, **params)
     except InfeasibleError as exc:
         rec.update(params=params, reason=str(exc), failures=dict(sorted(exc.failures.items())))
         return rec, {}
     world.preset = job.preset
     if job.preset:
         rec["preset"] = job.preset
+    if job.level is not None:  # the world's own seed is the draw that landed; the request's is kept beside it
+        rec.update(seed=world.seed, request_seed=job.seed)
     blobs = world.folder_blobs(formats, sdf_version, preview, ros)
     meta = json.loads(blobs[METADATA_NAME])
     folder = f"{WORLDS_DIR}/{world.folder_name}"

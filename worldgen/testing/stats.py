@@ -28,7 +28,7 @@ from worldgen.floats import finite_or_none  # None where scipy gives NaN or an i
 
 __all__ = [
     "INSTALL_HINT", "FIGURES", "NOTE", "require_scipy",
-    "clopper_pearson_lower", "clopper_pearson_interval", "runs_needed", "success_bound",
+    "clopper_pearson_lower", "clopper_pearson_interval", "wilson_interval", "runs_needed", "success_bound",
     "welch", "mann_whitney", "fisher", "compare_samples", "compare_runs",
 ]
 
@@ -87,6 +87,20 @@ def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[
         return 0.0, 1.0
     ci = require_scipy().binomtest(k, n).proportion_ci(confidence_level=confidence, method="exact")
     return float(ci.low), float(ci.high)
+
+
+def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Two-sided Wilson score interval on a success rate (the one BARN-style tables use; narrower than
+    Clopper-Pearson, never outside [0, 1]); (0, 1) when there are no runs."""
+    _check_counts(k, n)
+    _check_confidence(confidence)
+    if n == 0:
+        return 0.0, 1.0
+    z = float(require_scipy().norm.ppf(0.5 + confidence / 2.0))
+    p, zz = k / n, z * z
+    centre = (p + zz / (2 * n)) / (1 + zz / n)
+    half = z * math.sqrt(p * (1 - p) / n + zz / (4 * n * n)) / (1 + zz / n)
+    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def runs_needed(k: int, n: int, minimum: float, confidence: float = 0.95) -> Optional[int]:
