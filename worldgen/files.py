@@ -7,6 +7,7 @@ module), and every file or folder a command leaves behind goes through :func:`wr
 
 from __future__ import annotations
 
+import errno
 import json
 import os
 import shutil
@@ -115,13 +116,26 @@ def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]
                 fh.flush()
                 os.fsync(fh.fileno())
         os.chmod(tmp, creation_mode(0o777))
-        if target.exists():
+        try:
+            os.rename(tmp, target)
+        except OSError as exc:
+            if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY):
+                raise
+            # The folder is there (a rebuild, or another worker of a pack writing the same world this very
+            # moment): swap it out, then in; a folder another worker renames in between is swapped out too.
             old = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=out_dir))
-            os.rename(target, old / "w")
-            os.rename(tmp, target)
+            for k in range(8):
+                try:
+                    os.rename(target, old / f"w{k}")
+                except FileNotFoundError:
+                    pass
+                try:
+                    os.rename(tmp, target)
+                    break
+                except OSError as again:
+                    if again.errno not in (errno.EEXIST, errno.ENOTEMPTY) or k == 7:
+                        raise
             shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.rename(tmp, target)
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
         raise OutputError(f"cannot write world folder '{target}': {exc.strerror or exc}") from None
