@@ -54,7 +54,7 @@ def test_the_same_request_gives_the_same_world_from_the_cli_in_another_process(t
     ("cluttered", {"difficulty": "11/10"}, "parameter 'difficulty' must be a level 'k/10' with k in 1..10 (or the integer k), got '11/10'"),
     ("cluttered", {"difficulty": "3/5"}, "parameter 'difficulty' must be a level 'k/10'"),
     ("cluttered", {"difficulty": "7/10", "n_obstacles": 5}, "parameter 'difficulty' sets n_obstacles itself; leave out 'n_obstacles'"),
-    ("minimal", {"difficulty": "2/10"}, "parameter 'difficulty' is offered by the generators cluttered, corridor, door, "
+    ("minimal", {"difficulty": "2/10"}, "parameter 'difficulty' is offered by the generators barn, cluttered, corridor, door, "
      "not by 'minimal' (it has no random draws"),
     ("door", {"difficulty": "1/10"}, "parameter 'difficulty' 1/10 is out of reach of 'door': it reaches levels 2-10"),
     ("corridor", {"difficulty": "7/10", "shape": "U"}, "parameter 'difficulty' sets n_obstacles and shape itself; "

@@ -92,9 +92,7 @@ class Knob:
 
 #: The generators that can be asked for a level, and how each is turned. Calibrations (``start``): the
 #: value whose worlds' median level is the level, measured with seeds the tests do not use (docs/metrics.md).
-#: Every registered generator is a row here or in :data:`NO_LEVELS` (tests/test_leveling.py holds it). A new
-#: generator adds a row: ``barn`` (the cellular automaton's fill fraction) is wired by the lead, as
-#: ``"barn": Knob("fill", <start per level, measured>, <step>, <high>, integer=False)``.
+#: Every registered generator is a row here or in :data:`NO_LEVELS` (tests/test_leveling.py holds it).
 KNOBS: dict[str, Knob] = {
     "cluttered": Knob("n_obstacles", START, STEP, MAX_KNOB, per_area=True, excludes=("density",)),
     # Straight corridors with more and more obstacles, then an L, then a U bend (two turns).
@@ -103,6 +101,10 @@ KNOBS: dict[str, Knob] = {
     # Open doors (rooms in a row) up to level 5, closed leaves to push from level 6.
     "door": Knob("n_doors", (None, 1, 1, 1, 1, 1, 1, 1, 2, 4), 1.0, 5.0, low=1.0,
                  fixed=((1, 5, {"state": "open"}), (6, 10, {"state": "closed"}))),
+    # BARN's cellular-automaton fields, fuller and fuller (the field's size is the request's, not scaled:
+    # a fill fraction is already per cell). Medians of seeds 0-19: level 1 at 0.1, 5 at 0.2, 8 at 0.3.
+    "barn": Knob("fill_fraction", (0.1, 0.15, 0.175, 0.19, 0.2, 0.225, 0.275, 0.3, 0.325, 0.325), 0.025, 0.35,
+                 integer=False),
 }
 #: Generators without a level, and why (a request for one is refused in one line saying so).
 NO_LEVELS: dict[str, str] = {
