@@ -107,8 +107,10 @@ def test_bad_settings_are_one_line_errors(kwargs, message):
 @pytest.mark.parametrize("kwargs, message", [
     ({"generator": "cluttered", "curriculum": "ladder"}, "parameter 'curriculum' must be one of levels, replay"),
     ({"generator": "cluttered", "difficulty": "3/10", "curriculum": "levels"}, "leave out 'difficulty'"),
-    ({"generator": "door", "curriculum": "levels"},
+    ({"generator": "minimal", "curriculum": "levels"},
      "parameter 'curriculum' draws worlds at a level: parameter 'difficulty' is offered by the generators"),
+    ({"generator": "door", "curriculum": LevelCurriculum(start=1)},
+     "parameter 'curriculum' draws worlds at a level: parameter 'difficulty' 1/10 is out of reach of 'door'"),
     ({"preset": "drl_arena", "curriculum": "levels"}, "draws worlds at a level: .* leave out 'n_obstacles'"),
 ])
 def test_a_bad_curriculum_fails_when_the_env_is_made(kwargs, message):
@@ -188,3 +190,26 @@ def test_an_environment_with_a_curriculum_passes_gymnasium_s_checker(curriculum)
     from gymnasium.utils.env_checker import check_env
 
     check_env(gymnasium.make(ENV_ID, curriculum=curriculum, generator="cluttered", lidar_beams=16).unwrapped, skip_render_check=True)
+
+
+def test_a_generator_without_level_1_starts_at_its_lowest_and_is_never_sent_below_or_outside_it():
+    """door reaches levels 2-10 (worldgen.leveling.reachable): the curriculum starts at 2, demotes no lower,
+    and a pass of the top sends it among 2..10 only."""
+    env = gymnasium.make(ENV_ID, generator="door", curriculum="levels")
+    try:
+        _, info = env.reset(seed=3)
+        assert info["curriculum_level"] == 2
+        curriculum = env.unwrapped.curriculum
+        assert curriculum.ladder == tuple(range(2, 11))
+    finally:
+        env.close()
+    for _ in range(3 * curriculum.window):
+        curriculum.record(False)
+    assert curriculum.level == 2
+    curriculum.level, landed = 10, set()
+    for _ in range(60):
+        for _ in range(curriculum.window):
+            curriculum.record(True)
+        landed.add(curriculum.level)
+        curriculum.level = 10
+    assert 1 not in landed and len(landed) >= 5

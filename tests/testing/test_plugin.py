@@ -129,7 +129,7 @@ def test_a_mistake_in_a_marker_fails_that_test_with_one_line_and_the_run_goes_on
     one = {name.split("[")[0]: lines[0] for name, lines in sections.items()}
     assert "unknown argument 'n_obstacle' (did you mean 'n_obstacles'?); allowed: seeds, allow_infeasible, pack, " \
            "or a parameter of 'cluttered': box_size" in one["test_typo_in_a_parameter"]
-    assert "unknown generator 'clutterd' (did you mean 'cluttered'?); available: cluttered, corridor" \
+    assert "unknown generator 'clutterd' (did you mean 'cluttered'?); available: barn, cluttered, corridor" \
            in one["test_typo_in_the_generator"]
     assert "unknown argument 'seed' (did you mean 'seeds'?)" in one["test_seed_for_seeds"]
     assert "parameter 'n_obstacles' must be" in one["test_value_out_of_range"]

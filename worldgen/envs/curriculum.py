@@ -7,10 +7,12 @@
 :class:`LevelCurriculum`: every episode's world is drawn at the environment's current difficulty level
 (1..10, :mod:`worldgen.leveling`). After each finished episode the success rate over the last ``window``
 episodes at that level decides: at least ``promote`` moves the environment one level up, at most ``demote``
-one level down (never below 1); the window starts afresh at every change, so each decision is on
+one level down (never below the lowest); the window starts afresh at every change, so each decision is on
 ``window`` episodes of one level. An environment that is promoted from the top level is sent to a level
-drawn uniformly from 1..10 (the environment's curriculum stream, :func:`worldgen.seeding.curriculum_rng`),
-so that the top is not overfitted. The bookkeeping (:meth:`LevelCurriculum.record`) needs no environment.
+drawn uniformly from all of them (the environment's curriculum stream, :func:`worldgen.seeding.curriculum_rng`),
+so that the top is not overfitted. The levels are those the generator reaches
+(:func:`worldgen.leveling.reachable`: 2..10 for ``door``), and the first is the lowest of them unless
+``start`` says otherwise. The bookkeeping (:meth:`LevelCurriculum.record`) needs no environment.
 """
 
 from __future__ import annotations
@@ -42,23 +44,26 @@ def _number(name: str, value: Any, lo: float, hi: float, integer: bool = False):
 class LevelCurriculum:
     """Levels with promotion and demotion by a windowed success rate (see the module).
 
-    ``start`` the first level; ``window`` finished episodes per decision (default 20); ``promote`` the rate
+    ``start`` the first level (default: the generator's lowest); ``window`` finished episodes per decision (default 20); ``promote`` the rate
     at or above which the level goes up (default 0.8); ``demote`` the rate at or below which it goes down
     (default 0.4); ``levels`` how many there are (10, world.json's ``difficulty_level``).
     """
 
     name = "levels"
 
-    def __init__(self, start: int = 1, window: int = 20, promote: float = 0.8, demote: float = 0.4, levels: int = 10):
+    def __init__(self, start: Optional[int] = None, window: int = 20, promote: float = 0.8, demote: float = 0.4,
+                 levels: int = 10):
         self.levels = _number("levels", levels, 1, 10, integer=True)
-        self.start = _number("start", start, 1, self.levels, integer=True)
+        self.start = None if start is None else _number("start", start, 1, self.levels, integer=True)
         self.window = _number("window", window, 1, 100000, integer=True)
         self.promote = _number("promote", promote, 0.0, 1.0)
         self.demote = _number("demote", demote, 0.0, 1.0)
         if not self.demote < self.promote:
             raise ParameterError(f"parameter 'demote' must be below promote = {self.promote:g}, got {self.demote:g}")
+        #: The levels played, lowest first: 1..levels until :meth:`check` learns which the generator reaches.
+        self.ladder: tuple[int, ...] = tuple(range(1, self.levels + 1))
         #: The level the next episode is played at.
-        self.level = self.start
+        self.level = self.start if self.start is not None else 1
         self._recent: deque = deque(maxlen=self.window)
         self.episodes = np.zeros(self.levels, dtype=np.int64)
         self.successes = np.zeros(self.levels, dtype=np.int64)
@@ -87,10 +92,12 @@ class LevelCurriculum:
         moved = False
         if len(self._recent) == self.window:
             rate = sum(self._recent) / self.window
+            higher = [v for v in self.ladder if v > played]
+            lower = [v for v in self.ladder if v < played]
             if rate >= self.promote:
-                moved, self.level = True, self._above_top() if played == self.levels else played + 1
-            elif rate <= self.demote and played > 1:
-                moved, self.level = True, played - 1
+                moved, self.level = True, higher[0] if higher else self._above_top()
+            elif rate <= self.demote and lower:
+                moved, self.level = True, lower[-1]
         if moved:  # a fresh window after every move (a jump from the top that lands on it again included)
             self._recent.clear()
         self._changed = self.level != played
@@ -101,7 +108,7 @@ class LevelCurriculum:
         if self._rng is None:
             self.reseed(0)
         assert self._rng is not None
-        return int(self._rng.integers(1, self.levels + 1))
+        return self.ladder[int(self._rng.integers(len(self.ladder)))]
 
     def success_rates(self) -> np.ndarray:
         """(levels,) float: successes / episodes per level 1..10 (NaN where none was played)."""
@@ -117,16 +124,21 @@ class LevelCurriculum:
     def check(self, source) -> None:
         """ParameterError unless the source can be asked for levels (:func:`worldgen.leveling.check_request`)."""
         from worldgen.envs.replay import check_generator_source
-        from worldgen.leveling import check_request
+        from worldgen.leveling import check_request, reachable
 
         check_generator_source(source, "levels")
         if source.difficulty is not None:
             raise ParameterError("parameter 'curriculum' sets each episode's level itself; leave out 'difficulty' "
                                  f"(got difficulty={quoted(source.difficulty)})")
+        ladder = tuple(v for v in reachable(source.generator) if v <= self.levels)
+        start = self.start if self.start is not None else (ladder[0] if ladder else 1)
         try:
-            check_request(source.generator, self.start, source.params)
+            check_request(source.generator, start, source.params)
         except ParameterError as e:  # said for curriculum='levels', which sets the difficulty of every episode
             raise ParameterError(f"parameter 'curriculum' draws worlds at a level: {e}") from None
+        if not self.episodes.any():  # a fresh curriculum starts at its first level of this generator
+            self.level = start
+        self.ladder = ladder
 
     def next_world(self, source, world_rng: np.random.Generator):
         """The next episode's world at the current level: (EpisodeWorld, what reset's ``info`` adds)."""
