@@ -44,9 +44,10 @@ def _number(name: str, value: Any, lo: float, hi: float, integer: bool = False):
 class LevelCurriculum:
     """Levels with promotion and demotion by a windowed success rate (see the module).
 
-    ``start`` the first level (default: the generator's lowest); ``window`` finished episodes per decision (default 20); ``promote`` the rate
-    at or above which the level goes up (default 0.8); ``demote`` the rate at or below which it goes down
-    (default 0.4); ``levels`` how many there are (10, world.json's ``difficulty_level``).
+    ``start`` the first level (default: the generator's lowest); ``window`` finished episodes per decision
+    (default 20); ``promote`` the rate at or above which the level goes up (default 0.8); ``demote`` the rate
+    at or below which it goes down (default 0.4); ``levels`` how many there are (10, world.json's
+    ``difficulty_level``).
     """
 
     name = "levels"
