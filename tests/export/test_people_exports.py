@@ -23,6 +23,7 @@ import pytest
 from support.reftools_sdf import dump_sdf
 
 import worldgen
+from worldgen.errors import WorldgenError
 from worldgen.export.actor_path import TENSION, WAYPOINT_TOLERANCE, actor_waypoints
 from worldgen.scene.motion import drive_mocap, positions_at
 
@@ -122,6 +123,14 @@ def test_a_straight_walk_from_standing_to_standing_keeps_within_the_tolerance_wi
     assert raw.max() > 5 * MM
     # Tension 1 needed ceil(0.12 m x EASE / 0.9 mm) = 13 parts a leg, 651 waypoints; this takes under 4 a leg.
     assert math.ceil(0.12 * EASE / WAYPOINT_TOLERANCE) == 13 and len(way) < 4 * 50
+
+
+def test_a_walk_too_fast_to_cut_finely_enough_is_an_error_not_a_silent_offset():
+    # A right-angle turn 20 us after a 10 m leg: no part shorter than 10 us can be written (times keep 6
+    # decimals), so no cut keeps within the tolerance there.
+    rows = np.array([[0.0, 0.0, 0.0], [0.00002, 10.0, 0.0], [0.00004, 10.0, 10.0]])
+    with pytest.raises(WorldgenError, match=r"^actor waypoints: no cut keeps within 0\.0009 m of the walk near t = "):
+        actor_waypoints(rows)
 
 
 def with_z(rows: np.ndarray) -> np.ndarray:

@@ -45,6 +45,8 @@ _STEP = 8.0
 _S = np.linspace(0.0, 1.0, 33)[1:-1]
 _H10, _H11 = _S**3 - 2 * _S**2 + _S, _S**3 - _S**2
 _ROUNDS = 40
+#: The shortest part (s): ten times the 1 us that times are rounded to.
+_TICK = 1e-5
 #: How fast parts may grow away from a turn, as a share of the allowed displacement change per part.
 _GROW = 0.75
 
@@ -100,18 +102,21 @@ def actor_waypoints(trajectory, loop: bool = False, tolerance: float = WAYPOINT_
     grow = np.full(len(length), _GROW * bound)
     sigma = np.concatenate([[0.0], np.cumsum(length)])
     for _ in range(_ROUNDS):
-        way = _cut(rows, sigma, _field(sigma, local, grow, loop), grow)
+        way, capped = _cut(rows, sigma, _field(sigma, local, grow, loop), grow)
         bad = worst_deviation(way, rows) > tolerance
         if not bad.any():
             return way
         # The legs holding a straying part: shorter parts at their rows, growing more slowly.
         leg = np.unique(np.searchsorted(rows[:, 0], way[:-1, 0][bad], side="right") - 1)
+        if capped[leg].any():
+            break
         ends = np.unique(np.concatenate([leg, leg + 1]))
         local[ends] = np.minimum(local[ends], _field(sigma, local, grow, loop)[ends]) / 2
         grow[leg] /= 2
         if loop:
             local[0] = local[-1] = min(local[0], local[-1])
-    raise WorldgenError(f"actor waypoints: no cut keeps within {tolerance} m after {_ROUNDS} rounds")
+    raise WorldgenError(f"actor waypoints: no cut keeps within {tolerance} m of the walk near t = "
+                        f"{rows[leg[0], 0]:g} s (legs too short in time for how sharply it turns)")
 
 
 def _tangents(p: np.ndarray, tension: float) -> np.ndarray:
@@ -147,15 +152,19 @@ def _field(sigma: np.ndarray, local: np.ndarray, grow: np.ndarray, loop: bool) -
     return out[n - 1:2 * n - 1] if loop else out
 
 
-def _cut(rows: np.ndarray, sigma: np.ndarray, h: np.ndarray, grow: np.ndarray) -> np.ndarray:
-    """Rows plus, in each moving leg [a, b] (distances walked), the points that cut it into equal shares of
-    the integral of d sigma / h, h = min(sqrt(h_a^2 + 2 g (sigma - a)), sqrt(h_b^2 + 2 g (b - sigma)))."""
+def _cut(rows: np.ndarray, sigma: np.ndarray, h: np.ndarray, grow: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rows plus, in each moving leg [a, b] (distances walked), the points that cut it into equal
+    shares of the integral of d sigma / h, h = min(sqrt(h_a^2 + 2 g (sigma - a)), sqrt(h_b^2 + 2 g (b - sigma)));
+    and which legs got fewer parts than that asked for (one per :data:`_TICK` at most)."""
     a, b, g = sigma[:-1], sigma[1:], grow
     ha, hb = np.minimum(h[:-1], 1e9), np.minimum(h[1:], 1e9)
     cross = np.clip((hb**2 - ha**2) / (4 * g) + (a + b) / 2, a, b)  # where the two branches meet
     left = (np.sqrt(ha**2 + 2 * g * (cross - a)) - ha) / g
     total = left + (np.sqrt(hb**2 + 2 * g * (b - cross)) - hb) / g
-    parts = np.where(b > a, np.maximum(1, np.ceil(total - 1e-9)), 1).astype(np.int64)
+    # At most one part per _TICK of time, so that no two rounded times meet (and a hopeless leg stays finite).
+    most = np.maximum(1, np.floor(np.diff(rows[:, 0]) / _TICK))
+    wanted = np.where(b > a, np.maximum(1, np.ceil(total - 1e-9)), 1)
+    parts = np.minimum(wanted, most).astype(np.int64)
     leg = np.repeat(np.arange(len(a)), parts)
     k = np.arange(parts.sum()) - np.repeat(np.cumsum(parts) - parts, parts)  # 0 .. parts - 1 in each leg
     phi, g, ha, hb = k * (total / parts)[leg], g[leg], ha[leg], hb[leg]
@@ -165,5 +174,7 @@ def _cut(rows: np.ndarray, sigma: np.ndarray, h: np.ndarray, grow: np.ndarray) -
     out = rows[leg] + share[:, None] * (rows[leg + 1] - rows[leg])
     out[k == 0] = rows[:-1]  # the rows themselves, exactly
     out = np.round(np.vstack([out, rows[-1:]]), 6)
-    keep = np.concatenate([[True], np.diff(out[:, 0]) > 0])  # never two waypoints at one (rounded) time
-    return out[keep]
+    # Never two waypoints at one (rounded) time: an added point that would share one goes, a row stays.
+    row = np.concatenate([k == 0, [True]])
+    same = np.diff(out[:, 0]) <= 0
+    return out[row | ~(np.concatenate([[False], same]) | np.concatenate([same, [False]]))], wanted > most
