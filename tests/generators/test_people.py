@@ -14,7 +14,7 @@ from support.reftools_sdf import check_sdf
 import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.export import metadata
-from worldgen.export.sdf import actor_waypoints
+from worldgen.export.actor_path import TENSION, actor_waypoints, spline_positions
 from worldgen.export.xml import parse_bytes
 from worldgen.generators.people import KEEP_OUT, LEG_MAX, LEG_MIN, SLACK, draw_people, people_footprints
 from worldgen.scene.footprint import FootprintIndex
@@ -78,7 +78,7 @@ def test_sdf_actors_do_not_loop_and_carry_the_rows(world, tmp_path):
         assert actor.findtext("script/loop") == "false"
         points = [(float(w.findtext("time")), *map(float, w.findtext("pose").split()[:2]))
                   for w in actor.findall("script/trajectory/waypoint")]
-        # The rows, with the legs cut finer for Gazebo's eased spline (tests/export/test_people_exports.py).
+        # The rows, with points added on the legs for Gazebo's spline (tests/export/test_people_exports.py).
         np.testing.assert_array_equal(np.array(points), actor_waypoints(p["trajectory"]))
     links = {link.get("name") for link in parse_bytes((folder / "world.urdf").read_bytes()).getroot().findall("link")}
     assert not links & {p["name"] for p in meta["people"]}
@@ -128,8 +128,10 @@ def test_people_that_cannot_fit_say_so():
 
 def test_a_standing_person_stands_still_in_every_format(tmp_path):
     """person_in_doorway: the person stands in the doorway for 8 s; world.json says so with two rows at
-    the same place (t = 0 and t = 8), the SDF actor with the same two waypoints, and MuJoCo's mocap body,
-    driven by drive_mocap, stays there (within 1 um) at every sampled time of the stay."""
+    the same place (t = 0 and t = 8), the SDF actor with the same two waypoints and nothing between them,
+    played by Gazebo's spline (worldgen.export.actor_path's player of it, checked against the reference
+    in tests/export/test_people_exports.py) it stays there within 1 mm, and MuJoCo's mocap body, driven
+    by drive_mocap, stays there (within 1 um) at every sampled time of the stay."""
     world = worldgen.generate_preset("person_in_doorway")
     meta = world.metadata
     (person,) = meta["people"]
@@ -138,9 +140,13 @@ def test_a_standing_person_stands_still_in_every_format(tmp_path):
     np.testing.assert_array_equal(rows[:2], [[0.0, *centre], [8.0, *centre]])
     assert np.hypot(*(rows[2, 1:] - rows[1, 1:])) > 0  # and then it moves
     actor = parse_bytes(world.to_sdf().encode()).getroot().find("world/actor")
-    points = [(float(w.findtext("time")), *map(float, w.findtext("pose").split()[:2]))
-              for w in actor.findall("script/trajectory/waypoint")]
-    np.testing.assert_array_equal(np.array(points), rows)
+    assert float(actor.find("script/trajectory").get("tension")) == TENSION
+    points = np.array([(float(w.findtext("time")), *map(float, w.findtext("pose").split()[:2]))
+                       for w in actor.findall("script/trajectory/waypoint")])
+    np.testing.assert_array_equal(points, actor_waypoints(rows))
+    np.testing.assert_array_equal(points[:2], rows[:2])  # the stay: its two rows, nothing between
+    stay = np.linspace(0.0, 8.0, 8001)
+    assert np.hypot(*(spline_positions(points, stay) - centre).T).max() <= 1e-3
     ok, messages = check_sdf(world.write(tmp_path, preview=False) / "world.sdf")
     assert ok, "\n".join(messages)
     model, data = load_and_step(world.to_mjcf(), steps=1)

@@ -41,19 +41,20 @@ simulators' sources):
   up on its resource path, so add the world folder to ``GAZEBO_RESOURCE_PATH``.
 * No ``<plugin>``: Gazebo Sim loads its default systems (physics, scene
   broadcaster, user commands) when a world names none.
-* Movers (``scene.movers``) are ``<actor>``s, the same element in 1.6 and
-  1.9: a link ``body`` carrying the mover's cylinder (visual and collision, its
-  base on the floor) and a ``<script>`` looping one ``<trajectory>`` of timed
-  ``<waypoint>``s, one per trajectory row. Gazebo classic carries every actor
-  link along the script; ``tension="1"`` makes it pass through the waypoints
-  instead of overshooting them on its Catmull-Rom spline, but it eases in and
-  out of each one, so a person's legs are cut into parts of at most
-  ``WAYPOINT_TOLERANCE / EASE`` (9.4 mm) to keep its actor within 1 mm of
-  world.json at every time (:func:`actor_waypoints`; scripted movers keep one
-  waypoint per row). Gazebo Sim accepts
+* Movers (``scene.movers``) and people are ``<actor>``s, the same element in 1.6
+  and 1.9: a link ``body`` carrying the mover's cylinder (visual and collision,
+  its base on the floor) and a ``<script>`` playing one ``<trajectory>`` of
+  timed ``<waypoint>``s (one per line). Gazebo plays them as a gz-math spline
+  (tangent = (1 - tension) x Catmull-Rom's); ``tension="0"`` keeps Catmull-Rom,
+  which is exact on evenly cut straight runs, and the waypoints are world.json's
+  rows plus points on its legs, graded about each turn, so that the actor keeps
+  within 0.9 mm of world.json at every time (:mod:`worldgen.export.actor_path`).
+  Gazebo classic carries every actor link along the script. Gazebo Sim accepts
   skin-less, trajectory-only actors only since gz-sim pull request 1947 (2023),
-  may not draw their links (gz-sim issue 418) and ignores ``tension`` (gz-sim
-  issue 243). Neither gives actors physics: the collision element is there for
+  may not draw their links (gz-sim issue 418). A Gazebo that ignores
+  ``tension`` (gz-sim issue 243; ignition-common's ``PoseAnimation`` never
+  passed it to its spline, whose default is 0) plays the same Catmull-Rom
+  spline. Neither gives actors physics: the collision element is there for
   plugins that enable it, a stock actor is seen, not felt, and separation from
   movers is judged from world.json's trajectories. worldgen ships no skin (the
   worlds must load without a network); add a ``<skin>``/``<animation>`` to see
@@ -66,12 +67,12 @@ link is welded to the world by a fixed joint, so that the leaf can swing.
 
 from __future__ import annotations
 
-import math
 from typing import Optional
 
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError
+from worldgen.export.actor_path import TENSION, actor_waypoints
 from worldgen.export.formats import SDF_VERSIONS
 from worldgen.export.xml import XmlText, escape_text, fill, load_template
 from worldgen.floats import fmt, fmt_seq
@@ -79,8 +80,7 @@ from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matri
 from worldgen.scene.graph import Joint
 from worldgen.scene.mover import MOVER_RGBA, Mover
 
-__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "EASE", "WAYPOINT_TOLERANCE", "actor_waypoints",
-           "to_sdf"]
+__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "to_sdf"]
 
 TEMPLATE = "world.sdf"
 #: Smallest principal moment written (kg m^2): floats keep 6 decimals, and a
@@ -88,15 +88,6 @@ TEMPLATE = "world.sdf"
 MIN_MOMENT = 1e-6
 #: A mover's trajectory ``type``: it would name a skin animation played along it, if there were one.
 TRAJECTORY_TYPE = "walk"
-#: With ``tension="1"`` a Gazebo actor's spline has zero tangents (gz-math Spline: tangent = (1 - tension) x
-#: Catmull-Rom's): between two waypoints it goes straight but eases, at s = (t - t0) / (t1 - t0) it is at
-#: 3 s^2 - 2 s^3 of the way, which is ahead of or behind the straight walk by at most sqrt(3) / 18 of the
-#: segment's length (at s = 1/2 -+ sqrt(3) / 6).
-EASE = math.sqrt(3.0) / 18.0
-#: The most (m) a person's actor may lag or lead world.json's straight walk under that easing; 0.1 mm under
-#: the 1 mm the formats promise to agree within, for the 6-decimal rounding of times and poses.
-WAYPOINT_TOLERANCE = 0.9e-3
-
 
 def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> bytes:
     """The SDFormat world of ``scene``: UTF-8 bytes, pretty-printed (see the module docstring).
@@ -352,30 +343,11 @@ def _sdf_actor(out: XmlText, mover: Mover) -> None:
     out.leaf("loop", "true" if mover.loop else "false")
     out.leaf("delay_start", "0")
     out.leaf("auto_start", "true")
-    out.open("trajectory", f' id="0" type="{TRAJECTORY_TYPE}" tension="1"')
-    # One string per waypoint, the bytes out.open/leaf/close would write: a person has thousands.
+    out.open("trajectory", f' id="0" type="{TRAJECTORY_TYPE}" tension="{fmt(TENSION)}"')
+    # One line per waypoint (a person has thousands: a third of the bytes of one element per line).
     pad = "  " * out.depth
-    out.parts.extend(f"{pad}<waypoint>\n{pad}  <time>{fmt(t)}</time>\n{pad}  <pose>{fmt(x)} {fmt(y)} 0 0 0 0</pose>\n"
-                     f"{pad}</waypoint>\n"
-                     for t, x, y in (actor_waypoints(mover.trajectory).tolist() if mover.person else mover.trajectory))
+    out.parts.extend(f"{pad}<waypoint><time>{fmt(t)}</time><pose>{fmt(x)} {fmt(y)} 0 0 0 0</pose></waypoint>\n"
+                     for t, x, y in actor_waypoints(mover.trajectory, loop=mover.loop).tolist())
     out.close("trajectory")
     out.close("script")
     out.close("actor")
-
-
-def actor_waypoints(trajectory) -> np.ndarray:
-    """(k, 3) ``t, x, y`` waypoints of a person's actor: every row, and each straight leg between two rows
-    cut into equal parts (in time and length) short enough that the eased spline of ``tension="1"`` keeps
-    within :data:`WAYPOINT_TOLERANCE` of the straight walk (``EASE x part <= WAYPOINT_TOLERANCE``). The
-    added waypoints lie on world.json's legs, so its linear interpolation is unchanged; a stay (two rows at
-    one place) needs none."""
-    rows = np.asarray(trajectory, dtype=float)
-    if len(rows) < 2:
-        return rows
-    step = np.diff(rows, axis=0)
-    parts = np.maximum(1, np.ceil(np.hypot(step[:, 1], step[:, 2]) * EASE / WAYPOINT_TOLERANCE)).astype(np.int64)
-    leg = np.repeat(np.arange(len(step)), parts)
-    share = (np.arange(parts.sum()) - np.repeat(np.cumsum(parts) - parts, parts)) / np.repeat(parts, parts)
-    out = np.vstack([rows[leg] + share[:, None] * step[leg], rows[-1:]])
-    out[np.cumsum(parts) - parts] = rows[:-1]  # the rows themselves, exactly
-    return np.round(out, 6)
