@@ -5,11 +5,12 @@ Each person ``a`` accelerates as
 
     dv_a/dt = (v0_a e_a - v_a) / tau  +  sum_b w(e_a, r_b - r_a) f_ab  +  sum_B f_aB
 
-- ``e_a``: the unit direction to the next waypoint of a path planned for the person's disc by the
-  exact planner (:mod:`~worldgen.feasibility.planner`); a waypoint is passed when the next one is in
-  sight (checked every :data:`LOOK` steps), and the path is planned again from where the person
-  stands when its waypoint has been out of sight for :data:`REPLAN` checks (unless the waypoint
-  before it is in sight: then the person walks back to that one, which leads on); a person who has moved
+- ``e_a``: the unit direction to the next waypoint of the shortest path for the person's disc (exact;
+  one tangent graph per walk answers every leg, :mod:`~worldgen.feasibility.roadmap`); a waypoint is
+  passed when the next one is in sight (checked every :data:`LOOK` steps), and the path is planned
+  again from where the person stands when its waypoint has been out of sight for :data:`REPLAN`
+  checks (unless the waypoint before it is in sight: then the person walks back to that one, which
+  leads on); a person who has moved
   less than :data:`STUCK` m a look for ``2 x REPLAN`` looks in a row (held by others or by a wall's
   push near a place) gives that place up and walks to the next;
 - ``f_ab = -grad V(b)``, ``V = V0 exp(-(b - 2 r) / sigma)``, ``b`` the semi-minor axis of the
@@ -47,7 +48,7 @@ import numpy as np
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.groups import GroupForce, group_force
-from worldgen.feasibility.planner import Planner
+from worldgen.feasibility.roadmap import Roadmap
 from worldgen.floats import round_float
 from worldgen.generators.people import PERSON_HEIGHT, SLACK, draw_people, people_footprints
 from worldgen.scene import Mover, Robot, Scene, Task
@@ -178,7 +179,7 @@ def _runs(who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class _Router:
     """Each person's places and the planned path to the current one; ``target`` the waypoint steered to."""
 
-    def __init__(self, planner: Planner, sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
+    def __init__(self, planner: Roadmap, sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
         # Sight is tested in a configuration space SLACK thinner than the planner's: a waypoint on a
         # planner's circle is then in sight, not touching.
         self.planner, self.sight, self.places = planner, sight, places
@@ -284,7 +285,7 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
     if n == 0:
         return out
     walls = _Walls(obstacles, bounds)
-    router = _Router(Planner(ConfigSpace.build(obstacles, radius + SLACK, bounds)),
+    router = _Router(Roadmap(ConfigSpace.build(obstacles, radius + SLACK, bounds)),
                      ConfigSpace.build(obstacles, radius, bounds), starts, places)
     keep = radius + 2 * SLACK
     leave = np.zeros(n) if depart is None else np.asarray(depart, dtype=float)
