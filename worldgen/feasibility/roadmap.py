@@ -75,17 +75,15 @@ class Roadmap:
         self._start = np.searchsorted(self._chain, np.arange(2 * cs.n_circles + 1)).astype(np.int64)
         self._blocked, self._head = self._gaps()
         # Hot per-position data as Python lists: the search reads them one at a time.
-        self._u_l = self._u.tolist()
-        self._chain_l = self._chain.tolist()
-        self._node_l = self._node.tolist()
-        self._start_l = self._start.tolist()
-        self._full_l = self._full.tolist()
-        self._rho_l = cs.rho.tolist()
-        self._len_l = t.length.tolist()
-        self._arr_l = self._arrival_pos.tolist()
+        self._u_l, self._chain_l, self._node_l = self._u.tolist(), self._chain.tolist(), self._node.tolist()
+        self._start_l, self._full_l, self._rho_l = self._start.tolist(), self._full.tolist(), cs.rho.tolist()
+        self._len_l, self._arr_l = t.length.tolist(), self._arrival_pos.tolist()
         self._px, self._py = self._points[:, 0].tolist(), self._points[:, 1].tolist()
         self._n = n
         self._ways: dict[int, tuple] = {}
+        # A query's tangents: from a point to every circle, each side; twice (the start's, the goal's).
+        self._ends_rows = tuple(np.tile(a, 2) for a in every_side(np.full(cs.n_circles, -1), np.arange(cs.n_circles),
+                                                                  (1,), (1, -1)))
 
     # -- the graph ------------------------------------------------------------
     def _all_tangents(self) -> Tangents:
@@ -196,43 +194,42 @@ class Roadmap:
         (most of them never are): a tangent not yet tested waits in the queue at its cost, which no test
         can lower, and is tested when it comes first.
         """
-        cs = self.cs
-        start = np.asarray(start, dtype=float)
-        goal = np.asarray(goal, dtype=float)
+        cs, start, goal = self.cs, np.asarray(start, dtype=float), np.asarray(goal, dtype=float)
         if cs.segments_clear(start[None], goal[None])[0]:
             return Route(np.array([start, goal]), (), float(np.hypot(*(goal - start))))
-        c = np.arange(cs.n_circles)
-        ins = _Ends(self, tangents(cs, *every_side(np.full(len(c), -1), c, (1,), (1, -1)), src_xy=start,
-                                   clear=False), True)
-        outs = _Ends(self, tangents(cs, *every_side(c, np.full(len(c), -1), (1, -1), (1,)), dst_xy=goal,
-                                    clear=False), False)
+        # The start's and the goal's tangents to every circle in one call; the goal's walked backwards.
+        m = len(self._ends_rows[0]) // 2
+        both = tangents(cs, *self._ends_rows, src_xy=np.repeat([start, goal], m, axis=0), clear=False)
+        mine = np.all(both.q == start, axis=1)
+        to = both.take(np.flatnonzero(~mine))
+        ins = _Ends(self, both.take(np.flatnonzero(mine)), True)
+        outs = _Ends(self, Tangents(to.dst, to.src, -to.s2, -to.s1, to.t, to.q, to.nt, to.nq, to.length), False)
         gx, gy = float(goal[0]), float(goal[1])
         px, py, hypot = self._px, self._py, math.hypot
-        heap: list = []  # (f, order, kind, data): kinds below
-        order = 0
         seed_f = ins.length + ins.sweep * self.cs.rho[ins.chain // 2]
         if len(self._points):
             seed_f = seed_f + np.hypot(self._points[ins.pos, 0] - gx, self._points[ins.pos, 1] - gy)
-        for r in ins.rows.tolist():
-            heap.append((float(seed_f[r]), order, _SEED, r))
-            order += 1
-        for f, data in self._direct(ins, outs):
-            heap.append((f, order, _DIRECT, data))
-            order += 1
+        # The start's tangents join the queue one at a time, cheapest first: most are never reached.
+        seeds = ins.rows[np.argsort(seed_f[ins.rows], kind="stable")].tolist()
+        heap: list = [(f, k, _DIRECT, data) for k, (f, data) in enumerate(self._direct(ins, outs))]
+        order = len(heap) + 1  # (f, order, kind, data): kinds above; order 0 is the next start tangent
+        if seeds:
+            heap.append((float(seed_f[seeds[0]]), 0, _SEED, 0))
         heapq.heapify(heap)
         # The goal's departures by chain: (position before, sweep from it, cost to the goal, row).
         leave: dict[int, list] = {}
-        for r in outs.rows.tolist():
-            leave.setdefault(self._chain_l[outs.pos[r]], []).append((int(outs.pos[r]), float(outs.sweep[r]),
-                                                                      float(outs.length[r]), r))
+        rows = outs.rows
+        for ch, p, extra, length, r in zip(self._chain[outs.pos[rows]].tolist(), outs.pos[rows].tolist(),
+                                           outs.sweep[rows].tolist(), outs.length[rows].tolist(), rows.tolist()):
+            leave.setdefault(ch, []).append((p, extra, length, r))
         dist: dict[int, float] = {}
         parent: dict[int, tuple] = {}
-        pushed: dict[int, float] = {}
+        goal_f = np.full(len(outs.length), math.inf)  # the cheapest way to the goal over each goal tangent
         u = self._u_l
         while heap:
             f, _, kind, data = heapq.heappop(heap)
             if kind == _GOAL:
-                if outs.verified(int(data[1])):
+                if outs.verified(int(data[1]), upto=f + VERIFY_BAND, f=goal_f):
                     return self._route(start, goal, f, data, parent, ins, outs)
                 continue
             if kind == _DIRECT:
@@ -242,6 +239,9 @@ class Roadmap:
                     return self._route(start, goal, f, ("direct",) + data, parent, ins, outs)
                 continue
             if kind == _SEED:
+                if data + 1 < len(seeds):
+                    heapq.heappush(heap, (float(seed_f[seeds[data + 1]]), 0, _SEED, data + 1))
+                data = seeds[data]
                 if not ins.verified(data, upto=f + VERIFY_BAND, f=seed_f):
                     continue
                 k = int(ins.pos[data])
@@ -265,8 +265,8 @@ class Roadmap:
                         sweep = u[p] - u[k] + (_TWO_PI if idx >= m else 0.0) + extra
                         sweep = 0.0 if sweep < 0.0 or (full and sweep > _TWO_PI - EPS) else sweep
                         total = g + rho * sweep + length
-                        if total < pushed.get(r, math.inf):
-                            pushed[r] = total
+                        if total < goal_f[r]:
+                            goal_f[r] = total
                             heapq.heappush(heap, (total, order, _GOAL, (k, r, sweep)))
                             order += 1
             for p, cost, j, _ in out:
@@ -370,8 +370,7 @@ class _Ends:
         turn = np.where(wrap, 2 * np.pi, 0.0)  # over a full circle's seam
         self.sweep = np.maximum(there + turn - self.u if into else self.u + turn - there, 0.0)
         self.rows = np.flatnonzero(ok)
-        self.seg = np.zeros(len(tans), dtype=np.int8)
-        self.arc = np.zeros(len(tans), dtype=np.int8)
+        self.seg, self.arc = np.zeros(len(tans), dtype=np.int8), np.zeros(len(tans), dtype=np.int8)
 
     def verified(self, r: int, arc: bool = True, upto: Optional[float] = None, f=None) -> bool:
         """Row ``r``'s tangent keeps the clearance (and, with ``arc``, so does its arc along the chain); with
