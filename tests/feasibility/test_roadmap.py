@@ -99,14 +99,23 @@ def test_a_world_without_obstacles_and_one_of_discs_only():
 def test_a_crowd_walks_the_same_rows_as_with_the_planner(monkeypatch):
     world = worldgen.generate("cluttered", 7, size=[12.0, 12.0], n_obstacles=20, n_people=8, people_duration=20.0)
     obstacles = Obstacles2D.from_footprints(people_footprints(world.scene, world.tasks, world.robot))
-    people = [m for m in world.scene.movers if m.person]
-    assert len(people) == 8
     plan, _ = draw_people(world.scene.with_movers(()), world.tasks, world.robot, world.params,
                           people_rng(7, world.attempts - 1))
+    assert len(plan.starts) == 8
 
-    def walk():
+    def walk(router):
+        monkeypatch.setattr(crowd, "_route_finder", lambda cs, n, duration: router(cs))
         return crowd.simulate(obstacles, world.scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius,
                               plan.duration, depart=plan.depart, groups=plan.groups)
-    with_roadmap = walk()
-    monkeypatch.setattr(crowd, "Roadmap", Planner)
-    assert np.array_equal(walk(), with_roadmap)
+    with_roadmap = walk(Roadmap)
+    assert np.array_equal(walk(Planner), with_roadmap)
+    assert np.abs(np.diff(with_roadmap, axis=0)).max() > 0.01  # people walk
+
+
+def test_the_graph_is_built_for_many_legs_in_a_small_world_only():
+    cs = _space("cluttered", 0, {"size": [20.0, 20.0], "n_obstacles": 50}, 0.25)  # the benchmark's world
+    assert isinstance(crowd._route_finder(cs, 20, 60.0), Roadmap)
+    assert isinstance(crowd._route_finder(cs, 1, 60.0), Planner)  # one person: a few queries
+    big = _space("cluttered", 0, {"size": [40.0, 40.0], "n_obstacles": 200}, 0.25)
+    assert big.n_circles > crowd.ROADMAP_MAX_CIRCLES
+    assert isinstance(crowd._route_finder(big, 50, 60.0), Planner)
