@@ -34,9 +34,8 @@ __all__ = ["Roadmap"]
 
 #: Angles (rad) within this of each other count as one: the planner's tolerance on a sweep.
 EPS = 1e-9
-#: Chain keys: chain id times this plus the winding angle (< 2 pi + a hair), one sorted array for all.
-_SPAN = 8.0
-_TWO_PI = 2 * math.pi
+#: Chain keys: chain id times _SPAN plus the winding angle (< 2 pi + a hair), one sorted array for all.
+_SPAN, _TWO_PI = 8.0, 2 * math.pi
 #: A start tangent's clearance is tested together with those whose cost is within this (m) of it: one
 #: vectorised test for the few the search is about to reach.
 VERIFY_BAND = 1.0
@@ -204,8 +203,7 @@ class Roadmap:
         to = both.take(np.flatnonzero(~mine))
         ins = _Ends(self, both.take(np.flatnonzero(mine)), True)
         outs = _Ends(self, Tangents(to.dst, to.src, -to.s2, -to.s1, to.t, to.q, to.nt, to.nq, to.length), False)
-        gx, gy = float(goal[0]), float(goal[1])
-        px, py, hypot = self._px, self._py, math.hypot
+        gx, gy, px, py, hypot = float(goal[0]), float(goal[1]), self._px, self._py, math.hypot
         seed_f = ins.length + ins.sweep * self.cs.rho[ins.chain // 2]
         if len(self._points):
             seed_f = seed_f + np.hypot(self._points[ins.pos, 0] - gx, self._points[ins.pos, 1] - gy)
@@ -316,12 +314,12 @@ class Roadmap:
         if data[0] == "direct":
             _, a, b, sweep, _ = data
             contacts = [self._contact(int(tout.src[b]), int(tout.s1[b]), tin.nt[a], sweep)]
-            return Route(np.array([start, tin.t[a], tout.q[b], goal], dtype=float), tuple(contacts), float(length))
-        k, r_out, sweep = data
-        points = [goal, tout.q[r_out]]
-        contacts = []
+            points = [goal, tout.q[b], tin.t[a], start]
+        else:
+            k, r_out, sweep = data
+            points, contacts, t = [goal, tout.q[r_out]], [], self.tans
         # Walking back: at position k the path arrived on its chain; ``sweep`` ran from k to the way out.
-        while True:
+        while data[0] != "direct":
             prev, via = parent[k]
             ch = self._chain_l[k]
             side = 1 if ch % 2 == 0 else -1
@@ -330,12 +328,15 @@ class Roadmap:
                 contacts.append(self._contact(ch // 2, side, tin.nt[via], max(sweep, 0.0)))
                 points += [tin.t[via], start]
                 break
-            t = self.tans
             contacts.append(self._contact(ch // 2, side, t.nt[via], max(sweep, 0.0)))
             points += [t.t[via], t.q[via]]
             sweep = next(w for _, _, j, w in self._ways_out(prev)[4] if j == via)
             k = prev
-        return Route(np.array(points[::-1], dtype=float), tuple(contacts[::-1]), float(length))
+        # A contact with no sweep is the path passing straight by a circle (collinear grown edges): left out.
+        points, contacts = points[::-1], contacts[::-1]
+        keep = [k for k, c in enumerate(contacts) if c.sweep > EPS]
+        pts = [points[0]] + [p for k in keep for p in points[1 + 2 * k:3 + 2 * k]] + [points[-1]]
+        return Route(np.array(pts, dtype=float), tuple(contacts[k] for k in keep), float(length))
 
     @staticmethod
     def _contact(circle: int, side: int, normal: np.ndarray, sweep: float) -> Contact:
