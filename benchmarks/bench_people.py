@@ -7,8 +7,8 @@ For N = 10, 20 and 50 people and --worlds seeds (default 15): the whole of world
 it took, each drawing obstacles, walking the people and certifying the task), then, on the world it
 returned, its stages timed again on their own: the static world and its feasibility check without
 people, the people drawn and walked (generators.people + feasibility.crowd) and, within that walk, the
-people's exact route queries (feasibility.planner, timed call by call), the certificate
-(feasibility.timed). Medians over the worlds; the draws a world took and its arrival time beside them.
+people's routing (feasibility.roadmap: its tangent graph, and every exact route query, timed call by
+call), the certificate (feasibility.timed). Medians over the worlds; the draws a world took and its arrival time beside them.
 Pinned to one core (--all-cores to not pin). Target (issue 20): the whole, 20 people, median <= 150 ms.
 
 The table goes to stdout, the figures to benchmarks/results/people.json.
@@ -37,26 +37,33 @@ def _ms(fn) -> tuple[float, object]:
 
 
 class _Routing:
-    """Times every exact route query (``Planner.shortest``) made inside the ``with`` block."""
+    """Times the people's routing inside the ``with`` block: the tangent graph a walk builds once
+    (``Roadmap.__init__``), every exact route query (``Roadmap.shortest``, or ``Planner.shortest`` where
+    a walk is too short for the graph to pay), counted."""
 
     def __enter__(self):
         from worldgen.feasibility.planner import Planner
-        self.ms, self.calls, self._orig = 0.0, 0, Planner.shortest
+        from worldgen.feasibility.roadmap import Roadmap
+        self.ms, self.calls = 0.0, 0
+        self._orig = [(cls, name, getattr(cls, name)) for cls in (Roadmap, Planner) for name in ("shortest", "__init__")]
         outer = self
 
-        def timed(planner, start, goal):
-            t = time.perf_counter()
-            try:
-                return outer._orig(planner, start, goal)
-            finally:
-                outer.ms += (time.perf_counter() - t) * 1e3
-                outer.calls += 1
-        Planner.shortest = timed  # type: ignore[method-assign]
+        def timed(fn, count):
+            def call(*args):
+                t = time.perf_counter()
+                try:
+                    return fn(*args)
+                finally:
+                    outer.ms += (time.perf_counter() - t) * 1e3
+                    outer.calls += count
+            return call
+        for cls, name, fn in self._orig:
+            setattr(cls, name, timed(fn, int(name == "shortest")))
         return self
 
     def __exit__(self, *exc):
-        from worldgen.feasibility.planner import Planner
-        Planner.shortest = self._orig  # type: ignore[method-assign]
+        for cls, name, fn in self._orig:
+            setattr(cls, name, fn)
         return False
 
 

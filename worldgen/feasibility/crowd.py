@@ -5,11 +5,13 @@ Each person ``a`` accelerates as
 
     dv_a/dt = (v0_a e_a - v_a) / tau  +  sum_b w(e_a, r_b - r_a) f_ab  +  sum_B f_aB
 
-- ``e_a``: the unit direction to the next waypoint of a path planned for the person's disc by the
-  exact planner (:mod:`~worldgen.feasibility.planner`); a waypoint is passed when the next one is in
-  sight (checked every :data:`LOOK` steps), and the path is planned again from where the person
-  stands when its waypoint has been out of sight for :data:`REPLAN` checks (unless the waypoint
-  before it is in sight: then the person walks back to that one, which leads on); a person who has moved
+- ``e_a``: the unit direction to the next waypoint of the shortest path for the person's disc (exact;
+  a walk of many legs has them all answered by one tangent graph, :mod:`~worldgen.feasibility.roadmap`,
+  a short one asks :mod:`~worldgen.feasibility.planner` leg by leg); a waypoint is
+  passed when the next one is in sight (checked every :data:`LOOK` steps), and the path is planned
+  again from where the person stands when its waypoint has been out of sight for :data:`REPLAN`
+  checks (unless the waypoint before it is in sight: then the person walks back to that one, which
+  leads on); a person who has moved
   less than :data:`STUCK` m a look for ``2 x REPLAN`` looks in a row (held by others or by a wall's
   push near a place) gives that place up and walks to the next;
 - ``f_ab = -grad V(b)``, ``V = V0 exp(-(b - 2 r) / sigma)``, ``b`` the semi-minor axis of the
@@ -40,7 +42,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping, Optional, Sequence
+from typing import Any, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -48,11 +50,13 @@ from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.groups import GroupForce, group_force
 from worldgen.feasibility.planner import Planner
+from worldgen.feasibility.roadmap import Roadmap
 from worldgen.floats import round_float
 from worldgen.generators.people import PERSON_HEIGHT, SLACK, draw_people, people_footprints
 from worldgen.scene import Mover, Robot, Scene, Task
 
-__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF", "simulate", "walk_people"]
+__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF", "ROADMAP_ROWS_PER_PERSON_S",
+           "ROADMAP_MAX_CIRCLES", "simulate", "walk_people"]
 
 #: The integration step (s); the trajectories are written at it.
 DT = 0.1
@@ -67,6 +71,13 @@ ARRIVE = 0.2
 CUTOFF = 1.5
 #: Least distance (m) a walking person covers between two looks before it counts as held up.
 STUCK = 0.1
+#: When a walk's routes go over one tangent graph (:class:`Roadmap`) rather than a lazy planner query each
+#: (:class:`Planner`; the same paths): measured in the benchmark's world (137 corner circles), the graph
+#: costs about 0.67 us per candidate tangent (2 C^2 of them for C circles) and saves about 0.08 ms per
+#: person and second walked, so it pays from this many candidates per person-second; and only up to
+#: ROADMAP_MAX_CIRCLES (at 524 circles its build took 1.4 s and 0.5 GB, a query 2.5 ms against 2.7).
+ROADMAP_ROWS_PER_PERSON_S = 117
+ROADMAP_MAX_CIRCLES = 250
 
 
 @dataclass(frozen=True)
@@ -178,7 +189,7 @@ def _runs(who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class _Router:
     """Each person's places and the planned path to the current one; ``target`` the waypoint steered to."""
 
-    def __init__(self, planner: Planner, sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
+    def __init__(self, planner: Union[Roadmap, Planner], sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
         # Sight is tested in a configuration space SLACK thinner than the planner's: a waypoint on a
         # planner's circle is then in sight, not touching.
         self.planner, self.sight, self.places = planner, sight, places
@@ -284,7 +295,7 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
     if n == 0:
         return out
     walls = _Walls(obstacles, bounds)
-    router = _Router(Planner(ConfigSpace.build(obstacles, radius + SLACK, bounds)),
+    router = _Router(_route_finder(ConfigSpace.build(obstacles, radius + SLACK, bounds), n, duration),
                      ConfigSpace.build(obstacles, radius, bounds), starts, places)
     keep = radius + 2 * SLACK
     leave = np.zeros(n) if depart is None else np.asarray(depart, dtype=float)
@@ -315,6 +326,14 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
         v = (p_new - p) / dt
         p = out[k] = p_new
     return out
+
+
+def _route_finder(cs: ConfigSpace, n: int, duration: float):
+    """The router of a walk of ``n`` people for ``duration`` s: the one that costs less (both are exact)."""
+    c = cs.n_circles
+    if c <= ROADMAP_MAX_CIRCLES and 2 * c * c <= ROADMAP_ROWS_PER_PERSON_S * n * duration:
+        return Roadmap(cs)
+    return Planner(cs)
 
 
 def _people_force(p: np.ndarray, v: np.ndarray, e: np.ndarray, radius: float, m: SocialForce,

@@ -75,13 +75,14 @@ def every_side(src: np.ndarray, dst: np.ndarray, src_sides=(1, -1), dst_sides=(1
 
 
 def tangents(cs: ConfigSpace, src: np.ndarray, dst: np.ndarray, s1: np.ndarray, s2: np.ndarray,
-             src_xy=None, dst_xy=None, among=None) -> Tangents:
+             src_xy=None, dst_xy=None, among=None, clear: bool = True) -> Tangents:
     """The free common tangent from circle ``src[k]`` on side ``s1[k]`` to circle ``dst[k]`` on side ``s2[k]``.
 
     Circle ids of -1 stand for points: ``src_xy``/``dst_xy`` ((2,) or (m, 2)) give them.
     Kept: tangents that touch each circle inside its cone, run from the first to
     the second, and keep the clearance from every other obstacle (and the box);
-    ``among`` (ids), if given, holds every obstacle that could come near them.
+    ``among`` (ids), if given, holds every obstacle that could come near them. With ``clear=False`` the
+    clearance is not tested (the caller tests the few it needs, :meth:`ConfigSpace.segments_clear`).
     """
     src = np.asarray(src, dtype=np.int64)
     dst = np.asarray(dst, dtype=np.int64)
@@ -116,7 +117,7 @@ def tangents(cs: ConfigSpace, src: np.ndarray, dst: np.ndarray, s1: np.ndarray, 
     t = c2[rows] + r2[rows, None] * nt[rows]
     own1 = cs.owner[src[rows]] if src_xy is None else np.full(len(rows), -1)
     own2 = cs.owner[dst[rows]] if dst_xy is None else np.full(len(rows), -1)
-    free = cs.segments_clear(q, t, own1, own2, among=among)
+    free = cs.segments_clear(q, t, own1, own2, among=among) if clear else np.ones(len(rows), dtype=bool)
     keep = rows[free]
     q, t = q[free], t[free]
     seg = t - q
