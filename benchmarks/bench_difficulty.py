@@ -46,21 +46,6 @@ CONFIGS: tuple[tuple[str, dict], ...] = (
 )
 
 
-class _OneWorld:
-    """An environment source that hands out one in-memory world (so it is generated once, not per probe)."""
-
-    def __init__(self, world):
-        self.world_ = world
-
-    def __len__(self) -> int:
-        return 0
-
-    def world(self, seed):
-        from worldgen.envs.source import episode_world
-
-        return episode_world(self.world_)
-
-
 _ENV = None
 
 
@@ -92,6 +77,7 @@ def drive(job: tuple[int, int]) -> dict:
     import worldgen
     import worldgen.envs  # noqa: F401
     from worldgen.envs.probes import run_episode
+    from worldgen.envs.source import OneWorldSource
     from worldgen.errors import WorldgenError
 
     k, seed = job
@@ -104,7 +90,7 @@ def drive(job: tuple[int, int]) -> dict:
     rec.update(world_id=world.world_id, meta=_inputs(world))
     if _ENV is None:
         _ENV = gymnasium.make("worldgen/Navigation-v0", generator="minimal").unwrapped
-    _ENV.source = _OneWorld(world)
+    _ENV.source = OneWorldSource(world)
     for probe in PROBES:
         info = run_episode(_ENV, probe, seed=0, options={"world_seed": seed})
         rec[probe] = {"success": bool(info["success"]), "collided": bool(info["collisions"]),

@@ -16,21 +16,6 @@ from typing import Any, Mapping, Optional, Sequence
 __all__ = ["success_by_level", "ladder_figures"]
 
 
-class _OneWorld:
-    """An environment source that hands out one in-memory world (generated once, driven as it is)."""
-
-    def __init__(self, world):
-        self.world_ = world
-
-    def __len__(self) -> int:
-        return 0
-
-    def world(self, seed):
-        from worldgen.envs.source import episode_world
-
-        return episode_world(self.world_)
-
-
 def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int],
                      params: Optional[Mapping[str, Any]] = None, probe: str = "reactive") -> dict[int, list[bool]]:
     """``{level: [success of the probe in the world asked for with each seed]}``; a request that does not land
@@ -40,6 +25,7 @@ def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int]
     import worldgen
     import worldgen.envs  # noqa: F401  (registers the environment)
     from worldgen.envs.probes import run_episode
+    from worldgen.envs.source import OneWorldSource
     from worldgen.errors import InfeasibleError
 
     # The probes read neither the reward nor the geodesic field; the straight-line reward keeps the reset from
@@ -54,7 +40,7 @@ def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int]
                     world = worldgen.generate(generator, seed, difficulty=level, **dict(params or {}))
                 except InfeasibleError:
                     continue
-                env.source = _OneWorld(world)
+                env.source = OneWorldSource(world)
                 out[level].append(bool(run_episode(env, probe, seed=0)["success"]))
     finally:
         env.close()

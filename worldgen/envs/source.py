@@ -24,7 +24,7 @@ from typing import Any, Callable, Mapping, Optional
 from worldgen.errors import ParameterError, quoted
 from worldgen.scene import Robot
 
-__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "make_source"]
+__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "make_source"]
 
 
 @dataclass(eq=False)
@@ -176,6 +176,20 @@ class GeneratorSource:
                          **self.params)
         world.preset = self.preset
         return world
+
+
+class OneWorldSource:
+    """One in-memory world for every episode, driven as it is (the probes' yardsticks drive a world they
+    generated once: worldgen.envs.ladder, benchmarks/bench_difficulty.py); set it as an env's ``source``."""
+
+    def __init__(self, world):
+        self.world_ = world
+
+    def __len__(self) -> int:
+        return 0
+
+    def world(self, seed) -> EpisodeWorld:
+        return episode_world(self.world_)
 
 
 class PackSource:
