@@ -30,10 +30,16 @@ worlds:
 """
 
 
+def _sigint_as_in_a_terminal() -> None:
+    # A test run started in the background (`pytest &`) inherits SIGINT ignored, and so would the build;
+    # a build started from a terminal has it at its default.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def start(recipe: Path, pack: Path) -> tuple[subprocess.Popen, list[str]]:
     cmd = WORLDGEN + ["pack", "build", str(recipe), "--out", str(pack), "--jobs", str(JOBS)]
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True), cmd
+                            start_new_session=True, preexec_fn=_sigint_as_in_a_terminal), cmd
 
 
 def ctrl_c_after(proc: subprocess.Popen, pack: Path, records: int, then: float = 0.0) -> tuple[float, str]:
