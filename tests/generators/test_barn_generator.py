@@ -237,3 +237,26 @@ def test_a_parameter_mistake_is_one_line(setting, says, tmp_path):
 def test_a_field_too_full_to_cross_is_refused_with_the_reason(tmp_path):
     res = run("generate", "barn", "--set", "fill_fraction=0.9", "--set", "max_attempts=5", "--out", tmp_path)
     assert res.returncode == 3 and "field_blocked failed 5x" in res.stderr, res.stderr
+
+
+def test_the_crossing_screen_agrees_with_scipy_s_dilation_and_labelling():
+    """crossing_blocked grows the field and walks its free cells with numpy alone (scipy is not a core
+    dependency); scipy.ndimage's binary_dilation and 8-connected label are the reference, on 500 random
+    fields, cells and discs."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(11)
+    for _ in range(500):
+        rows, cols = rng.integers(2, 40, 2)
+        grid = rng.random((rows, cols)) < rng.uniform(0.0, 0.6)
+        cell, inflation = float(rng.uniform(0.05, 0.5)), float(rng.uniform(0.0, 1.0))
+        reach = inflation - cell / math.sqrt(2.0)
+        blocked = grid
+        if reach >= 0:
+            k = int(math.floor(reach / cell + 0.5)) + 1
+            o = np.abs(np.arange(-k, k + 1))
+            structure = np.hypot(np.maximum(o[None, :] - 0.5, 0) * cell, np.maximum(o[:, None] - 0.5, 0) * cell) <= reach
+            blocked = ndimage.binary_dilation(grid, structure=structure) | grid
+        labels, _ = ndimage.label(~blocked, structure=np.ones((3, 3), dtype=bool))
+        expected = not (set(labels[0][labels[0] > 0].tolist()) & set(labels[-1][labels[-1] > 0].tolist()))
+        assert crossing_blocked(grid, cell, inflation) == expected

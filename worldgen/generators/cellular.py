@@ -16,14 +16,13 @@ starts and stops).
 from __future__ import annotations
 
 import math
+from collections import deque
 
 import numpy as np
-from scipy import ndimage
 
 __all__ = ["random_fill", "neighbours", "smooth", "automaton", "merge_boxes", "crossing_blocked"]
 
 #: The eight neighbours of a cell, for labelling regions a disc can move between.
-_EIGHT = np.ones((3, 3), dtype=bool)
 
 
 def random_fill(rng: np.random.Generator, rows: int, cols: int, fraction: float) -> np.ndarray:
@@ -117,7 +116,37 @@ def crossing_blocked(grid: np.ndarray, cell: float, inflation: float) -> bool:
         dx = np.maximum(np.abs(offsets)[None, :] - 0.5, 0.0) * cell
         dy = np.maximum(np.abs(offsets)[:, None] - 0.5, 0.0) * cell
         structure = np.hypot(dx, dy) <= reach
-        blocked = ndimage.binary_dilation(g, structure=structure) | g
-    labels, _ = ndimage.label(~blocked, structure=_EIGHT)
-    first, last = set(labels[0][labels[0] > 0].tolist()), set(labels[-1][labels[-1] > 0].tolist())
-    return not (first & last)
+        blocked = _dilate(g, structure)
+    return not _rows_joined(~blocked)
+
+
+def _dilate(grid: np.ndarray, structure: np.ndarray) -> np.ndarray:
+    """``grid`` grown by the (2k + 1)-square ``structure`` centred on each filled cell (cells beyond the
+    edges are not filled)."""
+    rows, cols = grid.shape
+    k = structure.shape[0] // 2
+    padded = np.zeros((rows + 2 * k, cols + 2 * k), dtype=bool)
+    out = grid.copy()
+    padded[k:k + rows, k:k + cols] = grid
+    for dr, dc in zip(*np.nonzero(structure)):
+        out |= padded[2 * k - dr:2 * k - dr + rows, 2 * k - dc:2 * k - dc + cols]
+    return out
+
+
+def _rows_joined(free: np.ndarray) -> bool:
+    """True when a chain of free cells, each one of the eight neighbours of the last, joins the first row
+    to the last (a breadth-first walk from the free cells of the first row)."""
+    rows, cols = free.shape
+    seen = np.zeros_like(free)
+    queue = deque((0, c) for c in np.flatnonzero(free[0]).tolist())
+    seen[0, free[0]] = True
+    while queue:
+        r, c = queue.popleft()
+        if r == rows - 1:
+            return True
+        for rr in (r - 1, r, r + 1):
+            for cc in (c - 1, c, c + 1):
+                if 0 <= rr < rows and 0 <= cc < cols and free[rr, cc] and not seen[rr, cc]:
+                    seen[rr, cc] = True
+                    queue.append((rr, cc))
+    return False
