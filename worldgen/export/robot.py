@@ -34,6 +34,7 @@ geometry); Gazebo spawns the SDF. Both are bytes-stable: same world and argument
 from __future__ import annotations
 
 import math
+from typing import Mapping
 
 from lxml import etree
 
@@ -75,11 +76,18 @@ class Dimensions:
         self.chassis_bottom = self.caster_radius
 
 
+def _meta(world) -> Mapping:
+    """world.json's content: a :class:`~worldgen.World`'s metadata, or a world.json already read."""
+    return world if isinstance(world, Mapping) else world.metadata
+
+
 def dimensions(world) -> Dimensions:
-    """The robot's :class:`Dimensions` for ``world`` (its ``robot`` footprint and world.json's lidar height)."""
-    lidar = world.metadata["sensors"]["lidar"]
-    spawn_z = world.metadata["tasks"][0]["spawn"][2]
-    return Dimensions(float(world.robot.radius), float(world.robot.height), float(lidar["pose"][2]) - float(spawn_z))
+    """The robot's :class:`Dimensions` for ``world`` (a World or world.json's content): its ``robot``
+    footprint and world.json's lidar height above the first spawn."""
+    meta = _meta(world)
+    lidar, robot = meta["sensors"]["lidar"], meta["robot"]
+    spawn_z = meta["tasks"][0]["spawn"][2]
+    return Dimensions(float(robot["radius"]), float(robot["height"]), float(lidar["pose"][2]) - float(spawn_z))
 
 
 def _release(gz_release: str) -> tuple[str, str]:
@@ -231,7 +239,7 @@ def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: fl
 
 def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_release: str = "harmonic",
               sensors: bool = True, lidar_rate: float = 10.0, odom_rate: float = 50.0) -> str:
-    """``robot.sdf`` (SDFormat 1.9, one ``<model>``) of the robot for ``world``.
+    """``robot.sdf`` (SDFormat 1.9, one ``<model>``) of the robot for ``world`` (a World or world.json's content).
 
     ``lidar_noise``: the lidar's Gaussian noise, standard deviation in m (0: exact ranges);
     ``gz_release``: whose plugin names the systems get (``fortress``, ``garden``, ``harmonic``, ``ionic``);
@@ -251,7 +259,7 @@ def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_r
         _el("pose", fmt_seq((0, 0, -d.wheel_radius, 0, 0, 0)), relative_to="base_link"))
     _sdf_links(model, d)
     if sensors:
-        _sdf_sensors(model, d, world.metadata["sensors"]["lidar"], float(lidar_noise), float(lidar_rate))
+        _sdf_sensors(model, d, _meta(world)["sensors"]["lidar"], float(lidar_noise), float(lidar_rate))
     _sdf_plugins(model, d, name, gz_release, float(odom_rate))
     return to_bytes(root).decode()
 
