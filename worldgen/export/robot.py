@@ -44,7 +44,7 @@ from worldgen.floats import fmt, fmt_seq
 
 __all__ = ["DEFAULT_NAME", "GZ_RELEASES", "LIDAR_WINDOW", "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
 
-#: The model's name: the ROS 2 bundle's robot (worldgen.export.ros2.DEFAULT_ROBOT_NAME).
+#: The model's name: the ROS 2 bundle's robot (worldgen.ros.bundle.DEFAULT_ROBOT_NAME).
 DEFAULT_NAME = "robot"
 #: How each Gazebo release names a model system's plugin (file, class): Fortress keeps the ignition names.
 GZ_RELEASES = {"fortress": ("ignition-gazebo-{}-system", "ignition::gazebo::systems::{}"),
