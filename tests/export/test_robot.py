@@ -18,8 +18,8 @@ from support.reftools_urdf import check_urdf
 import worldgen
 from worldgen.errors import ParameterError
 from worldgen.export import robot as robot_export
-from worldgen.ros.bundle import DEFAULT_ROBOT_NAME
 from worldgen.export.xml import parse_bytes
+from worldgen.ros.bundle import DEFAULT_ROBOT_NAME
 
 
 def _world(**params):
