@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from worldgen.files import METADATA_NAME
 from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboServer, locate
 
 __all__ = ["gazebo_scan", "edge_rays", "EDGE_JUMP"]
@@ -40,7 +41,7 @@ def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> np
     from worldgen.sim.textproto import first
 
     folder = Path(world)
-    meta = json.loads((folder / "world.json").read_text(encoding="utf-8"))
+    meta = json.loads((folder / METADATA_NAME).read_text(encoding="utf-8"))
     spawn = meta["tasks"][0]["spawn"]
     install = locate()
     env = {**install.env, "IGN_PARTITION": f"worldgen_scan_{os.getpid()}"}
