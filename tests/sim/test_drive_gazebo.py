@@ -39,10 +39,11 @@ def worlds(tmp_path_factory) -> dict[str, Path]:
     return {g: worldgen.generate(g, seed=1).write(out, preview=False) for g in GENERATORS}
 
 
-def test_one_scan_agrees_with_world_json_and_misses_only_on_edges(worlds):
+@pytest.mark.parametrize("generator", ["cluttered", "minimal"])
+def test_one_scan_agrees_with_world_json_and_misses_only_on_edges(worlds, generator):
     from worldgen.sim.scan import edge_rays, gazebo_scan
 
-    folder = worlds["cluttered"]
+    folder = worlds[generator]
     truth = np.array(json.loads((folder / "world.json").read_text())["sensors"]["lidar"]["ranges"])
     got = gazebo_scan(folder)
     assert got.shape == truth.shape

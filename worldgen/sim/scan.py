@@ -5,7 +5,8 @@
 
 The world runs with the Sensors system (ogre2, EGL: ``--headless-rendering``), the robot
 (:mod:`worldgen.export.robot`) is spawned at the first task's spawn, the world steps until the lidar
-has published, and the first ``/scan`` is returned. :func:`edge_rays` names the rays that graze an
+has published, and the first ``/scan`` is returned, a ray that hit nothing at ``range_max`` as world.json
+writes it (Gazebo publishes +inf there). :func:`edge_rays` names the rays that graze an
 obstacle's edge: where the true range jumps between neighbouring rays, a renderer's depth
 resolution and its sub-pixel sampling put the ray on either side of the jump.
 """
@@ -68,7 +69,8 @@ def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> np
     ranges = np.array([float(r) for r in got[0].get("ranges", [])])
     if len(ranges) != int(first(got[0], "count", len(ranges))):
         raise GazeboError(f"/scan held {len(ranges)} ranges for a count of {first(got[0], 'count')}")
-    return ranges
+    # Gazebo reports +inf for a ray that hits nothing (REP 117); world.json writes range_max there.
+    return np.where(np.isposinf(ranges), float(meta["sensors"]["lidar"]["range_max"]), ranges)
 
 
 def edge_rays(truth) -> np.ndarray:
