@@ -114,3 +114,11 @@ def test_a_folder_without_world_json_and_an_existing_run_are_refused(worlds, tmp
     assert run_cli("drive", worlds["minimal"], "--out", tmp_path / "o").returncode == 0
     again = run_cli("drive", worlds["minimal"], "--out", tmp_path / "o")
     assert again.returncode == 2 and "exists already" in again.stderr
+
+
+def test_gazebo_missing_is_one_line_naming_how_to_install(worlds, tmp_path, monkeypatch):
+    monkeypatch.setenv("WORLDGEN_GAZEBO_SETUP", str(tmp_path / "no-such-setup.sh"))
+    result = run_cli("drive", worlds["minimal"], "--sim", "gazebo", "--out", tmp_path / "o")
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and "install Gazebo" in result.stderr
+    assert not (tmp_path / "o").exists()

@@ -23,7 +23,7 @@ Examples:
 """)
 @click.argument("world", type=click.Path(path_type=Path), metavar="WORLD")
 @click.option("--sim", type=click.Choice(["gazebo", "mujoco"]), default="mujoco", show_default=True,
-              help="The simulator: Gazebo Fortress headless (docs/gazebo.md), or MuJoCo.")
+              help="The simulator: Gazebo Fortress headless, or MuJoCo (docs/drive.md).")
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Where the run's bag folder is written (DIR/<world id>-<task>-<sim>).")
 @click.option("--task", metavar="ID", help="The task to drive [default: the world's first].")
