@@ -1,10 +1,12 @@
 """``worldgen drive``: a robot drives a task's reference path in a simulator, the run is recorded as a rosbag2
 bag and judged, the loop of a Gazebo + nav2 test closed without ROS.
 
-    >>> from worldgen.sim.drive import drive                               # doctest: +SKIP
-    >>> outcome = drive("worlds/cluttered-s0-55fec0f6", "runs", sim="mujoco")
-    >>> outcome.passed, outcome.verdict
-    (True, 'reached the goal ...')
+    >>> import worldgen
+    >>> from worldgen.sim.drive import drive
+    >>> folder = worldgen.generate("minimal", seed=2).write("worlds", preview=False)
+    >>> outcome = drive(folder, "runs", sim="mujoco")            # or sim="gazebo"
+    >>> outcome.passed, outcome.ended, outcome.run["collisions"], outcome.bag.name
+    (True, 'goal', [], 'minimal-s2-...-task_0-mujoco')
 
 The controller is pure pursuit with differential-drive (unicycle) kinematics, fed back from the
 simulator's own pose of the robot every control step: a forward speed along the heading and a turn

@@ -1,7 +1,7 @@
-"""One scan of the robot's gpu_lidar in Gazebo at a task's spawn, to hold against world.json's ground truth.
+"""One scan of the robot's gpu_lidar in Gazebo at a task's spawn, to hold against world.json's ground truth::
 
-    >>> from worldgen.sim.scan import gazebo_scan                          # doctest: +SKIP
-    >>> ranges = gazebo_scan("worlds/cluttered-s0-55fec0f6")                # world.json's rays, m
+    from worldgen.sim.scan import gazebo_scan
+    ranges = gazebo_scan("worlds/cluttered-s0-55fec0f6")     # world.json's rays, m (needs Gazebo)
 
 The world runs with the Sensors system (ogre2, EGL: ``--headless-rendering``), the robot
 (:mod:`worldgen.export.robot`) is spawned at the first task's spawn, the world steps until the lidar
