@@ -114,6 +114,9 @@ def test_a_folder_without_world_json_and_an_existing_run_are_refused(worlds, tmp
     assert run_cli("drive", worlds["minimal"], "--out", tmp_path / "o").returncode == 0
     again = run_cli("drive", worlds["minimal"], "--out", tmp_path / "o")
     assert again.returncode == 2 and "exists already" in again.stderr
+    (tmp_path / "file").write_text("x")
+    onto_a_file = run_cli("drive", worlds["minimal"], "--out", tmp_path / "file")
+    assert onto_a_file.returncode == 2 and "is not a folder" in onto_a_file.stderr
 
 
 def test_gazebo_missing_is_one_line_naming_how_to_install(worlds, tmp_path, monkeypatch):
