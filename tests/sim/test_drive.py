@@ -125,3 +125,19 @@ def test_gazebo_missing_is_one_line_naming_how_to_install(worlds, tmp_path, monk
     assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
     assert len(result.stderr.strip().splitlines()) == 1 and "install Gazebo" in result.stderr
     assert not (tmp_path / "o").exists()
+
+
+def test_an_unwritable_cache_is_one_line(tmp_path, monkeypatch):
+    from worldgen.errors import OutputError
+    from worldgen.sim import bridge
+
+    if bridge.shutil.which("g++") is None or bridge.shutil.which("pkg-config") is None:
+        pytest.skip("no compiler here: the build stops before the cache")
+    blocker = tmp_path / "cache"
+    blocker.write_text("a file where the cache folder would go")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
+    try:
+        with pytest.raises(OutputError, match="XDG_CACHE_HOME"):
+            bridge.build_bridge()
+    except bridge.GazeboMissingError:
+        pytest.skip("no ign-transport headers here")

@@ -22,6 +22,7 @@ from pathlib import Path
 
 from lxml import etree
 
+from worldgen.errors import OutputError
 from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboMissingError, GazeboServer, locate
 
 __all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "GazeboBackend", "world_step"]
@@ -51,16 +52,20 @@ def build_bridge(env: dict[str, str] | None = None) -> Path:
     exe = cache_dir() / f"drive_bridge-{digest}"
     if exe.exists():
         return exe
-    exe.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=exe.parent) as tmp:
-        src = Path(tmp) / SOURCE_NAME
-        src.write_bytes(source)
-        out = Path(tmp) / "drive_bridge"
-        cmd = [compiler, "-O2", "-std=c++17", "-pthread", str(src), "-o", str(out), *flags.stdout.split()]
-        built = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
-        if built.returncode != 0:
-            raise GazeboError(f"building the Gazebo drive bridge failed: {built.stderr.strip()[:500]}")
-        os.replace(out, exe)  # a rename: a parallel run never starts half a binary
+    try:
+        exe.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=exe.parent) as tmp:
+            src = Path(tmp) / SOURCE_NAME
+            src.write_bytes(source)
+            out = Path(tmp) / "drive_bridge"
+            cmd = [compiler, "-O2", "-std=c++17", "-pthread", str(src), "-o", str(out), *flags.stdout.split()]
+            built = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
+            if built.returncode != 0:
+                raise GazeboError(f"building the Gazebo drive bridge failed: {built.stderr.strip()[:500]}")
+            os.replace(out, exe)  # a rename: a parallel run never starts half a binary
+    except OSError as exc:
+        raise OutputError(f"cannot build the Gazebo drive bridge in '{exe.parent}' ({exc.strerror or exc}); "
+                          "set XDG_CACHE_HOME to a writable folder") from None
     return exe
 
 
