@@ -141,3 +141,21 @@ def test_an_unwritable_cache_is_one_line(tmp_path, monkeypatch):
             bridge.build_bridge()
     except bridge.GazeboMissingError:
         pytest.skip("no ign-transport headers here")
+
+
+def test_movers_follow_their_scripts_in_mujoco(tmp_path):
+    from worldgen.envs.movers import MoverScript
+    from worldgen.sim.mujoco import MujocoBackend
+
+    folder = worldgen.generate("cluttered", seed=2, n_movers=3).write(tmp_path, preview=False)
+    meta = json.loads((folder / "world.json").read_text())
+    backend = MujocoBackend(folder / meta["files"]["mjcf"]["path"], meta)
+    spawn = meta["tasks"][0]["spawn"]
+    backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
+    t, *_ = backend.step(0.0, 0.0, 500)
+    script = MoverScript(meta["dynamic_obstacles"])
+    # The last placement was for the last step's start, one step before t.
+    expected = script.positions(np.array([t - backend.dt]))[0]
+    placed = backend._sim.data.mocap_pos[backend._sim.mocap, :2]
+    assert placed == pytest.approx(expected, abs=1e-9)
+    assert not np.allclose(expected, script.positions(np.zeros(1))[0])  # they did move
