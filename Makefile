@@ -9,7 +9,7 @@ ROS_STAMP := $(VENV)/.installed-ros
 TRAIN_STAMP := $(VENV)/.installed-train
 DEMO_OUT ?= demo-worlds
 
-.PHONY: demo test bench bench-learning fuzz clean
+.PHONY: demo test test-gazebo bench bench-learning fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -51,6 +51,12 @@ test: $(TEST_STAMP)
 	$(VENV)/bin/ruff check worldgen tests benchmarks examples
 	$(VENV)/bin/mypy
 	$(PY) -m pytest -q
+
+## test-gazebo: only the tests that load and step every kind of world in a real Gazebo server (tests/sim,
+## marker `gazebo`; also part of `make test`); Gazebo from WORLDGEN_GAZEBO_SETUP or /opt/gz-fortress2
+## (docs/gazebo.md)
+test-gazebo: $(TEST_STAMP)
+	$(PY) -m pytest -q -m gazebo tests/sim
 
 ## bench: per-stage medians for cluttered worlds against the serialisation floor, a 1,000-world pack
 ## with --jobs 2, the RL environment's steps/s and reset split, BARN's metrics against worldgen's
