@@ -23,7 +23,7 @@ from pathlib import Path
 from lxml import etree
 
 from worldgen.errors import OutputError
-from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboMissingError, GazeboServer, locate
+from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate
 
 __all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "GazeboBackend", "world_step"]
 
@@ -76,16 +76,6 @@ def world_step(sdf_path: Path) -> float:
     return float(text) if text else 0.001
 
 
-class _BridgeWaitedServer(GazeboServer):
-    """The harness's server, not waited for here: the bridge's spawn waits on the world's create service
-    itself every 0.1 s, where each of the harness's tries is an ``ign service`` process (0.1 to 2 s); the
-    bridge's first answer proves the world up. Everything else (start, stop, the log) is the harness's."""
-
-    def _wait_up(self, started: float) -> None:
-        if self._proc is None or self._proc.poll() is not None:
-            raise GazeboError(f"Gazebo exited while loading {self.world_sdf}: {self.problems()[:5]}")
-
-
 class GazeboBackend:
     """The robot in a headless Gazebo: :meth:`start` spawns it, :meth:`step` drives it N physics steps.
 
@@ -106,11 +96,10 @@ class GazeboBackend:
     def start(self, spawn: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
         """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
         install = locate()
-        # A partition of its own: another Gazebo on the machine (a parallel test, a user's) never shares our topics.
-        env = {**install.env, "IGN_PARTITION": f"worldgen_drive_{os.getpid()}_{id(self)}"}
-        exe = build_bridge(env)
-        self._server = _BridgeWaitedServer(self.world_sdf, install=GazeboInstall(install.setup, env, install.version))
-        self._server.start()
+        exe = build_bridge(install.env)
+        self._server = GazeboServer(self.world_sdf, install=install).start()
+        # The server's environment carries its own IGN_PARTITION: the bridge must share it.
+        env = self._server.env
         self._model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
         self._model.write(self._robot_sdf)
         self._model.flush()

@@ -5,9 +5,8 @@
 // Fortress's ign-transport has no Python bindings, and one `ign service` call costs a process start
 // (about 0.1 s), so a controller at 50 Hz cannot drive through the `ign` command. This program stays up
 // for a whole run. It first spawns the model in MODEL_SDF (a file) as NAME at (X, Y, Z, YAW) through
-// /world/WORLD/create, asking every 0.1 s until the server (started paused) serves it, so the server's
-// start-up is waited on at that granularity without a process per try. Then it speaks lines on
-// stdin/stdout:
+// /world/WORLD/create (one request, answered within 30 s; the server is up and paused), which saves the
+// `ign service` process a spawn would otherwise cost. Then it speaks lines on stdin/stdout:
 //
 //   in:  "s N V W"   publish Twist(linear.x = V, angular.z = W) on CMD_TOPIC, run N physics steps
 //                    (WorldControl multi_step on /world/WORLD/control, the world stays paused), wait
@@ -72,7 +71,9 @@ int Fail(const std::string &_why)
   return 1;
 }
 
-// Create the model once the world serves its create service (60 s at most); false when it never does.
+// Create the model through the world's create service; false when it refuses or does not answer in 30 s.
+// One request only: a request given up early could still be served, and a second one would then be
+// refused for the name taken.
 bool Spawn(ignition::transport::Node &_node, const std::string &_world, char **_argv)
 {
   std::ifstream file(_argv[5]);
@@ -90,15 +91,9 @@ bool Spawn(ignition::transport::Node &_node, const std::string &_world, char **_
   pose->mutable_orientation()->set_z(std::sin(yaw / 2));
   pose->mutable_orientation()->set_w(std::cos(yaw / 2));
   const std::string service = "/world/" + _world + "/create";
-  for (int i = 0; i < 600; ++i)
-  {
-    ignition::msgs::Boolean reply;
-    bool result = false;
-    if (_node.Request(service, request, 100, reply, result))
-      return result && reply.data();
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  return false;
+  ignition::msgs::Boolean reply;
+  bool result = false;
+  return _node.Request(service, request, 30000, reply, result) && result && reply.data();
 }
 }  // namespace
 
