@@ -15,6 +15,7 @@ __all__ = [
     "SceneError",
     "OutputError",
     "MissingDependencyError",
+    "BagError",
     "quoted",
     "did_you_mean",
     "read_user_text",
@@ -72,6 +73,13 @@ class MissingDependencyError(WorldgenError, ImportError):
 
     Here rather than beside one feature, so every stage with an optional extra (testing's statistics,
     the environments) raises the same class.
+    """
+
+
+class BagError(WorldgenError, ValueError):
+    """A recorded run (a bag) cannot be used: missing, not a bag, truncated, or holding no pose source.
+
+    The reader library's own exceptions never reach a caller: they are re-raised as this, with the reason.
     """
 
 
