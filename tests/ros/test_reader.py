@@ -233,7 +233,7 @@ test_msgs/msg/BasicTypes_Response[<=1] response
 def _foreign_bag(path, kind: str, storage: str):
     """A bag as rosbag2's own tests record them: /rosout only, a std_msgs/String chatter, or service events."""
     from rosbags.rosbag2 import StoragePlugin, Writer
-    from rosbags.typesys import Stores, get_typestore, get_types_from_msg
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
     store = get_typestore(Stores.ROS2_JAZZY)
     if kind == "events":

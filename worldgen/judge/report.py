@@ -29,7 +29,7 @@ from worldgen.errors import OutputError
 __all__ = ["write_report", "RUN_COLUMNS", "draw_run", "COLOURS"]
 
 #: Columns of report.csv, in order; any other key of a row follows, sorted.
-RUN_COLUMNS = ["run", "bag", "readable", "world_id", "task", "source", "start", "start_time", "success", "reason",
+RUN_COLUMNS = ["run", "bag", "outcome", "readable", "world_id", "task", "source", "start", "start_time", "success", "reason",
                "reached_goal", "time_to_goal", "duration", "path_length", "path_efficiency", "min_clearance",
                "collisions", "min_separation", "max_velocity", "drift_bounded", "source_detail", "picture"]
 #: RGB of the picture's layers (the reference path and markers as preview.png draws them).
@@ -74,7 +74,7 @@ def _markdown(report: dict) -> str:
     s = report["summary"]
     out = [f"# Run report: {'PASS' if report['passed'] else 'FAIL'}", ""]
     out.append(f"{s.get('bags', s.get('runs'))} bags, {s.get('runs', 0)} runs judged, {s.get('successes', 0)} succeeded, "
-               f"{s.get('unreadable', 0)} unreadable.")
+               f"{s.get('unjudged', 0)} unjudged (no verdict: left out of every rate).")
     out.append("")
     if report["failures"]:
         out += ["## Failures", ""] + [f"- {f}" for f in report["failures"]] + [""]
@@ -94,13 +94,13 @@ def _markdown(report: dict) -> str:
     elif isinstance(per_world, list) and per_world:
         keys = sorted({k for v in per_world for k in v})
         out += ["## Per world", ""] + _table(keys, [[_cell(v.get(k)) for k in keys] for v in per_world]) + [""]
-    head = ["run", "world", "task", "source", "success", "reason", "time to goal (s)", "path eff.", "min clearance (m)",
+    head = ["run", "world", "task", "source", "outcome", "reason", "time to goal (s)", "path eff.", "min clearance (m)",
             "contacts", "picture"]
     rows = []
     for r in report["runs"]:
         pic = f"[png]({r['picture']})" if r.get("picture") else ""
         rows.append([str(r.get("run")), _cell(r.get("world_id")), _cell(r.get("task")), _cell(r.get("source")),
-                     "yes" if r.get("success") else "no", _cell(r.get("reason")), _cell(r.get("time_to_goal")),
+                     _cell(r.get("outcome")), _cell(r.get("reason")), _cell(r.get("time_to_goal")),
                      _cell(r.get("path_efficiency")), _cell(r.get("min_clearance")), str(len(r.get("collisions") or [])), pic])
     out += ["## Runs", ""] + _table(head, rows) + [""]
     return "\n".join(out)

@@ -58,7 +58,8 @@ from worldgen.ros.bagio import (
 )
 from worldgen.ros.deps import require_rosbags
 
-__all__ = ["BagRun", "RunMismatchError", "read_run", "bag_metadata", "peek_metadata", "START_RULES", "GOAL_TOPICS", "MOTION_START"]
+__all__ = ["BagRun", "RunMismatchError", "read_run", "bag_metadata", "peek_metadata", "START_RULES", "GOAL_TOPICS",
+           "MOTION_START"]
 
 START_RULES = ("command", "goal", "motion", "bag")
 #: Where a goal shows: RViz's and nav2's goal topic, and the navigate_to_pose action's topics as recorded.
