@@ -259,3 +259,27 @@ def test_the_progress_bar_goes_to_stderr_when_asked(setup, tmp_path):
     assert r.returncode == 0 and r.stderr.splitlines() == ["judging: 1 of 2 bags (50%)", "judging: 2 of 2 bags (100%)"]
     quiet = run("judge", setup["clean"], "--world", setup["world"], "--out", tmp_path / "q")
     assert quiet.returncode == 0 and quiet.stderr == ""  # not a terminal: no bar
+
+
+def test_a_run_among_people_is_drawn_with_the_people_where_they_were_at_the_contact(tmp_path):
+    """The caption said 'collision with person_0 at t=4.55 s' over an empty line: now the person is drawn."""
+    from worldgen.export.preview import layout
+    from worldgen.export.topdown import PERSON_COLOURS, discs_at
+    from worldgen.judge.report import _HEADER, _WIDTH
+    from worldgen.presets import generate_preset
+
+    world = generate_preset("person_head_on").write(tmp_path / "worlds", preview=False)
+    bag = write_bag(tmp_path / "bags" / "straight", world, along(world), storage="mcap")  # no yielding: it meets the person
+    r = run("judge", bag, "--world", world, "--out", tmp_path / "r")
+    assert r.returncode == 1
+    row = _report(tmp_path / "r")["runs"][0]
+    person = next(c for c in row["collisions"] if c["entity"] == "person_0")
+    meta = oracles.load(world).meta
+    (_, x, y, radius, colour), = [d for d in discs_at(meta, person["time"]) if d[0] == "person_0"]
+    assert colour == PERSON_COLOURS[0]
+    lay = layout(meta, _WIDTH)
+    with Image.open(tmp_path / "r" / row["picture"]) as img:
+        rgb = img.convert("RGB")
+        u, v = lay.px(x + 0.6 * radius, y)  # inside the person's disc, off the crossed-out robot at its centre
+        assert rgb.getpixel((round(u), round(v) + _HEADER)) == PERSON_COLOURS[0]
+        assert {c for _, c in rgb.getcolors(1 << 20)} >= {PERSON_COLOURS[0], (200, 30, 30)}
