@@ -75,7 +75,8 @@ def test_the_manifest_records_each_worlds_level_and_the_pack_verifies(tmp_path):
     manifest = json.loads((out / "manifest.json").read_text())
     assert [w["level"] for w in manifest["worlds"]] == [1, 1, 4, 4, 6, 7]
     for w in manifest["worlds"]:
-        meta = json.loads((out / "worlds" / w["world_id"] / "world.json").read_text())
+        folder = f"L{w['level']}-r{w['request_seed']}--{w['world_id']}"  # the level and request seed, then the id
+        meta = json.loads((out / "worlds" / folder / "world.json").read_text())
         assert meta["metrics"]["difficulty_level"] == w["level"]
         # The world's own seed is the draw that landed; the request's seed is kept beside it.
         assert meta["seed"] == w["seed"] and meta["difficulty_request"]["seed"] == w["request_seed"]

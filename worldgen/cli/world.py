@@ -207,7 +207,10 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
         failed = ",".join(c.name for c in world.feasibility.failed())
         verdict = f"\tinfeasible: {failed}" if failed else ""
-        click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}{verdict}")
+        request = world.difficulty_request  # a level request: the level, its seed and every draw it took
+        tried = (f"level {request['level']}, request seed {request['seed']}\tdraws {len(request['draws'])}" if request
+                 else f"attempts {world.attempts}")
+        click.echo(f"{folder}\tpath {lengths} m\t{tried}{verdict}")
 
 
 @click.command("preview", context_settings=_CONTEXT)
