@@ -110,10 +110,15 @@ def _markdown(report: dict) -> str:
 _HEADER = 54
 
 
-def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict):
+#: Worlds whose picture is kept while a report is drawn (runs usually come grouped by world).
+_WORLDS_KEPT = 4
+
+
+def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict, worlds: Optional[dict] = None):
     """The run's picture (a Pillow image): the world as preview.png draws it from world.json (walls, obstacles,
     no-go zone, reference path, spawn and goal, movers' and people's tracks), the run over it, and at each
-    contact who was where, all with :mod:`worldgen.export.topdown`; a header with the run and its verdict."""
+    contact who was where, all with :mod:`worldgen.export.topdown`; a header with the run and its verdict.
+    ``worlds`` keeps each world's picture between runs (it costs tens of ms to draw)."""
     from PIL import Image, ImageDraw
 
     from worldgen.export.preview import draw, layout
@@ -121,14 +126,21 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
     from worldgen.export.topdown import draw_run as draw_trajectory
     from worldgen.groundtruth.ground import load
 
-    meta = load(world).meta
-    lay = layout(meta, _WIDTH)
-    picture = draw(meta, _WIDTH)
+    worlds = {} if worlds is None else worlds
+    key = str(Path(world).resolve())
+    if key not in worlds:
+        ground = load(world)
+        worlds[key] = (ground, layout(ground.meta, _WIDTH), draw(ground.meta, _WIDTH))
+        while len(worlds) > _WORLDS_KEPT:
+            worlds.pop(next(iter(worlds)))
+    ground, lay, background = worlds[key]
+    meta = ground.meta
+    picture = background.copy()
     draw_trajectory(Pen(picture, lay), meta, trajectory, bool(row.get("success")), row.get("collisions") or [])
     canvas = Image.new("RGB", (picture.width, picture.height + _HEADER), COLOURS["background"])
     canvas.paste(picture, (0, _HEADER))
     pen = ImageDraw.Draw(canvas)
-    t = load(world).task(task)
+    t = ground.task(task)
     colour = COLOURS["run_ok"] if row.get("success") else COLOURS["run"]
     verdict = "success" if row.get("success") else f"FAIL: {row.get('reason') or ''}"
     pen.text((6, 3), f"{row.get('run')}   task {t['id']}   source: {row.get('source')}", fill=COLOURS["text"],
@@ -150,11 +162,12 @@ def write_report(result, out) -> Path:
         shutil.rmtree(tmp, ignore_errors=True)
         (tmp / "runs").mkdir(parents=True)
         report = result.report
+        worlds: dict = {}
         for k, (row, plot) in enumerate(zip(report["runs"], result.plots)):
             row["picture"] = None
             if plot is None:
                 continue
-            image = draw_run(plot["world"], plot["task"], result.trajectory(k), row)
+            image = draw_run(plot["world"], plot["task"], result.trajectory(k), row, worlds)
             if image is not None:
                 name = f"runs/{_safe(str(row['run']))}.png"
                 image.save(tmp / name, format="PNG")
