@@ -39,8 +39,9 @@ def read_runs(path) -> list[dict]:
     from worldgen.testing.stats import judged_runs
 
     if not judged_runs(runs):
-        raise ParameterError(f"report '{file}' holds no judged run ({len(runs)} rows, none with a verdict: "
-                             "every bag was unjudged); nothing to compare")
+        rows = f"{len(runs)} row{'' if len(runs) == 1 else 's'}"
+        raise ParameterError(f"report '{file}' holds no judged run ({rows}, none with a verdict: every bag was "
+                             "unjudged); nothing to compare")
     return runs
 
 

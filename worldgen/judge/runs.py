@@ -259,10 +259,12 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
                 row["run"] = _run_name(world_id, task_id, item.run or named.get("worldgen.run"), names)
                 row["world_folder"] = str(folder)
                 try:
-                    claimed = named.get("worldgen.world_id")
-                    if claimed and claimed != world_id:
-                        raise RunMismatchError(f"bag '{item.bag}' was recorded in world {claimed!r}, not {world_id!r}")
+                    _same_world(item.bag, named, world_id)
                     got = read_run(item.bag, g, task=task, start=start, **options)
+                    _same_world(item.bag, got.metadata, world_id)  # a bare storage file carries its own
+                    if item.run is None and not named.get("worldgen.run") and got.metadata.get("worldgen.run"):
+                        names.discard(row["run"])
+                        row["run"] = _run_name(world_id, task_id, got.metadata["worldgen.run"], names)
                 except RunMismatchError as exc:  # read, and not this task's run: a failure, not missing data
                     extra.append(row)
                     plots.append(None)
@@ -296,6 +298,15 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
             yield from runs_iter
         report = evaluate(chained(), criteria).to_dict()
     return JudgeResult(_assemble(report, extra), plots, scratch)
+
+
+def _same_world(bag: Path, metadata: dict, world_id: str) -> None:
+    """RunMismatchError when the bag's metadata names a world other than the one it is judged in."""
+    from worldgen.ros.reader import RunMismatchError
+
+    claimed = metadata.get("worldgen.world_id")
+    if claimed and claimed != world_id:
+        raise RunMismatchError(f"bag '{bag}' was recorded in world {claimed!r}, not {world_id!r}")
 
 
 def _unique(name: str, taken: set[str]) -> str:
