@@ -8,13 +8,14 @@ stream                          key                           used by
 ==============================  ============================  =====================================
 draw ``k`` of a world           ``(k,)``                      ``api.generate``, every generator
 its movers                      ``(k, MOVER_STREAM)``         ``generators.movers``
-its people                      ``(k, PEOPLE_STREAM)``        ``generators.people``
+its people                      ``(k, PEOPLE_STREAM)``        ``people.places``
 an environment's worlds         ``(WORLD_STREAM,)``           ``envs.navigation`` (reset's seed)
 an environment's sensor noise   ``(NOISE_STREAM,)``           ``envs.navigation`` (reset's seed)
 draw ``k`` towards a level      ``(LEVEL_STREAM, k)``         ``leveling`` (a world asked for at a level)
 an environment's curriculum     ``(CURRICULUM_STREAM,)``      ``envs.curriculum``, ``envs.replay`` (reset's seed)
-an edit of a level              ``(EDIT_STREAM,)``            ``editing`` (the edit's own seed)
+an edit of a level              ``(EDIT_STREAM,)``            ``verify.edits`` (the edit's own seed)
 a recipe's sampled parameter    ``[seed, entry, tag(name)]``  ``pack.recipe`` (entropy, no key)
+a baseline policy's actions     ``()``                        ``envs.policies`` (the policy's seed)
 ==============================  ============================  =====================================
 
 >>> float(attempt_rng(7, 0).random()) == float(attempt_rng(7, 0).random())
@@ -35,7 +36,7 @@ import numpy as np
 from worldgen.errors import ParameterError
 
 __all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "CURRICULUM_STREAM",
-           "EDIT_STREAM", "level_seed", "curriculum_rng", "edit_rng",
+           "EDIT_STREAM", "level_seed", "curriculum_rng", "edit_rng", "policy_rng",
            "check_seed", "attempt_rng", "mover_rng", "people_rng", "env_rngs", "draw_seed", "recipe_rng"]
 
 #: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
@@ -52,7 +53,7 @@ LEVEL_STREAM = 0x6C766C
 #: Key of an environment's curriculum stream (levels it jumps to, levels it replays or edits), beside the
 #: world and noise streams of a reset's seed: a curriculum never moves a plain environment's worlds.
 CURRICULUM_STREAM = 2
-#: Key of an edit's stream ("edt"), beside the edit's own seed (worldgen.editing).
+#: Key of an edit's stream ("edt"), beside the edit's own seed (worldgen.verify.edits).
 EDIT_STREAM = 0x656474
 
 
@@ -93,8 +94,14 @@ def curriculum_rng(entropy: int) -> np.random.Generator:
     return _stream(entropy, CURRICULUM_STREAM)
 
 
+def policy_rng(seed: int) -> np.random.Generator:
+    """A baseline policy's own stream (worldgen.envs.policies), from the seed it was made with. No key: the same
+    numbers as ``numpy.random.default_rng(seed)``, which the policies used before this module held them."""
+    return _stream(seed)
+
+
 def edit_rng(seed: int) -> np.random.Generator:
-    """The stream of one edit of a level, from the edit's seed (worldgen.editing)."""
+    """The stream of one edit of a level, from the edit's seed (worldgen.verify.edits)."""
     return _stream(seed, EDIT_STREAM)
 
 

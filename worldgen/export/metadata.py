@@ -35,6 +35,7 @@ SCHEMA_ID = "worldgen.world/1"
 _DISC_QUAD_SEGS = 32
 
 
+# long: world.json's top-level keys in the order the contract lists them (docs/world-json.md)
 def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
     """world.json of ``world`` as a plain dict (floats already rounded).
 
@@ -195,12 +196,10 @@ def schema() -> dict:
 def validate(meta: Mapping[str, Any]) -> None:
     """Raise ``jsonschema.ValidationError`` unless ``meta`` follows the schema.
 
-    Needs the optional ``jsonschema`` package (``pip install worldgen[test]``).
+    jsonschema is one of worldgen's own dependencies (``worldgen check`` validates with it).
     """
-    try:
-        import jsonschema
-    except ImportError:  # pragma: no cover - depends on the environment
-        raise ImportError("worldgen.export.metadata.validate needs jsonschema: pip install 'worldgen[test]'") from None
+    import jsonschema
+
     jsonschema.Draft202012Validator(schema()).validate(meta)
 
 

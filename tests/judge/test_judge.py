@@ -1,0 +1,206 @@
+"""`worldgen judge` end to end: real bags in tmp folders, the command in a real process, the report folder read back."""
+
+import csv
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+from support.cli import run
+from support.runs import along, idle_then, small_world, toward, write_bag
+
+from worldgen import oracles
+
+pytest.importorskip("rosbags")
+
+CRITERIA = """
+navigation:
+  success_rate: 1.0
+safety:
+  collision_tolerance: 0
+"""
+
+
+@pytest.fixture(scope="module")
+def setup(tmp_path_factory):
+    """One world (folder inside a folder of worlds) and three bags: clean, idle then clean, a collision."""
+    root = tmp_path_factory.mktemp("judge")
+    world = small_world(root / "worlds")
+    meta = oracles.load(world).meta
+    obstacle = next(e for e in meta["entities"] if e["role"] == "obstacle")
+    bags = root / "bags"
+    bags.mkdir()
+    clean = write_bag(bags / "clean", world, along(world), storage="mcap", run="clean")
+    idle = write_bag(bags / "idle", world, idle_then(along(world), 4.0), storage="sqlite3", distro="humble")
+    crash = write_bag(bags / "crash", world, toward(world, obstacle["pose"][:2]), storage="mcap")
+    (root / "criteria.yaml").write_text(CRITERIA)
+    return {"root": root, "world": world, "clean": clean, "idle": idle, "crash": crash, "obstacle": obstacle["name"],
+            "criteria": root / "criteria.yaml"}
+
+
+def _report(out):
+    return json.loads((out / "report.json").read_text())
+
+
+def test_clean_runs_pass_the_gate(setup, tmp_path):
+    out = tmp_path / "report"
+    r = run("judge", setup["clean"], setup["idle"], "--world", setup["world"], "--criteria", setup["criteria"], "--out", out)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[0] == "2 bags, 2 judged, 2 succeeded, 0 unreadable: PASS"
+    report = _report(out)
+    assert report["passed"] is True and report["summary"]["unreadable"] == 0
+    clean, idle = report["runs"]
+    assert clean["run"] == "clean" and idle["run"] == "idle"  # from the bag's metadata, else its name
+    assert clean["source"] == idle["source"] == "tf" and clean["start"] == "command"
+    assert idle["start_time"] == pytest.approx(4.0)
+    # the idle seconds before the first command do not count: the same drive, the same time to goal
+    assert idle["time_to_goal"] == pytest.approx(clean["time_to_goal"], abs=1e-9)
+    truth = oracles.run(along(setup["world"]), setup["world"])
+    assert clean["time_to_goal"] == pytest.approx(truth.time_to_goal, abs=1e-9)
+    assert clean["path_efficiency"] == pytest.approx(truth.path_efficiency, abs=1e-9)
+    assert clean["min_clearance"] == pytest.approx(truth.min_clearance, abs=1e-9)
+    with (out / "report.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert [r["run"] for r in rows] == ["clean", "idle"] and rows[0]["success"] == "True"
+    md = (out / "report.md").read_text()
+    assert md.startswith("# Run report: PASS\n") and "| navigation.success_rate | >= 1 | 1 | PASS |" in md
+    for row in report["runs"]:
+        with Image.open(out / row["picture"]) as img:
+            assert img.format == "PNG" and img.width >= 400
+
+
+def test_a_collision_fails_the_gate_and_is_drawn(setup, tmp_path):
+    out = tmp_path / "report"
+    r = run("judge", setup["clean"], setup["crash"], "--world", setup["world"], "--criteria", setup["criteria"],
+            "--out", out)
+    assert r.returncode == 1, r.stderr
+    report = _report(out)
+    crash = report["runs"][1]
+    assert crash["success"] is False and crash["reason"].startswith("collision with ")
+    assert setup["obstacle"] in {c["entity"] for c in crash["collisions"]}
+    assert "FAILED navigation.success_rate: required >= 1, measured 0.5, failed by 0.5" in r.stdout
+    # The picture marks the contact in the contact colour, the trajectory of a failed run in the failure colour.
+    from worldgen.judge.report import COLOURS
+    with Image.open(out / crash["picture"]) as img:
+        colours = {c for _, c in img.convert("RGB").getcolors(1 << 20)}
+    assert COLOURS["contact"] in colours and COLOURS["path"] in colours and COLOURS["spawn"] in colours
+
+
+def test_an_unreadable_bag_is_a_row_and_fails_the_gate(setup, tmp_path):
+    broken = tmp_path / "broken.mcap"
+    data = next(setup["clean"].glob("*.mcap")).read_bytes()
+    broken.write_bytes(data[: len(data) // 3])
+    out = tmp_path / "report"
+    r = run("judge", setup["clean"], broken, "--world", setup["world"], "--out", out)
+    assert r.returncode == 1, r.stderr
+    report = _report(out)
+    assert report["summary"]["unreadable"] == 1 and report["summary"]["bags"] == 2 and report["summary"]["runs"] == 1
+    row = report["runs"][1]
+    assert row["readable"] is False and row["run"] == "broken" and "cannot be read as a ROS bag" in row["reason"]
+    assert "bags: 1 of 2 could not be read; a gate does not pass on missing data" in report["failures"]
+    only_broken = run("judge", broken, "--world", setup["world"], "--out", tmp_path / "r2")
+    assert only_broken.returncode == 1 and _report(tmp_path / "r2")["summary"]["runs"] == 0
+
+
+def test_worlds_named_in_the_bags_metadata_and_a_runs_table(setup, tmp_path):
+    worlds = setup["world"].parent
+    r = run("judge", setup["clean"], setup["idle"], "--pack", worlds, "--out", tmp_path / "a")
+    assert r.returncode == 0, r.stderr
+    table = tmp_path / "runs.csv"
+    table.write_text(f"bag,world,task,run\n{setup['clean']},{setup['world']},task_0,first\n"
+                     f"{setup['crash']},{setup['world'].name},,second\n")
+    r = run("judge", "--runs", table, "--pack", worlds, "--out", tmp_path / "b")
+    # No criteria: the gate is that every run meets its scenario, and the crash does not.
+    assert r.returncode == 1, r.stderr
+    report = _report(tmp_path / "b")
+    assert [row["run"] for row in report["runs"]] == ["first", "second"]
+    assert [row["success"] for row in report["runs"]] == [True, False]
+    assert report["failures"][0].startswith("navigation.success_rate: required >= 1, measured 0.5")
+
+
+def test_a_bag_from_another_world_is_an_unreadable_row(setup, tmp_path):
+    other = small_world(tmp_path / "other", seed=1)
+    r = run("judge", setup["clean"], "--world", other, "--out", tmp_path / "r")
+    assert r.returncode == 1
+    reason = _report(tmp_path / "r")["runs"][0]["reason"]
+    assert "was recorded in world" in reason or "from the task's spawn" in reason
+
+
+@pytest.mark.parametrize("args,message", [
+    (["--out", "R"], "give at least one BAG"),
+    (["BAG", "--out", "R"], "say where the worlds are: --world DIR"),
+    (["BAG", "--world", "nowhere", "--out", "R"], "--world 'nowhere' is not a world folder (no world.json)"),
+    (["BAG", "--world", "WORLD", "--criteria", "BAD", "--out", "R"], "unknown section 'speed'"),
+    (["--runs", "TABLE", "--out", "R"], "runs table"),
+])
+def test_bad_input_is_one_line_exit_2_and_no_report(setup, tmp_path, args, message):
+    (tmp_path / "bad.yaml").write_text("speed: {max: 1}\n")
+    (tmp_path / "table.csv").write_text("bag\nx\n")
+    subst = {"BAG": setup["clean"], "WORLD": setup["world"], "BAD": tmp_path / "bad.yaml", "R": tmp_path / "r",
+             "TABLE": tmp_path / "table.csv"}
+    r = run("judge", *[subst.get(a, a) for a in args])
+    assert r.returncode == 2, r.stdout + r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1 and message in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "r").exists() and not list(tmp_path.glob(".r.*"))
+
+
+def test_an_earlier_report_is_replaced_and_another_folder_refused(setup, tmp_path):
+    out = tmp_path / "r"
+    assert run("judge", setup["clean"], "--world", setup["world"], "--out", out).returncode == 0
+    first = (out / "report.json").read_bytes()
+    assert run("judge", setup["clean"], "--world", setup["world"], "--out", out).returncode == 0
+    assert (out / "report.json").read_bytes() == first  # same inputs, same bytes
+    (tmp_path / "keep").mkdir()
+    (tmp_path / "keep" / "notes.txt").write_text("mine")
+    r = run("judge", setup["clean"], "--world", setup["world"], "--out", tmp_path / "keep")
+    assert r.returncode == 2 and "is not a report folder" in r.stderr
+    assert (tmp_path / "keep" / "notes.txt").read_text() == "mine"
+
+
+def test_help_has_an_example():
+    r = run("judge", "--help")
+    assert r.returncode == 0 and "worldgen judge runs/*.mcap --world" in r.stdout
+
+
+def test_decimated_picture_keeps_the_ends():
+    from worldgen.judge.runs import _decimate
+    t = np.linspace(0, 100, 5001)
+    traj = np.column_stack([t, np.cos(t / 10), np.sin(t / 10), t * 0])
+    d = _decimate(traj, 100)
+    assert len(d) <= 102 and (d[0] == traj[0, :3]).all() and (d[-1] == traj[-1, :3]).all()
+
+
+def test_the_mujoco_example_loop_is_judged_end_to_end(tmp_path):
+    """examples/diffdrive_mujoco.py records real bags; `worldgen judge` on them gives the example's own report,
+    and the official mcap reader decodes them."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[2] / "examples" / "diffdrive_mujoco.py"
+    ex = subprocess.run([sys.executable, str(script), str(tmp_path / "ex"), "3"], capture_output=True, text=True,
+                        timeout=300)
+    assert ex.returncode == 0, ex.stdout + ex.stderr
+    bags = sorted((tmp_path / "ex" / "bags").iterdir())
+    (tmp_path / "c.yaml").write_text(CRITERIA)
+    r = run("judge", *bags, "--pack", tmp_path / "ex" / "worlds", "--criteria", tmp_path / "c.yaml", "--out", tmp_path / "r")
+    assert r.returncode == 0, r.stdout + r.stderr
+    mine, theirs = _report(tmp_path / "r"), _report(tmp_path / "ex" / "report")
+    drop = {"bag", "world_folder", "picture"}
+    assert [{k: v for k, v in row.items() if k not in drop} for row in mine["runs"]] == \
+           [{k: v for k, v in row.items() if k not in drop} for row in theirs["runs"]]
+    assert all(row["success"] and row["source"] == "tf" and row["start"] == "command" for row in mine["runs"])
+    mcap_reader = pytest.importorskip("mcap.reader")
+    decoder = pytest.importorskip("mcap_ros2.decoder")
+    with next(bags[0].glob("*.mcap")).open("rb") as f:
+        reader = mcap_reader.make_reader(f, decoder_factories=[decoder.DecoderFactory()])
+        odom = [m for _, ch, _, m in reader.iter_decoded_messages(topics=["/odom"])]
+    assert odom[0].pose.pose.position.x == 0.0 and odom[0].pose.pose.position.y == 0.0  # zeroed at the spawn
+    assert odom[0].header.frame_id == "odom" and odom[0].child_frame_id == "base_footprint"
+
+
+def test_the_progress_bar_goes_to_stderr_when_asked(setup, tmp_path):
+    r = run("judge", setup["clean"], setup["idle"], "--world", setup["world"], "--out", tmp_path / "r", "--progress")
+    assert r.returncode == 0 and r.stderr.splitlines() == ["judging: 1 of 2 bags (50%)", "judging: 2 of 2 bags (100%)"]
+    quiet = run("judge", setup["clean"], "--world", setup["world"], "--out", tmp_path / "q")
+    assert quiet.returncode == 0 and quiet.stderr == ""  # not a terminal: no bar

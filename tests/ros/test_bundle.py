@@ -1,0 +1,614 @@
+"""The ROS 2 bundle (worldgen.ros.bundle): what can be checked without ROS 2 or Gazebo installed.
+
+ROS 2 and Gazebo cannot be installed on the machines these tests run on (Debian 12), so the bundle's
+files are checked for structure and against lists pinned from the ROS packages' documentation and
+sources (each list says where it comes from); the launch file, goal sender and loop are imported and
+their pure parts run. The SDF with plugins goes through libsdformat. docs/ros2.md says the same.
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+import importlib.util
+import json
+import math
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+from hypothesis import given
+from hypothesis import strategies as st
+from support.cli import QUICK, run, world_dirs
+from support.reftools_sdf import check_sdf
+
+import worldgen
+from worldgen.errors import ParameterError
+from worldgen.ros import bundle as ros2
+
+#: ros_gz_bridge's YAML keys (ros_gz_bridge/src/bridge_config.cpp, README "Example 5: Configuring the Bridge
+#: via YAML"); the bundle writes the five that name a topic pair and its direction.
+BRIDGE_KEYS = {"topic_name", "ros_topic_name", "gz_topic_name", "ros_type_name", "gz_type_name", "direction",
+               "publisher_queue", "subscriber_queue", "lazy", "qos_profile"}
+BRIDGE_DIRECTIONS = {"BIDIRECTIONAL", "GZ_TO_ROS", "ROS_TO_GZ"}
+#: ROS type -> Gazebo type pairs the bridge converts (the table in ros_gz_bridge's README, the rows the bundle uses).
+BRIDGE_TYPES = {"rosgraph_msgs/msg/Clock": "Clock", "tf2_msgs/msg/TFMessage": "Pose_V",
+                "ros_gz_interfaces/msg/Contacts": "Contacts", "geometry_msgs/msg/Twist": "Twist",
+                "nav_msgs/msg/Odometry": "Odometry", "sensor_msgs/msg/LaserScan": "LaserScan"}
+#: (package, executable) the launch file starts as Nodes: ros_gz_sim's `create` (ros_gz_sim/src/create.cpp),
+#: ros_gz_bridge's `parameter_bridge` (its README), robot_state_publisher.
+NODES = {("ros_gz_sim", "create"), ("ros_gz_bridge", "parameter_bridge"),
+         ("robot_state_publisher", "robot_state_publisher")}
+#: Files of other packages the launch file uses: ros_gz_sim/launch/gz_sim.launch.py(.in),
+#: nav2_bringup/launch/bringup_launch.py and nav2_bringup/params/nav2_params.yaml.
+SHARED_FILES = {("ros_gz_sim", "launch", "gz_sim.launch.py"), ("nav2_bringup", "launch", "bringup_launch.py"),
+                ("nav2_bringup", "params", "nav2_params.yaml")}
+#: Launch arguments those files declare: gz_sim.launch.py (gz_args, gz_version; on_exit_shutdown in
+#: Jazzy's ros_gz and later, ignored before), bringup_launch.py (nav2 Humble to Kilted).
+GZ_SIM_ARGS = {"gz_args", "gz_version", "on_exit_shutdown", "ign_args", "ign_version"}
+BRINGUP_ARGS = {"namespace", "use_namespace", "slam", "map", "use_sim_time", "params_file", "autostart",
+                "use_composition", "use_respawn", "log_level", "use_localization", "keepout_mask", "speed_mask",
+                "graph", "use_keepout_zones", "use_speed_zones"}
+#: ros_gz_sim create's flags (its gflags in ros_gz_sim/src/create.cpp).
+CREATE_FLAGS = {"-world", "-file", "-param", "-string", "-topic", "-name", "-allow_renaming",
+                "-x", "-y", "-z", "-R", "-P", "-Y"}
+#: gz sim flags used (gz-sim's `gz sim --help`: -r run, -s server only, --headless-rendering, --seed).
+GZ_SIM_FLAGS = {"-r", "-s", "--headless-rendering", "--seed", "-v"}
+#: ros2 bag record flags used (rosbag2's ros2bag/verb/record.py: -o/--output, -s/--storage,
+#: --include-hidden-topics; --use-sim-time from Humble's backport, rosbag2 PR 1017; --topics and
+#: --custom-data KEY=VALUE... on the releases after Humble, rosbag2 PR 1038 for the custom data).
+RECORD_FLAGS = {"-o", "--output", "-s", "--storage", "--use-sim-time", "--include-hidden-topics"}
+RECORD_FLAGS_AFTER_HUMBLE = RECORD_FLAGS | {"--topics", "--custom-data"}
+#: What the launch file imports from ROS's launch packages (launch, launch_ros, ament_index_python APIs).
+LAUNCH_API = {"launch": {"LaunchDescription"},
+              "launch.actions": {"DeclareLaunchArgument", "OpaqueFunction", "ExecuteProcess", "IncludeLaunchDescription",
+                                 "RegisterEventHandler", "Shutdown", "TimerAction"},
+              "launch.event_handlers": {"OnProcessExit"},
+              "launch.launch_description_sources": {"PythonLaunchDescriptionSource"},
+              "launch_ros.actions": {"Node"},
+              "ament_index_python.packages": {"get_package_share_directory"}}
+#: nav2_simple_commander's BasicNavigator methods the goal sender may call (nav2_simple_commander/robot_navigator.py).
+NAVIGATOR_API = {"waitUntilNav2Active", "goToPose", "isTaskComplete", "getResult", "cancelTask", "get_clock",
+                 "destroy_node"}
+#: The topics `worldgen judge` reads (issue 18): the bundle must record them all.
+JUDGE_TOPICS = {"/odom", "/tf", "/tf_static", "/cmd_vel", "/clock", "/scan"}
+
+#: ROS 2 names (design article "Topic and Service name mapping to DDS" / rcl's validation): tokens of
+#: [A-Za-z0-9_], not starting with a digit; we also refuse repeated underscores, which the design reserves.
+TOKEN = r"[A-Za-z_][A-Za-z0-9_]*"
+NODE_NAME = re.compile(rf"^{TOKEN}$")
+TOPIC_NAME = re.compile(rf"^(/{TOKEN})+$")
+
+
+def valid_token(name: str) -> bool:
+    return bool(NODE_NAME.match(name)) and "__" not in name and not name.endswith("_")
+
+
+def valid_topic(name: str) -> bool:
+    return bool(TOPIC_NAME.match(name)) and "__" not in name
+
+
+@pytest.fixture(scope="module")
+def world():
+    return worldgen.generate("cluttered", seed=7, size=[6, 6], n_obstacles=6, n_tasks=2)
+
+
+@pytest.fixture(scope="module")
+def folder(world, tmp_path_factory):
+    return world.write(tmp_path_factory.mktemp("ros"), ros=True)
+
+
+def load(path: Path, name: str):
+    """A bundle script as a module (they import only the standard library and PyYAML at the top)."""
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def launch(world, folder):
+    return load(folder / "ros2" / "launch" / f"{ros2.ros_name(world.world_id)}.launch.py", "bundle_launch")
+
+
+def read_yaml(path: Path):
+    return yaml.safe_load(path.read_text())
+
+
+# -- names -------------------------------------------------------------------
+
+@given(st.text(max_size=80))
+def test_ros_name_is_always_a_valid_ros_token(text):
+    name = ros2.ros_name(text)
+    assert valid_token(name), (text, name)
+    assert name == ros2.ros_name(name)  # a valid name stays as it is
+
+
+def test_world_ids_become_ros_names():
+    assert ros2.ros_name("cluttered-s7-60ec3d70") == "cluttered_s7_60ec3d70"
+    assert ros2.ros_name("drl_arena--cluttered-s0-1a2b3c4d") == "drl_arena_cluttered_s0_1a2b3c4d"
+    assert ros2.ros_name("7up") == "w_7up"
+    assert ros2.ros_name("--") == "w"
+
+
+def test_every_ros_name_in_the_bundle_is_valid(world, folder, launch):
+    assert valid_token(next((folder / "ros2" / "launch").iterdir()).name.removesuffix(".launch.py"))
+    for entry in read_yaml(folder / "ros2" / "bridge.yaml"):
+        assert valid_topic(entry["ros_topic_name"]), entry
+    assert all(valid_topic(t) for t in launch.RECORDED_TOPICS)
+    for name, _, _ in launch.ARGUMENTS:
+        assert valid_token(name)
+    assert valid_token("worldgen_send_goal") and "node_name='worldgen_send_goal'" in (
+        folder / "ros2" / "send_goal.py").read_text()
+    # The robot's model name is sanitised too, so Gazebo's /model/<robot>/pose stays a valid name.
+    topics = {e["gz_topic_name"] for e in ros2.bridge_config("my-robot.v2")}
+    assert "/model/my_robot_v2/pose" in topics and all(valid_topic(t) for t in topics)
+
+
+# -- the bridge ----------------------------------------------------------------
+
+@pytest.mark.parametrize("release", sorted(ros2.GZ_RELEASES))
+def test_bridge_config_uses_the_documented_keys_types_and_directions(release):
+    config = yaml.safe_load(ros2.dumps(ros2.bridge_config("robot", release)))
+    assert isinstance(config, list) and config
+    prefix = "ignition.msgs." if release == "fortress" else "gz.msgs."
+    for entry in config:
+        assert set(entry) <= BRIDGE_KEYS
+        assert {"ros_topic_name", "gz_topic_name", "ros_type_name", "gz_type_name", "direction"} <= set(entry)
+        assert entry["direction"] in BRIDGE_DIRECTIONS
+        assert entry["gz_type_name"] == prefix + BRIDGE_TYPES[entry["ros_type_name"]]
+    by_topic = {e["ros_topic_name"]: e for e in config}
+    assert by_topic["/clock"]["direction"] == "GZ_TO_ROS"  # the bridge README: a one-way /clock
+    assert by_topic["/cmd_vel"]["direction"] == "ROS_TO_GZ"
+    # The ground truth: OdometryPublisher's Pose_V on /model/<robot>/pose, as TFMessage on /ground_truth,
+    # the topic worldgen judge reads first.
+    assert by_topic["/ground_truth"]["ros_type_name"] == "tf2_msgs/msg/TFMessage"
+    assert by_topic["/ground_truth"]["gz_topic_name"] == "/model/robot/pose"
+    assert JUDGE_TOPICS - {"/tf_static"} <= set(by_topic)
+
+
+# -- nav2 overrides and goals ---------------------------------------------------
+
+def test_nav2_overrides_put_amcl_at_each_tasks_spawn(world, folder):
+    meta = json.loads((folder / "world.json").read_text())
+    assert len(meta["tasks"]) == 2
+    for task in meta["tasks"]:
+        params = read_yaml(folder / "ros2" / "nav2" / f"{task['id']}.yaml")
+        amcl = params["amcl"]["ros__parameters"]
+        assert amcl["set_initial_pose"] is True
+        x, y, z, _, _, yaw = task["spawn"]
+        assert amcl["initial_pose"] == {"x": x, "y": y, "z": z, "yaw": yaw}
+        assert (folder / params["map_server"]["ros__parameters"]["yaml_filename"]).is_file()
+        for costmap in ("local_costmap", "global_costmap"):
+            assert params[costmap][costmap]["ros__parameters"]["robot_radius"] == meta["robot"]["radius"]
+        blocks = [v["ros__parameters"] for v in params.values() if "ros__parameters" in v]
+        assert blocks and all(b["use_sim_time"] is True for b in blocks)
+
+
+def test_goals_are_world_json_tasks(folder):
+    meta = json.loads((folder / "world.json").read_text())
+    spec = read_yaml(folder / "ros2" / "tasks.yaml")
+    assert spec["world_id"] == meta["world_id"] and spec["frame_id"] == "map"
+    assert [t["id"] for t in spec["tasks"]] == [t["id"] for t in meta["tasks"]]
+    for goal, task in zip(spec["tasks"], meta["tasks"]):
+        x, y, _, _, _, yaw = task["goal"]
+        assert goal["goal"] == {"frame_id": "map", "x": x, "y": y, "yaw": yaw}
+        assert goal["tolerance"] == task["goal_tolerance"]
+        assert goal["time_limit"] == task["time_limit"]
+        sx, sy, sz, _, _, syaw = task["spawn"]
+        assert goal["spawn"] == {"x": sx, "y": sy, "z": sz, "yaw": syaw}
+
+
+def test_the_launch_file_merges_the_overrides_over_a_full_params_file(folder, launch):
+    base = {"amcl": {"ros__parameters": {"use_sim_time": False, "max_particles": 2000, "set_initial_pose": False}},
+            "local_costmap": {"local_costmap": {"ros__parameters": {"use_sim_time": False, "width": 3,
+                                                                    "robot_radius": 0.22}}},
+            "docking_server": {"ros__parameters": {"use_sim_time": False}}}
+    overrides = read_yaml(folder / "ros2" / "nav2" / "task_0.yaml")
+    params = launch.merged_params(base, overrides, str(folder))
+    amcl = params["amcl"]["ros__parameters"]
+    assert amcl["max_particles"] == 2000 and amcl["set_initial_pose"] is True
+    assert amcl["initial_pose"] == overrides["amcl"]["ros__parameters"]["initial_pose"]
+    local = params["local_costmap"]["local_costmap"]["ros__parameters"]
+    assert local["width"] == 3 and local["robot_radius"] == 0.2
+    assert params["docking_server"]["ros__parameters"]["use_sim_time"] is True  # every node, not only ours
+    assert params["map_server"]["ros__parameters"]["yaml_filename"] == str(folder / "map.yaml")
+
+
+# -- the launch file ------------------------------------------------------------
+
+def _calls(tree: ast.AST, name: str) -> list[ast.Call]:
+    return [n for n in ast.walk(tree) if isinstance(n, ast.Call)
+            and (getattr(n.func, "id", None) == name or getattr(n.func, "attr", None) == name)]
+
+
+def _keywords(call: ast.Call) -> dict[str, ast.AST]:
+    return {k.arg: k.value for k in call.keywords}
+
+
+def test_the_launch_file_starts_what_the_ros_documentation_names(world, folder):
+    path = folder / "ros2" / "launch" / f"{ros2.ros_name(world.world_id)}.launch.py"
+    tree = ast.parse(path.read_text(), str(path))
+    nodes = {(ast.literal_eval(_keywords(c)["package"]), ast.literal_eval(_keywords(c)["executable"]))
+             for c in _calls(tree, "Node")}
+    assert nodes == NODES
+    shared = {tuple(ast.literal_eval(a) if not isinstance(a, ast.Call) else ast.literal_eval(a.args[0])
+                    for a in c.args)
+              for c in _calls(tree, "join") if c.args and isinstance(c.args[0], ast.Call)
+              and getattr(c.args[0].func, "id", None) == "get_package_share_directory"}
+    assert shared == SHARED_FILES
+    includes = {}
+    for call in _calls(tree, "IncludeLaunchDescription"):
+        source = ast.unparse(call.args[0])
+        keys = {ast.literal_eval(k) for k in _keywords(call)["launch_arguments"].func.value.keys}
+        includes["gz" if "gz_sim.launch.py" in source else "nav2"] = keys
+    assert set(includes) == {"gz", "nav2"}
+    assert includes["gz"] <= GZ_SIM_ARGS and "gz_args" in includes["gz"]
+    assert includes["nav2"] <= BRINGUP_ARGS and {"map", "params_file", "use_sim_time"} <= includes["nav2"]
+    imported = {}
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and node.module.split(".")[0] in {"launch", "launch_ros", "ament_index_python"}:
+            imported.setdefault(node.module, set()).update(a.name for a in node.names)
+    assert imported and all(names <= LAUNCH_API[module] for module, names in imported.items())
+    # Shutdown on the goal sender's exit, on a failed spawn and on a wall-clock backstop; never a kill by name.
+    assert len(_calls(tree, "OnProcessExit")) == 2 and len(_calls(tree, "Shutdown")) == 3 and _calls(tree, "TimerAction")
+    assert not re.search(r"\b(pkill|killall|kill)\b", path.read_text())
+
+
+def test_the_launch_files_commands_use_only_documented_flags(world, folder, launch):
+    task = launch.find_task(read_yaml(folder / "ros2" / "tasks.yaml"), "task_1")
+    args = launch.spawn_arguments(task, "robot.sdf", "", "robot")
+    flags = [a for a in args if a.startswith("-") and not _number(a)]
+    assert set(flags) <= CREATE_FLAGS and {"-world", "-file", "-name", "-x", "-y", "-z", "-Y"} <= set(flags)
+    values = dict(zip(args[::2], args[1::2]))
+    x, y, z, _, _, yaw = world.metadata["tasks"][1]["spawn"]
+    assert (float(values["-x"]), float(values["-y"]), float(values["-z"]), float(values["-Y"])) == (x, y, z, yaw)
+    assert values["-world"] == world.world_id and values["-file"] == str(Path("robot.sdf").resolve())
+    assert launch.spawn_arguments(task, "", "/robot_description", "r")[4:6] == ["-topic", "/robot_description"]
+    with pytest.raises(ValueError, match="robot:=FILE"):
+        launch.spawn_arguments(task, "", "", "robot")
+    gz = launch.gz_args("/w/world.sdf", 4).split()
+    assert {a for a in gz if a.startswith("-")} <= GZ_SIM_FLAGS and gz[-1] == "/w/world.sdf" and "4" in gz
+    custom = {"world_id": world.world_id, "task": "task_1", "run": 3, "seed": 9}
+    humble = launch.record_command("/bags/b", "mcap", "humble", custom)
+    assert humble[:3] == ["ros2", "bag", "record"] and {a for a in humble if a.startswith("-")} <= RECORD_FLAGS
+    topics = [a for a in humble if a.startswith("/") and a != "/bags/b"]
+    assert JUDGE_TOPICS <= set(topics) and {"/ground_truth", "/navigate_to_pose/_action/status"} <= set(topics)
+    jazzy = launch.record_command("/bags/b", "mcap", "jazzy", custom)
+    assert {a for a in jazzy if a.startswith("-")} <= RECORD_FLAGS_AFTER_HUMBLE
+    at, data = jazzy.index("--topics"), jazzy.index("--custom-data")
+    assert jazzy[at + 1:data] == topics and data > at  # --custom-data last: it takes every word after it
+    assert jazzy[data + 1:] == [f"worldgen.world_id={world.world_id}", "worldgen.task=task_1", "worldgen.run=3",
+                                "worldgen.seed=9"]
+    goal = launch.goal_command("task_1", "/bags/b.result.yaml", 3, 9)
+    assert goal[goal.index("--ros-args"):] == ["--ros-args", "-p", "use_sim_time:=true"]
+    assert launch.bag_name(world.folder_name, "task_1", 3) == f"{world.folder_name}__task_1__run3"
+    assert launch.wall_limit(task, "") == pytest.approx(10 * task["time_limit"] + 120)
+    with pytest.raises(ValueError, match="task_0, task_1"):
+        launch.find_task(read_yaml(folder / "ros2" / "tasks.yaml"), "task_9")
+
+
+def _number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+# -- the goal sender and the loop -------------------------------------------------
+
+def test_the_goal_sender_calls_only_basic_navigator_api(folder, tmp_path):
+    path = folder / "ros2" / "send_goal.py"
+    tree = ast.parse(path.read_text())
+    called = {c.func.attr for c in ast.walk(tree) if isinstance(c, ast.Call) and isinstance(c.func, ast.Attribute)
+              and isinstance(c.func.value, ast.Name) and c.func.value.id == "navigator"}
+    assert called <= NAVIGATOR_API and {"waitUntilNav2Active", "goToPose", "isTaskComplete", "cancelTask"} <= called
+    # nav2 is waited for by its lifecycle, not by a fixed sleep
+    assert not [c for c in ast.walk(tree) if isinstance(c, ast.Call) and "sleep" in ast.unparse(c.func)]
+    goal = load(path, "bundle_send_goal")
+    qx, qy, qz, qw = goal.quaternion(1.2)
+    assert (qx, qy) == (0.0, 0.0) and math.isclose(2 * math.atan2(qz, qw), 1.2)
+    assert goal.over_limit(10.1, 10.0) and not goal.over_limit(10.0, 10.0) and not goal.over_limit(1e9, None)
+    # Bad input is exit status 3 before rclpy is touched (rclpy is not installed here).
+    assert goal.main(["--tasks", str(folder / "ros2" / "tasks.yaml"), "--task", "nope",
+                      "--result", str(tmp_path / "r.yaml")]) == 3
+    assert not (tmp_path / "r.yaml").exists()
+
+
+def test_the_loop_plans_n_worlds_by_m_runs(tmp_path):
+    done = run("generate", "cluttered", "--seed", 1, "--count", 2, *QUICK, "--set", "n_tasks=2", "--out",
+               tmp_path / "w", "--ros", "--gz-release", "fortress")
+    assert done.returncode == 0, done.stderr
+    worlds = world_dirs(tmp_path / "w")
+    loop = load(worlds[0] / "ros2" / "run_loop.py", "bundle_run_loop")
+    plan = loop.runs([str(w) for w in worlds], 3, "robot.urdf", "", str(tmp_path / "bags"), seed=10, which="all")
+    assert len(plan) == 2 * 2 * 3
+    bag, command = plan[5]
+    assert command[:2] == ["ros2", "launch"] and command[2].endswith(".launch.py") and Path(command[2]).is_file()
+    assert f"seed:={10 + 2}" in command and "run:=2" in command and "task:=task_1" in command
+    assert bag == str(tmp_path / "bags" / f"{worlds[0].name}__task_1__run2")
+    assert len(loop.runs([str(worlds[0])], 2, "", "/robot_description", "bags")) == 2  # first task only
+    (tmp_path / "bags").mkdir()
+    Path(plan[0][0]).mkdir()  # a recorded run is skipped on resumption
+    out = subprocess.run([sys.executable, str(worlds[0] / "ros2" / "run_loop.py"), "--runs", "3", "--robot", "r.urdf",
+                          "--out", str(tmp_path / "bags"), "--tasks", "all", "--dry-run", *map(str, worlds)],
+                         capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.count("ros2 launch ") == 11 and out.stdout.count("skip ") == 1
+    # Fortress: the ignition system names in the SDF and the ignition message names in the bridge.
+    assert "ignition-gazebo-sensors-system" in (worlds[0] / "ros2" / "world.sdf").read_text()
+    assert all(e["gz_type_name"].startswith("ignition.msgs.") for e in read_yaml(worlds[0] / "ros2" / "bridge.yaml"))
+
+
+# -- the SDF with plugins -------------------------------------------------------
+
+@pytest.mark.parametrize("version", ["1.9", "1.6"])
+@pytest.mark.parametrize("release", ["fortress", "harmonic"])
+def test_the_sdf_with_plugins_passes_libsdformat(world, tmp_path, version, release):
+    path = tmp_path / "world.sdf"
+    path.write_bytes(ros2.with_plugins(world.export("sdf", version), release))
+    ok, messages = check_sdf(path)
+    assert ok, messages
+    text = path.read_text()
+    for filename, name, _ in ros2.plugins(release):
+        assert f'<plugin filename="{filename}" name="{name}"' in text
+    assert text.count("<plugin ") == 6
+
+
+def test_the_bundles_sdf_points_its_meshes_one_folder_up(tmp_path):
+    from support.scenes import showcase_scene
+
+    from worldgen.export.meshes import mesh_files
+    from worldgen.export.sdf import to_sdf
+
+    scene = showcase_scene()
+    text = ros2.with_plugins(to_sdf(scene).decode(), "harmonic", "../").decode()
+    uris = re.findall(r"<uri>([^<]*)</uri>", text)
+    assert uris and all(u.startswith("../meshes/") for u in uris)
+    for rel, data in mesh_files(scene).items():
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_bytes(data)
+        assert f"../{rel}" in uris
+    (tmp_path / "ros2").mkdir()
+    (tmp_path / "ros2" / "world.sdf").write_text(text)
+    ok, messages = check_sdf(tmp_path / "ros2" / "world.sdf")
+    assert ok, messages
+
+
+def test_bad_releases_and_options_are_one_line_errors(world):
+    with pytest.raises(ParameterError, match="'gz_release' must be one of fortress, garden, harmonic, ionic"):
+        ros2.bundle(world, gz_release="citadel")
+    with pytest.raises(ParameterError, match="'ros' must be true or a Gazebo release"):
+        world.folder_blobs(ros="dome")
+    no_plugins = ros2.bundle(world, gz_release=None)
+    assert "ros2/world.sdf" not in no_plugins
+    assert b"SDF = 'world.sdf'" in next(v for k, v in no_plugins.items() if k.endswith(".launch.py"))
+
+
+# -- wiring, determinism --------------------------------------------------------
+
+_DIGEST = ("import hashlib, worldgen\n"
+           "from worldgen.ros.bundle import bundle\n"
+           "w = worldgen.generate('cluttered', seed=7, size=[6, 6], n_obstacles=6, n_tasks=2)\n"
+           "print(hashlib.sha256(repr(sorted(bundle(w).items())).encode()).hexdigest())\n")
+
+
+def test_the_bundle_is_the_same_bytes_in_two_processes(world):
+    here = hashlib.sha256(repr(sorted(ros2.bundle(world).items())).encode()).hexdigest()
+    for _ in range(2):
+        done = subprocess.run([sys.executable, "-c", _DIGEST], capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        assert done.stdout.strip() == here
+
+
+def test_generate_with_ros_end_to_end(tmp_path):
+    done = run("generate", "cluttered", "--seed", 5, *QUICK, "--out", tmp_path, "--ros")
+    assert done.returncode == 0, done.stderr
+    [folder] = world_dirs(tmp_path)
+    names = sorted(str(p.relative_to(folder)) for p in (folder / "ros2").rglob("*") if p.is_file())
+    launch_name = f"ros2/launch/{ros2.ros_name(folder.name)}.launch.py"
+    assert names == sorted(["ros2/bridge.yaml", "ros2/tasks.yaml", "ros2/nav2/task_0.yaml", "ros2/world.sdf",
+                            "ros2/send_goal.py", "ros2/run_loop.py", launch_name])
+    assert "gz-sim-sensors-system" in (folder / "ros2" / "world.sdf").read_text()
+    ast.parse((folder / launch_name).read_text())
+    checked = run("check", folder)  # the bundle is outside world.json's files: the folder still checks
+    assert checked.returncode == 0 and checked.stdout.startswith("OK"), checked.stdout + checked.stderr
+    plain = run("generate", "cluttered", "--seed", 5, *QUICK, "--out", tmp_path / "plain")
+    assert plain.returncode == 0 and not (world_dirs(tmp_path / "plain")[0] / "ros2").exists()
+    bad = run("generate", "cluttered", "--seed", 5, *QUICK, "--out", tmp_path / "bad", "--ros", "--gz-release", "dome")
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1 and "gz-release" in bad.stderr
+    alone = run("generate", "cluttered", "--seed", 5, *QUICK, "--out", tmp_path / "alone", "--gz-release", "ionic")
+    assert alone.returncode == 2 and alone.stderr == ("error: --gz-release ionic names the Gazebo release of the "
+                                                      "ROS 2 bundle: add --ros\n")
+    assert not (tmp_path / "alone").exists()
+
+
+def test_a_pack_recipe_asks_for_the_bundle(tmp_path):
+    from worldgen.pack.recipe import RecipeError, parse_recipe
+    from worldgen.pack.render import render_job
+
+    recipe = parse_recipe("ros: fortress\nseeds: 1\nworlds:\n  - generator: minimal\n")
+    assert recipe.ros == "fortress"
+    _, blobs = render_job(recipe.jobs[0], recipe.formats, recipe.sdf_version, recipe.preview, recipe.ros)
+    assert "ros2/bridge.yaml" in blobs and b"ignition-gazebo-physics-system" in blobs["ros2/world.sdf"]
+    assert parse_recipe("ros: true\nseeds: 1\nworlds:\n  - generator: minimal\n").ros == ros2.DEFAULT_GZ_RELEASE
+    plain = parse_recipe("seeds: 1\nworlds:\n  - generator: minimal\n")
+    assert not plain.ros
+    assert not any(k.startswith("ros2/") for k in render_job(plain.jobs[0], plain.formats, plain.sdf_version,
+                                                             False, plain.ros)[1])
+    with pytest.raises(RecipeError, match=r"<recipe>:1: key 'ros': must be true, false or a Gazebo release"):
+        parse_recipe("ros: dome\nseeds: 1\nworlds:\n  - generator: minimal\n")
+
+
+@pytest.mark.parametrize("store", ["ROS2_HUMBLE", "ROS2_JAZZY"])
+def test_the_bridged_ros_types_exist_in_humble_and_jazzy(store):
+    """Every ROS type the bridge names is a message of that release (rosbags' shipped definitions);
+    ros_gz_interfaces is ros_gz's own package, not in the core set."""
+    # rosbags comes with the test extra once worldgen.ros (the bag reader) is in; until then this skips.
+    typesys = pytest.importorskip("rosbags.typesys")
+    Stores, get_typestore = typesys.Stores, typesys.get_typestore
+    types = get_typestore(getattr(Stores, store)).types
+    named = {e["ros_type_name"] for e in ros2.bridge_config()} | {"action_msgs/msg/GoalStatusArray"}
+    assert {t for t in named if not t.startswith("ros_gz_interfaces/")} <= set(types)
+    assert named - set(types) == {"ros_gz_interfaces/msg/Contacts"}
+
+
+class _Recorded:
+    """A stand-in for one class of ROS's launch API: records how the launch file constructs it. ROS
+    cannot be installed here; this runs the launch file's own code paths, it does not emulate ROS."""
+
+    made: list = []
+
+    def __init__(self, *args, **kwargs):
+        self.args, self.kwargs = args, kwargs
+        _Recorded.made.append(self)
+
+
+def _fake_launch_api(monkeypatch, share: Path) -> None:
+    import types
+
+    names = {"launch": ["LaunchDescription"],
+             "launch.actions": sorted(LAUNCH_API["launch.actions"]),
+             "launch.event_handlers": ["OnProcessExit"],
+             "launch.launch_description_sources": ["PythonLaunchDescriptionSource"],
+             "launch_ros.actions": ["Node"]}
+    for module, classes in {**names, "launch_ros": [], "ament_index_python": []}.items():
+        fake = types.ModuleType(module)
+        for cls in classes:
+            setattr(fake, cls, type(cls, (_Recorded,), {}))
+        monkeypatch.setitem(sys.modules, module, fake)
+    packages = types.ModuleType("ament_index_python.packages")
+    packages.get_package_share_directory = lambda package: str(share / package)
+    monkeypatch.setitem(sys.modules, "ament_index_python.packages", packages)
+
+
+def test_the_launch_files_setup_runs_through(world, folder, launch, tmp_path, monkeypatch):
+    share = tmp_path / "share"
+    (share / "nav2_bringup" / "params").mkdir(parents=True)
+    (share / "nav2_bringup" / "params" / "nav2_params.yaml").write_text(yaml.safe_dump(
+        {"amcl": {"ros__parameters": {"use_sim_time": False, "max_particles": 2000}},
+         "controller_server": {"ros__parameters": {"use_sim_time": False, "controller_frequency": 20.0}}}))
+    _fake_launch_api(monkeypatch, share)
+    _Recorded.made = []
+    description = launch.generate_launch_description()
+    declared = {a.args[0]: a.kwargs["default_value"] for a in _Recorded.made if type(a).__name__ == "DeclareLaunchArgument"}
+    assert declared["task"] == "task_0" and declared["robot_name"] == "robot" and declared["storage"] == "mcap"
+    setup = next(a for a in _Recorded.made if type(a).__name__ == "OpaqueFunction").kwargs["function"]
+    assert type(description).__name__ == "LaunchDescription"
+
+    class Context:
+        launch_configurations = {**declared, "robot": str(tmp_path / "robot.urdf"), "task": "task_1", "run": "2",
+                                 "seed": "5", "out": str(tmp_path / "bags"), "robot_state_publisher": "true"}
+
+    (tmp_path / "robot.urdf").write_text("<robot name='r'/>")
+    monkeypatch.setenv("ROS_DISTRO", "jazzy")
+    _Recorded.made = []
+    actions = setup(Context())
+    kinds = [type(a).__name__ for a in actions]
+    assert kinds == ["IncludeLaunchDescription", "Node", "Node", "IncludeLaunchDescription", "ExecuteProcess",
+                     "ExecuteProcess", "RegisterEventHandler", "RegisterEventHandler", "TimerAction", "Node"]
+    gazebo, spawn, bridge, nav2, record, goal = actions[:6]
+    gz_args = dict(gazebo.kwargs["launch_arguments"])["gz_args"].split()
+    assert gz_args[-1] == str(folder / "ros2" / "world.sdf") and gz_args[gz_args.index("--seed") + 1] == "5"
+    assert spawn.kwargs["arguments"][spawn.kwargs["arguments"].index("-Y") + 1] == repr(world.tasks[1].spawn.yaw)
+    assert bridge.kwargs["parameters"] == [{"config_file": str(folder / "ros2" / "bridge.yaml"), "use_sim_time": True}]
+    nav2_args = dict(nav2.kwargs["launch_arguments"])
+    assert nav2_args["map"] == str(folder / "map.yaml") and nav2_args["use_sim_time"] == "true"
+    params = read_yaml(Path(nav2_args["params_file"]))
+    amcl = params["amcl"]["ros__parameters"]
+    x, y, z, _, _, yaw = world.metadata["tasks"][1]["spawn"]
+    assert amcl["max_particles"] == 2000 and amcl["initial_pose"] == {"x": x, "y": y, "z": z, "yaw": yaw}
+    assert params["controller_server"]["ros__parameters"] == {"use_sim_time": True, "controller_frequency": 20.0}
+    bag = str(tmp_path / "bags" / f"{world.folder_name}__task_1__run2")
+    assert record.kwargs["cmd"][record.kwargs["cmd"].index("-o") + 1] == bag
+    assert f"worldgen.world_id={world.world_id}" in record.kwargs["cmd"]
+    assert goal.kwargs["cmd"][goal.kwargs["cmd"].index("--result") + 1] == bag + ".result.yaml"
+    assert actions[8].kwargs["period"] == pytest.approx(10 * world.metadata["tasks"][1]["time_limit"] + 120)
+    assert actions[9].kwargs["parameters"][0]["robot_description"] == "<robot name='r'/>"
+    Path(bag).mkdir()
+    with pytest.raises(RuntimeError, match="exists already"):  # a recorded run is never overwritten
+        setup(Context())
+
+
+class _Time:
+    def __init__(self, ns):
+        self.nanoseconds = ns
+
+    def __sub__(self, other):
+        return _Time(self.nanoseconds - other.nanoseconds)
+
+    def to_msg(self):
+        return self.nanoseconds
+
+
+def _fake_nav2(monkeypatch, finishes_after: float, result: str, calls: list) -> None:
+    """Stand-ins for rclpy, geometry_msgs and nav2_simple_commander: a navigator whose task completes
+    after ``finishes_after`` simulated seconds (each isTaskComplete call advances 0.1 s) with ``result``."""
+    import types
+
+    class Navigator:
+        def __init__(self, node_name):
+            self.t = 100.0
+            calls.append(("init", node_name))
+
+        def __getattr__(self, name):
+            def call(*args):
+                calls.append((name,) + args)
+                if name == "isTaskComplete":
+                    self.t += 0.1
+                    return self.t - self.start >= finishes_after
+                if name == "goToPose":
+                    self.start = self.t
+                    return True
+                return getattr(TaskResult, result, None) if name == "getResult" else None
+            return call
+
+        def get_clock(self):
+            return types.SimpleNamespace(now=lambda: _Time(round(self.t * 1e9)))
+
+    TaskResult = types.SimpleNamespace(SUCCEEDED="S", CANCELED="C", FAILED="F")
+    pose = lambda: types.SimpleNamespace(  # noqa: E731
+        header=types.SimpleNamespace(frame_id="", stamp=None),
+        pose=types.SimpleNamespace(position=types.SimpleNamespace(x=0, y=0, z=0),
+                                   orientation=types.SimpleNamespace(x=0, y=0, z=0, w=1)))
+    modules = {"rclpy": {"init": lambda args: calls.append(("rclpy.init", args)), "shutdown": lambda: None},
+               "geometry_msgs": {}, "geometry_msgs.msg": {"PoseStamped": pose},
+               "nav2_simple_commander": {},
+               "nav2_simple_commander.robot_navigator": {"BasicNavigator": Navigator, "TaskResult": TaskResult}}
+    for name, attrs in modules.items():
+        module = types.ModuleType(name)
+        module.__dict__.update(attrs)
+        monkeypatch.setitem(sys.modules, name, module)
+
+
+@pytest.mark.parametrize("finishes_after, result, outcome, status", [
+    (5.0, "SUCCEEDED", "succeeded", 0), (5.0, "FAILED", "failed", 1), (1e9, None, "time_limit", 2)])
+def test_the_goal_sender_runs_through(folder, tmp_path, monkeypatch, finishes_after, result, outcome, status):
+    goal_module = load(folder / "ros2" / "send_goal.py", "bundle_send_goal_run")
+    calls: list = []
+    _fake_nav2(monkeypatch, finishes_after, result, calls)
+    out = tmp_path / "run.result.yaml"
+    code = goal_module.main(["--tasks", str(folder / "ros2" / "tasks.yaml"), "--task", "task_1", "--result", str(out),
+                             "--world-dir", str(folder), "--run", "4", "--seed", "7",
+                             "--ros-args", "-p", "use_sim_time:=true"])
+    assert code == status
+    names = [c[0] for c in calls]
+    # Active first, then the goal; the ROS arguments reach rclpy.
+    assert names[:4] == ["rclpy.init", "init", "waitUntilNav2Active", "goToPose"]
+    assert calls[0][1][1:] == ["--ros-args", "-p", "use_sim_time:=true"]
+    assert ("cancelTask" in names) == (outcome == "time_limit")
+    record = read_yaml(out)
+    spec = read_yaml(folder / "ros2" / "tasks.yaml")["tasks"][1]
+    assert record["outcome"] == outcome and record["task"] == "task_1" and (record["run"], record["seed"]) == (4, 7)
+    assert record["goal"] == spec["goal"] and record["world_dir"] == str(folder)
+    elapsed = record["finished_sim_time"] - record["goal_sent_sim_time"]
+    expected = spec["time_limit"] if outcome == "time_limit" else finishes_after
+    assert expected <= elapsed <= expected + 0.2  # the limit is simulation time from the goal
+    goal = [c for c in calls if c[0] == "goToPose"][0][1]
+    assert (goal.pose.position.x, goal.pose.position.y, goal.header.frame_id) == (
+        spec["goal"]["x"], spec["goal"]["y"], "map")
+    assert math.isclose(2 * math.atan2(goal.pose.orientation.z, goal.pose.orientation.w), spec["goal"]["yaw"])

@@ -1,0 +1,130 @@
+"""``worldgen check``'s ``timed`` check: a world's certificate among people, re-proved from world.json.
+
+The timed path (``tasks[].timed_path``, docs/people.md) is checked on its own terms, without the code
+that found it (:mod:`worldgen.people.timed`): rows from the spawn at t = 0 to the goal at
+``arrival_time``, times increasing, no faster than ``robot.max_speed``; every row on the recorded path
+(``tasks[].path.waypoints``) and each two consecutive rows on one leg of it, so the robot between them
+stays on the path and never cuts a corner; the rows' polyline clear of the static geometry by FCL (the
+regenerated scene, doors at their open limit, as the path was proven); and, sampled every
+:data:`TIMED_STEP` s, every person's ``trajectory`` (straight between rows, standing after the last)
+never closer than ``robot.radius + robot.clearance + radius`` plus ``w TIMED_STEP / 2``, ``w`` the
+robot's top speed plus the fastest any person walks: what two discs moving straight at those speeds
+could close between two samples.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["TIMED_STEP", "ON_PATH", "TimedPathError", "check_timed"]
+
+#: Time step (s) at which a timed path is sampled against every person (docs/people.md: 2 ms).
+TIMED_STEP = 0.002
+#: How far (m) a timed path's row may lie off the recorded path: world.json's rows are rounded to 6 decimals.
+ON_PATH = 1e-5
+
+
+class TimedPathError(Exception):
+    """A timed path that does not hold: the message is the one line ``worldgen check`` prints."""
+
+
+def check_timed(meta: dict, world) -> None:
+    """Re-prove every task's timed path of world.json ``meta`` (``world``: its regenerated World, for the
+    static geometry); raise :class:`TimedPathError` with one line at the first fault."""
+    people = meta.get("people") or []
+    if not people:
+        return
+    robot = meta["robot"]
+    inflation, v_max = robot["radius"] + robot["clearance"], float(robot["max_speed"])
+    tracks = [(str(p["name"]), np.asarray(p["trajectory"], dtype=float).reshape(-1, 3), float(p["radius"]))
+              for p in people]
+    fastest = max((_speeds(track).max(initial=0.0) for _, track, _ in tracks), default=0.0)
+    colliders = None
+    for task in meta["tasks"]:
+        rows = task.get("timed_path")
+        if rows is None:
+            if meta["feasibility"]["feasible"] and task.get("path") is not None:
+                raise TimedPathError(f"{task['id']} has no timed_path, but the world is recorded feasible among people")
+            continue
+        if task.get("path") is None:
+            raise TimedPathError(f"{task['id']} has a timed_path but no path for it to follow")
+        rows = np.asarray(rows, dtype=float).reshape(-1, 3)
+        _timed_rows(task, rows, v_max)
+        _timed_on_path(task, rows)
+        if colliders is None:
+            from worldgen.feasibility.collision import Colliders
+            from worldgen.scene.doors import open_scene
+
+            colliders = Colliders(open_scene(world.scene))
+        from worldgen.feasibility.verify import verify_path
+
+        nearest = verify_path(colliders, world.robot, rows[:, 1:])
+        if nearest.distance < world.robot.clearance - 1e-6:
+            raise TimedPathError(f"{task['id']} timed_path comes {nearest.distance:.6f} m from {nearest.name}, "
+                                 f"under the clearance {world.robot.clearance} m")
+        # Between two samples a robot and a person, each straight at constant speed, close at most w h / 2.
+        reach = (v_max + fastest) * TIMED_STEP / 2
+        t = np.arange(0.0, rows[-1, 0] + TIMED_STEP, TIMED_STEP)
+        me = _at(rows, t)
+        for name, track, radius in tracks:
+            gap = np.hypot(*(me - _at(track, t)).T) - (inflation + radius)
+            k = int(np.argmin(gap))
+            if gap[k] < reach:
+                raise TimedPathError(f"{task['id']} timed_path at t = {t[k]:.3f} s comes "
+                                     f"{gap[k] + radius + inflation:.4f} m from {name}'s centre, under "
+                                     "robot.radius + robot.clearance + its radius = "
+                                     f"{inflation + radius:.4f} m (+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
+
+
+def _speeds(rows: np.ndarray) -> np.ndarray:
+    d = np.diff(rows, axis=0)
+    with np.errstate(divide="ignore"):  # rows not after the one before: an infinite speed, never a pass
+        return np.where(d[:, 0] > 0, np.hypot(d[:, 1], d[:, 2]) / np.where(d[:, 0] > 0, d[:, 0], 1.0), np.inf)
+
+
+def _at(rows: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(len(t), 2) positions along ``rows`` (t, x, y): straight between rows, standing before and after."""
+    return np.column_stack([np.interp(t, rows[:, 0], rows[:, 1]), np.interp(t, rows[:, 0], rows[:, 2])])
+
+
+def _timed_rows(task: dict, rows: np.ndarray, v_max: float) -> None:
+    """From the spawn at t = 0 to the goal at arrival_time, times increasing, at most robot.max_speed."""
+    tid = task["id"]
+    if len(rows) < 1 or not np.all(np.isfinite(rows)):
+        raise TimedPathError(f"{tid} timed_path needs finite [t, x, y] rows")
+    if rows[0, 0] != 0.0 or np.hypot(*(rows[0, 1:] - task["spawn"][:2])) > ON_PATH:
+        raise TimedPathError(f"{tid} timed_path starts at t = {rows[0, 0]:g} s at {rows[0, 1:].tolist()}, "
+                             f"not at t = 0 at the spawn {task['spawn'][:2]}")
+    if np.hypot(*(rows[-1, 1:] - task["goal"][:2])) > ON_PATH or rows[-1, 0] != task.get("arrival_time"):
+        raise TimedPathError(f"{tid} timed_path ends at t = {rows[-1, 0]:g} s at {rows[-1, 1:].tolist()}, not at "
+                             f"arrival_time {task.get('arrival_time')} s at the goal {task['goal'][:2]}")
+    dt = np.diff(rows[:, 0])
+    if np.any(dt <= 0):
+        k = int(np.argmax(dt <= 0)) + 1
+        raise TimedPathError(f"{tid} timed_path row {k} (t = {rows[k, 0]:g} s) does not come after the one before")
+    speed = _speeds(rows)
+    if len(speed) and speed.max() > v_max:
+        k = int(np.argmax(speed))
+        raise TimedPathError(f"{tid} timed_path goes {speed[k]:.6f} m/s from t = {rows[k, 0]:g} to {rows[k + 1, 0]:g} s, "
+                             f"above robot.max_speed {v_max:g} m/s")
+
+
+def _timed_on_path(task: dict, rows: np.ndarray) -> None:
+    """Every row on the recorded path, and each two rows in a row on one leg of it (so the robot between
+    them is too: it never cuts a corner)."""
+    wp = np.asarray(task["path"]["waypoints"], dtype=float).reshape(-1, 2)
+    a, b = (wp[:-1], wp[1:]) if len(wp) > 1 else (wp, wp)
+    ab = b - a
+    ap = rows[:, None, 1:] - a[None]
+    u = np.clip(np.einsum("kij,ij->ki", ap, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+    near = np.hypot(*(a[None] + u[..., None] * ab[None] - rows[:, None, 1:]).transpose(2, 0, 1)) <= ON_PATH
+    off = np.flatnonzero(~near.any(axis=1))
+    if len(off):
+        k = int(off[0])
+        raise TimedPathError(f"{task['id']} timed_path row {k} (t = {rows[k, 0]:g} s) at {rows[k, 1:].tolist()} is off "
+                             "the recorded path")
+    apart = np.flatnonzero(~(near[:-1] & near[1:]).any(axis=1))
+    if len(apart):
+        k = int(apart[0])
+        raise TimedPathError(f"{task['id']} timed_path leaves the recorded path between t = {rows[k, 0]:g} and "
+                             f"{rows[k + 1, 0]:g} s (the rows lie on different legs: it cuts a corner)")
