@@ -23,7 +23,7 @@ import click
 
 import worldgen
 from worldgen.errors import EXIT_USAGE, InfeasibleError, OutputError, ParameterError, WorldgenError, did_you_mean
-from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
+from worldgen.export.formats import ALL_FORMATS, FORMATS, SDF_VERSIONS, normalise_formats, require_formats
 from worldgen.export.ros2 import DEFAULT_GZ_RELEASE, GZ_RELEASES
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
@@ -165,7 +165,8 @@ def parameter_tables(specs) -> str:
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Folder to write DIR/<world_id>/ (DIR/<preset>--<world_id>/ with --preset) into (created if missing).")
 @click.option("--formats", default=",".join(FORMATS), show_default=True,
-              help=f"Comma-separated subset of {', '.join(FORMATS)}; world.json is always written.")
+              help=f"Comma-separated formats among {', '.join(ALL_FORMATS)} (usd, for Isaac Sim, needs "
+                   f"pip install 'worldgen[usd]'); world.json is always written.")
 @click.option("--sdf-version", type=click.Choice(SDF_VERSIONS), default=SDF_VERSIONS[0], show_default=True,
               help="SDFormat version: 1.9 (Gazebo Fortress to Harmonic) or 1.6 (Gazebo classic).")
 @click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
@@ -211,6 +212,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         if not allow_infeasible:
             raise
     chosen = normalise_formats(formats)
+    require_formats(chosen)  # a missing extra stops the command before any world is drawn
     if gz_release is not None and not ros:
         raise ParameterError(f"--gz-release {gz_release} names the Gazebo release of the ROS 2 bundle: add --ros")
     if seed + count - 1 > MAX_SEED:

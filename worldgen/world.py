@@ -108,7 +108,7 @@ class World:
         return text
 
     def _render(self, fmt: str, sdf_version: str) -> str:
-        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version).decode()
+        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version, world=self).decode()
 
     def mesh_files(self) -> dict[str, bytes]:
         """Mesh files the exported formats refer to: relative path -> bytes."""
@@ -123,6 +123,7 @@ class World:
     def rendered_files(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> dict[str, tuple[str, bytes]]:
         """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
         formats = normalise_formats(formats)
+        formats_table.require_formats(formats)  # a missing extra: one line, before anything is rendered
         files = {fmt: (FILE_NAMES[fmt], self.export(fmt, sdf_version).encode()) for fmt in formats}
         if formats_table.uses_meshes(formats):
             for rel, data in self.mesh_files().items():
