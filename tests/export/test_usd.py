@@ -1,0 +1,340 @@
+"""world.usda read back with usd-core agrees with world.json and the SDF, passes usd-core's validators,
+and is the same bytes in every process; without usd-core, asking for it is one line and no folder.
+
+Every generator and every preset: each collider's pose and size within 1 mm of world.json, door
+hinges (axis, limits, where the hinge is) against the SDF's, every time sample of every mover and
+person within 1 mm of world.json's trajectory (and halfway between samples, where USD interpolates).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from functools import lru_cache
+from pathlib import Path
+
+import numpy as np
+import pytest
+from support.cli import run, world_dirs
+from support.reftools_usd import open_stage, pxr_modules, validation_issues, world_matrix
+
+import worldgen
+from worldgen.generators.registry import names as generator_names
+from worldgen.presets import generate_preset
+from worldgen.presets import names as preset_names
+from worldgen.scene.motion import positions_at
+from worldgen.scene.pose import rpy_matrix
+
+TOL = 1e-3  # m: what every format promises to agree within
+CASES = [("generator", g, s) for g in generator_names() for s in (0, 1)] + [("preset", p, 0) for p in preset_names()]
+IDS = [f"{kind}-{name}-s{seed}" for kind, name, seed in CASES]
+
+
+@lru_cache(maxsize=None)
+def _world(kind: str, name: str, seed: int):
+    world = generate_preset(name, seed) if kind == "preset" else worldgen.generate(name, seed)
+    return world, open_stage(world.export("usd"))
+
+
+def _meta(world) -> dict:
+    return world.metadata_for(world.rendered_files(["sdf", "usd"]))
+
+
+def _shape_prims(stage) -> dict:
+    """Scene node name -> its Xform prim (the parent of a `shape` prim), movers and people left out."""
+    out = {}
+    for prim in stage.Traverse():
+        path = str(prim.GetPath())
+        if prim.GetName() == "shape" and not path.startswith(("/World/Movers/", "/World/People/")):
+            out[prim.GetParent().GetName()] = prim.GetParent()
+    return out
+
+
+@pytest.mark.parametrize("kind,name,seed", CASES, ids=IDS)
+def test_stage_opens_and_every_validator_passes(kind, name, seed):
+    world, stage = _world(kind, name, seed)
+    Usd, UsdGeom, UsdPhysics, *_ = pxr_modules()
+    assert stage.GetCompositionErrors() == []
+    assert validation_issues(stage) == []
+    assert UsdGeom.GetStageUpAxis(stage) == "Z" and UsdGeom.GetStageMetersPerUnit(stage) == 1.0
+    assert UsdPhysics.GetStageKilogramsPerUnit(stage) == 1.0
+    assert stage.GetDefaultPrim().GetPath() == "/World" and stage.GetTimeCodesPerSecond() == 60
+    scene = UsdPhysics.Scene(stage.GetPrimAtPath("/World/PhysicsScene"))
+    g = np.array(world.scene.physics.gravity)
+    assert np.allclose(np.array(scene.GetGravityDirectionAttr().Get()) * scene.GetGravityMagnitudeAttr().Get(), g, atol=1e-5)
+
+
+@pytest.mark.parametrize("kind,name,seed", CASES, ids=IDS)
+def test_every_collider_agrees_with_world_json(kind, name, seed):
+    """Pose and size of each entity's shape within 1 mm; collider, rigid body and friction as the scene says."""
+    world, stage = _world(kind, name, seed)
+    Usd, UsdGeom, UsdPhysics, *_ = pxr_modules()
+    prims = _shape_prims(stage)
+    entities = [e for e in _meta(world)["entities"] if e["shape"] is not None]
+    assert sorted(prims) == sorted(e["name"] for e in entities)
+    for entity in entities:
+        node = world.scene.node(entity["name"])
+        xform, shape = prims[entity["name"]], prims[entity["name"]].GetChild("shape")
+        m = world_matrix(shape)
+        pose = entity["pose"]
+        assert np.allclose(m[:3, 3], pose[:3], atol=TOL), entity["name"]
+        r = rpy_matrix(*pose[3:])
+        described = entity["shape"]
+        if described["type"] == "box":
+            assert shape.GetTypeName() == "Cube" and shape.GetAttribute("size").Get() == 1.0
+            expected = r * np.array(described["size"])  # unit cube: columns scaled by the extents
+        elif described["type"] == "cylinder":
+            assert shape.GetTypeName() == "Cylinder" and shape.GetAttribute("axis").Get() == "Z"
+            assert abs(shape.GetAttribute("radius").Get() - described["radius"]) < TOL
+            assert abs(shape.GetAttribute("height").Get() - described["length"]) < TOL
+            expected = r
+        elif described["type"] == "sphere":
+            assert abs(shape.GetAttribute("radius").Get() - described["radius"]) < TOL
+            expected = r
+        else:
+            assert shape.GetTypeName() == "Mesh"
+            expected = r * np.array(described["scale"])
+        # Each column is a shape axis times its extent, so 1 mm here is 1 mm at the shape's faces.
+        assert np.allclose(m[:3, :3], expected, atol=TOL), entity["name"]
+        assert shape.HasAPI(UsdPhysics.CollisionAPI) == node.collision
+        assert xform.HasAPI(UsdPhysics.RigidBodyAPI) == (not node.static), entity["name"]
+        if node.collision:
+            (target,) = shape.GetRelationship("material:binding:physics").GetTargets()
+            material = UsdPhysics.MaterialAPI(stage.GetPrimAtPath(target))
+            assert abs(material.GetDynamicFrictionAttr().Get() - node.material.friction) < 1e-6
+            assert abs(material.GetStaticFrictionAttr().Get() - node.material.friction) < 1e-6
+        if not node.static:
+            assert abs(UsdPhysics.MassAPI(xform).GetMassAttr().Get() - node.mass) < 1e-6
+
+
+def _sdf_frames(sdf_text: str) -> dict:
+    """Joint name -> (world origin, world unit axis, lower, upper) read off an SDF 1.9 world by hand:
+    model pose, link poses relative to their parent links, the joint's pose in its child, axis in the joint."""
+    from lxml import etree
+
+    from worldgen.export.xml import safe_parser
+
+    def matrix(text):
+        x, y, z, roll, pitch, yaw = (float(v) for v in (text or "0 0 0 0 0 0").split())
+        m = np.eye(4)
+        m[:3, :3], m[:3, 3] = rpy_matrix(roll, pitch, yaw), (x, y, z)
+        return m
+
+    out = {}
+    root = etree.fromstring(sdf_text.encode(), safe_parser())
+    for model in root.iter("model"):
+        base = matrix(model.findtext("pose"))
+        links = {link.get("name"): link for link in model.findall("link")}
+        placed: dict = {}
+
+        def world_of(name):
+            if name not in placed:
+                pose = links[name].find("pose")
+                if pose is None:
+                    placed[name] = base
+                else:
+                    placed[name] = world_of(pose.get("relative_to")) @ matrix(pose.text)
+            return placed[name]
+
+        for joint in model.findall("joint[@type='revolute']"):
+            frame = world_of(joint.findtext("child")) @ matrix(joint.findtext("pose"))
+            axis = frame[:3, :3] @ np.array([float(v) for v in joint.findtext("axis/xyz").split()])
+            limit = joint.find("axis/limit")
+            out[joint.get("name")] = (frame[:3, 3], axis / np.linalg.norm(axis),
+                                      float(limit.findtext("lower")), float(limit.findtext("upper")))
+    return out
+
+
+def _quat_matrix(q) -> np.ndarray:
+    w, (x, y, z) = q.GetReal(), q.GetImaginary()
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+
+def _joint_frame(stage, joint, side: int) -> np.ndarray:
+    """The joint's frame on body ``side`` (0 or 1) in the world."""
+    targets = joint.GetRelationship(f"physics:body{side}").GetTargets()
+    body = world_matrix(stage.GetPrimAtPath(targets[0])) if targets else np.eye(4)
+    local = np.eye(4)
+    local[:3, :3] = _quat_matrix(joint.GetAttribute(f"physics:localRot{side}").Get())
+    local[:3, 3] = np.array(joint.GetAttribute(f"physics:localPos{side}").Get())
+    return body @ local
+
+
+DOOR_CASES = [(kind, name, seed) for kind, name, seed in CASES if name in ("door", "door_crossing", "person_in_doorway")]
+
+
+@pytest.mark.parametrize("kind,name,seed", DOOR_CASES + [("door_ajar", "door", 3)],
+                         ids=[f"{k}-{n}-s{s}" for k, n, s in DOOR_CASES] + ["door-ajar"])
+def test_door_hinges_agree_with_the_sdf_and_world_json(kind, name, seed):
+    """Axis, hinge, limits: the SDF's (whose limits are measured from the initial angle) and world.json's."""
+    if kind == "door_ajar":  # leaves that start ajar: the frames must still read world.json's angle
+        world = worldgen.generate("door", seed, state="ajar")
+        stage = open_stage(world.export("usd"))
+    else:
+        world, stage = _world(kind, name, seed)
+    Usd, UsdGeom, UsdPhysics, *_ = pxr_modules()
+    sdf = _sdf_frames(world.to_sdf())
+    doors = {d["joint"]: d for d in _meta(world)["doors"]}
+    joints = {p.GetName(): p for p in stage.Traverse() if p.IsA(UsdPhysics.RevoluteJoint)}
+    assert sorted(joints) == sorted(doors) == sorted(sdf) and doors
+    for name_, prim in joints.items():
+        door, (origin, axis, lower, upper) = doors[name_], sdf[name_]
+        joint = UsdPhysics.RevoluteJoint(prim)
+        assert joint.GetAxisAttr().Get() == "Z"
+        f0, f1 = _joint_frame(stage, prim, 0), _joint_frame(stage, prim, 1)
+        assert np.allclose(f0[:3, 2], axis, atol=1e-5) and np.allclose(f1[:3, 2], door["axis"], atol=1e-5)
+        assert np.allclose(f0[:3, 3], origin, atol=TOL) and np.allclose(f1[:3, 3], origin, atol=TOL)
+        # The hinge line of world.json passes through the joint's origin.
+        offset = origin - np.array(door["hinge"])
+        assert np.linalg.norm(offset - offset.dot(axis) * axis) < TOL
+        # Frame 1 is frame 0 turned about z by world.json's angle: the angle PhysX reads at the start.
+        turn = f0[:3, :3].T @ f1[:3, :3]
+        assert abs(math.atan2(turn[1, 0], turn[0, 0]) - door["angle"]) < 1e-5 and abs(turn[2, 2] - 1) < 1e-6
+        lo, hi = math.radians(joint.GetLowerLimitAttr().Get()), math.radians(joint.GetUpperLimitAttr().Get())
+        assert abs(lo - (lower + door["angle"])) < 1e-5 and abs(hi - (upper + door["angle"])) < 1e-5
+        assert abs(lo - door["limits"][0]) < 1e-5 and abs(hi - door["limits"][1]) < 1e-5
+        damping = prim.GetAttribute("drive:angular:physics:damping")
+        assert abs((math.degrees(damping.Get()) if damping else 0.0) - door["damping"]) < 1e-3
+
+
+MOVING_CASES = [(kind, name, seed) for kind, name, seed in CASES if kind == "preset" and name.startswith(("person", "group"))]
+
+
+def _moving_worlds():
+    for kind, name, seed in MOVING_CASES:
+        yield f"{name}", *_world(kind, name, seed)
+    for generator in generator_names():  # scripted movers, looping
+        world = worldgen.generate(generator, 0, n_movers=2)
+        yield f"{generator}-movers", world, open_stage(world.export("usd"))
+
+
+@pytest.mark.parametrize("index", range(len(MOVING_CASES) + len(generator_names())))
+def test_every_time_sample_agrees_with_world_json(index):
+    """Each sample, and each midpoint between samples, within 1 mm of world.json's walk at that time."""
+    label, world, stage = list(_moving_worlds())[index]
+    Usd, UsdGeom, UsdPhysics, *_ = pxr_modules()
+    meta = _meta(world)
+    movers = [(m, "Movers") for m in meta["dynamic_obstacles"]] + [(m, "People") for m in meta.get("people", [])]
+    assert movers, label
+    rate = stage.GetTimeCodesPerSecond()
+    for entry, group in movers:
+        prim = stage.GetPrimAtPath(f"/World/{group}/{entry['name']}")
+        assert UsdPhysics.RigidBodyAPI(prim).GetKinematicEnabledAttr().Get() is True
+        assert entry["formats"]["usd"] == "kinematic_body"
+        shape = prim.GetChild("shape")
+        assert abs(shape.GetAttribute("radius").Get() - entry["radius"]) < TOL
+        translate = prim.GetAttribute("xformOp:translate")
+        codes = np.array(translate.GetTimeSamples())
+        track, loop = np.asarray(entry["trajectory"], dtype=float), bool(entry.get("loop", False))
+        mids = (codes[:-1] + codes[1:]) / 2
+        for times in (codes, mids):
+            got = np.array([translate.Get(c) for c in times])
+            want = positions_at([track], [loop], times / rate)[:, 0, :]
+            assert np.abs(got[:, :2] - want).max() < TOL, (label, entry["name"])
+            assert np.allclose(got[:, 2], entry["height"] / 2, atol=1e-9)
+        if loop:  # written out over the longest time limit a task allows
+            longest = max(t["time_limit"] for t in meta["tasks"] if t["time_limit"] is not None)
+            assert codes[-1] / rate >= min(longest, 1e9) - 1e-6
+        else:
+            assert len(codes) == len(track)
+        assert stage.GetEndTimeCode() >= codes[-1]
+
+
+@pytest.mark.parametrize("kind,name,seed", CASES[::3], ids=IDS[::3])
+def test_tasks_are_named_xforms_at_world_json_poses(kind, name, seed):
+    world, stage = _world(kind, name, seed)
+    for task in _meta(world)["tasks"]:
+        for label in ("spawn", "goal"):
+            prim = stage.GetPrimAtPath(f"/World/Tasks/{task['id']}/{label}")
+            m, pose = world_matrix(prim), task[label]
+            assert np.allclose(m[:3, 3], pose[:3], atol=TOL)
+            assert np.allclose(m[:3, :3], rpy_matrix(*pose[3:]), atol=1e-5)
+        tolerance = stage.GetPrimAtPath(f"/World/Tasks/{task['id']}/goal").GetAttribute("worldgen:goalTolerance")
+        assert tolerance.Get() == task["goal_tolerance"]
+
+
+_WRITE = (
+    "import sys, worldgen\n"
+    "from worldgen.presets import generate_preset\n"
+    "for name in ('person_in_doorway', 'door_crossing'):\n"
+    "    sys.stdout.write(generate_preset(name, 1).export('usd'))\n"
+    "sys.stdout.write(worldgen.generate('cluttered', 2, n_movers=2).export('usd'))\n"
+)
+
+
+def test_the_same_bytes_in_two_processes():
+    outs = [subprocess.run([sys.executable, "-c", _WRITE], capture_output=True, text=True, timeout=300) for _ in range(2)]
+    assert all(o.returncode == 0 for o in outs), outs[0].stderr[-2000:]
+    assert outs[0].stdout == outs[1].stdout and len(outs[0].stdout) > 10000
+
+
+def test_writing_usd_changes_world_json_only_by_its_file_and_notes():
+    world = generate_preset("person_crossing", 0)
+    with_usd, without = _meta(world), world.metadata_for(world.rendered_files(["sdf"]))
+    assert with_usd["files"].pop("usd")["path"] == "world.usda"
+    for entry in with_usd["people"]:
+        assert entry["formats"].pop("usd") == "kinematic_body"
+    assert json.dumps(with_usd, sort_keys=True) == json.dumps(without, sort_keys=True)
+
+
+def test_command_writes_and_check_reverifies_world_usda(tmp_path):
+    res = run("generate", "door", "--out", tmp_path, "--formats", "usd,sdf")
+    assert res.returncode == 0, res.stderr
+    (folder,) = world_dirs(tmp_path)
+    assert (folder / "world.usda").read_text().startswith("#usda 1.0")
+    assert run("check", folder).returncode == 0
+    usda = folder / "world.usda"
+    usda.write_text(usda.read_text().replace("physics:upperLimit = ", "physics:upperLimit = 1"))
+    res = run("check", folder)
+    assert res.returncode != 0 and "world.usda" in res.stdout + res.stderr
+
+
+_BLOCKED = (
+    "import sys\n"
+    "sys.modules['pxr'] = None  # as if usd-core were not installed\n"
+    "from pathlib import Path\n"
+    "import worldgen\n"
+    "from worldgen.errors import MissingDependencyError\n"
+    "from worldgen.verify import check_folder\n"
+    "out = Path(sys.argv[1])\n"
+    "world = worldgen.generate('door', 0)\n"
+    "try:\n"
+    "    world.write(out / 'a', formats=['sdf', 'usd'])\n"
+    "    raise SystemExit('usd written without pxr')\n"
+    "except MissingDependencyError as exc:\n"
+    "    assert \"pip install 'worldgen[usd]'\" in str(exc) and '\\n' not in str(exc), exc\n"
+    "assert not (out / 'a').exists()\n"
+    "assert check_folder(world.write(out / 'b')).ok\n"
+    "from worldgen.cli import main\n"
+    "sys.argv = ['worldgen', 'generate', 'door', '--out', str(out / 'c'), '--formats', 'sdf,usd']\n"
+    "raise SystemExit(main())\n"
+)
+
+
+def test_without_usd_core_one_line_and_no_folder(tmp_path):
+    res = subprocess.run([sys.executable, "-c", _BLOCKED, str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 2, res.stderr[-2000:]
+    assert res.stderr.count("\n") == 1 and "pip install 'worldgen[usd]'" in res.stderr and "usd-core" in res.stderr
+    assert "Traceback" not in res.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b"]  # the world without usd, and nothing else
+    assert {p.name for p in next((tmp_path / "b").iterdir()).iterdir()} >= {"world.sdf", "world.mjcf.xml", "world.urdf"}
+    assert not any(p.name == "world.usda" for p in (tmp_path / "b").rglob("*"))
+
+
+def test_a_pack_recipe_with_usd_and_without_usd_core(tmp_path):
+    recipe = tmp_path / "r.yaml"
+    recipe.write_text("formats: [sdf, usd]\nseeds: 1\nworlds:\n  - generator: minimal\n")
+    script = ("import sys\nsys.modules['pxr'] = None\nfrom worldgen.cli import main\n"
+              f"sys.argv = ['worldgen', 'pack', 'build', {str(recipe)!r}, '--out', {str(tmp_path / 'pack')!r}]\nraise SystemExit(main())\n")
+    res = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 2 and "pip install 'worldgen[usd]'" in res.stderr, res.stderr[-2000:]
+    assert not (tmp_path / "pack").exists()
+    res = run("pack", "build", recipe, "--out", tmp_path / "pack")
+    assert res.returncode == 0, res.stderr
+    assert len(list(Path(tmp_path / "pack").rglob("world.usda"))) == 1
