@@ -10,6 +10,9 @@ times across runs). Stages:
   sdf/mjcf/urdf each exporter, Scene -> text
   metadata     world.json from the rendered files
   pipeline     generate() + all three formats + metadata, in memory (what an RL loop pays)
+  usd          the USD exporter alone, Scene -> world.usda text (where usd-core is installed)
+  pipeline_usd the pipeline with world.usda written too (generate() + four formats + metadata): the
+               usd format's cost when asked for; "usd_share" = pipeline_usd / pipeline - 1
   floor        the serialisation floor for the same world, no planning: its three XML documents
                rebuilt element by element as lxml trees and serialised, plus json.dumps of world.json
                (the cost of merely writing what the pipeline writes); "ratio" = pipeline / floor
@@ -36,6 +39,8 @@ from pathlib import Path
 
 import worldgen
 from worldgen import feasibility
+from worldgen.export.formats import ALL_FORMATS
+from worldgen.export.usd_prims import usd_available
 from worldgen.generators import get, robot_from_params
 from worldgen.seeding import attempt_rng
 
@@ -51,6 +56,10 @@ SERIES = {
 }
 STAGES = ("build", "feasibility", "sdf", "mjcf", "urdf", "metadata", "pipeline", "floor", "write",
           "lidar", "occupancy", "metrics", "groundtruth")
+#: Stages timed only where usd-core is installed (the usd extra).
+USD_STAGES = ("usd", "pipeline_usd")
+#: Issue 32's target: writing USD adds at most this share to the pipeline, at (series, obstacles).
+USD_TARGET = ("default", 50, 0.30)
 #: Issue 9's targets: (series, obstacles) -> largest median pipeline ms, and pipeline / floor ratio.
 PIPELINE_TARGETS = {("default", 50): 12.0, ("default", 200): 40.0, ("scaling", 1000): 250.0}
 RATIO_TARGETS = {("default", 50): 7.0, ("default", 200): 6.0}
@@ -105,6 +114,14 @@ def time_world(params: dict, seed: int, out_dir: Path) -> dict[str, float]:
     world.write(out_dir)
     t["write"] = time.perf_counter() - t0
     t["attempts"] = world.attempts
+    if usd_available():
+        t0 = time.perf_counter()
+        world._render("usd", "1.9")
+        t["usd"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        again = worldgen.generate("cluttered", seed=seed, **params)
+        again.metadata_for(again.rendered_files(ALL_FORMATS))
+        t["pipeline_usd"] = time.perf_counter() - t0
     return t
 
 
@@ -164,6 +181,11 @@ def targets(results: dict) -> list[dict]:
     got = series[name][str(n)]["feasibility"]
     out.append({"target": f"feasibility alone, {n} obstacles ({name})", "limit": limit, "measured": got,
                 "unit": "ms", "met": got <= limit})
+    name, n, limit = USD_TARGET
+    got = series[name][str(n)].get("usd_share")
+    if got is not None:
+        out.append({"target": f"pipeline with usd / without - 1, {n} obstacles ({name})", "limit": limit,
+                    "measured": got, "unit": "", "met": got <= limit})
     got = results["slope"]
     out.append({"target": "log-log slope of pipeline cost vs obstacles (scaling, 10-1000)", "limit": SLOPE_TARGET,
                 "measured": got, "unit": "", "met": got <= SLOPE_TARGET})
@@ -183,11 +205,14 @@ def run(runs: int) -> dict:
                 time_world(params, 10_000, Path(tmp))  # warm-up: imports, caches
                 for seed in seeds:
                     samples.append(time_world(params, seed, Path(tmp)))
+            stages = STAGES + (USD_STAGES if "usd" in samples[0] else ())
             rows[str(n)] = {
-                **{stage: _ms(statistics.median(s[stage] for s in samples)) for stage in STAGES},
+                **{stage: _ms(statistics.median(s[stage] for s in samples)) for stage in stages},
                 "ratio": round(statistics.median(s["pipeline"] / s["floor"] for s in samples), 2),
                 "attempts_mean": round(statistics.mean(s["attempts"] for s in samples), 2),
                 "worlds": len(samples),
+                **({"usd_share": round(statistics.median(s["pipeline_usd"] / s["pipeline"] - 1 for s in samples), 3)}
+                   if "usd" in samples[0] else {}),
             }
         results["series"][series] = rows
     results["slope"] = round(loglog_slope(results["series"]["scaling"]), 3)
@@ -198,17 +223,18 @@ def run(runs: int) -> dict:
 def print_table(results: dict) -> None:
     for series, rows in results["series"].items():
         print(f"\nseries '{series}' (median ms over {results['runs']} seeds; 1000 obstacles: fewer)")
-        print(f"{'obstacles':>9} " + " ".join(f"{s:>11}" for s in STAGES) + f" {'ratio':>6} {'attempts':>8} {'x per obst.':>11}")
+        stages = STAGES + tuple(s for s in USD_STAGES if s in next(iter(rows.values())))
+        print(f"{'obstacles':>9} " + " ".join(f"{s:>11}" for s in stages) + f" {'ratio':>6} {'attempts':>8} {'x per obst.':>11}")
         first = None
         for n, row in rows.items():
             first = first or (row["pipeline"], int(n))
             growth = (row["pipeline"] / first[0]) / (int(n) / first[1])
-            print(f"{n:>9} " + " ".join(f"{row[s]:>11.2f}" for s in STAGES)
+            print(f"{n:>9} " + " ".join(f"{row[s]:>11.2f}" for s in stages)
                   + f" {row['ratio']:>6.2f} {row['attempts_mean']:>8.2f} {growth:>11.2f}")
         print("  'x per obst.': pipeline time ratio to the first row divided by the obstacle-count ratio"
               " (1.0 = linear, below 1 = sub-linear); 'ratio': pipeline / floor, median of per-world ratios")
     print(f"\nlog-log slope of pipeline cost against obstacle count (scaling series): {results['slope']:.3f}")
-    print("\ntargets (issue 9):")
+    print("\ntargets (issues 9 and 32):")
     for t in results["targets"]:
         print(f"  {'met   ' if t['met'] else 'MISSED'} {t['target']:<66} {t['measured']:>8.2f} {t['unit']:<2}"
               f" (limit {t['limit']:g} {t['unit']})")
