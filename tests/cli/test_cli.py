@@ -184,7 +184,7 @@ MISTAKES = {
     "seed in --set": (["generate", "cluttered", "--set", "seed=3", "--out", "{out}"],
                       r"error: unknown parameter 'seed' for generator 'cluttered' \(the seed is set with --seed\); known .*"),
     "bad formats": (["generate", "cluttered", "--formats", "sdf,obj", "--out", "{out}"],
-                    r"error: parameter 'formats' must name formats among sdf, mjcf, urdf, got 'obj'"),
+                    r"error: parameter 'formats' must name formats among sdf, mjcf, urdf, usd, usdc, got 'obj'"),
     "empty formats": (["generate", "cluttered", "--formats", ",", "--out", "{out}"],
                       r"error: parameter 'formats' must name at least one of sdf, mjcf, urdf, got nothing"),
     "bad sdf version": (["generate", "cluttered", "--sdf-version", "1.7", "--out", "{out}"],

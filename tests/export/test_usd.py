@@ -21,6 +21,7 @@ from support.cli import run, world_dirs
 from support.reftools_usd import open_stage, pxr_modules, validation_issues, world_matrix
 
 import worldgen
+from worldgen.errors import OutputError
 from worldgen.generators.registry import names as generator_names
 from worldgen.presets import generate_preset
 from worldgen.presets import names as preset_names
@@ -338,3 +339,39 @@ def test_a_pack_recipe_with_usd_and_without_usd_core(tmp_path):
     res = run("pack", "build", recipe, "--out", tmp_path / "pack")
     assert res.returncode == 0, res.stderr
     assert len(list(Path(tmp_path / "pack").rglob("world.usda"))) == 1
+
+
+def test_a_world_written_without_usd_never_imports_usd_core(tmp_path):
+    """Not asking for usd costs nothing: neither pxr nor the USD writer is imported."""
+    script = (
+        "import sys, worldgen\n"
+        "world = worldgen.generate('door', 0, n_movers=1)\n"
+        "world.write(sys.argv[1])\n"
+        "print(sorted(m for m in sys.modules if m == 'pxr' or m.startswith(('pxr.', 'worldgen.export.usd'))))\n"
+    )
+    res = subprocess.run([sys.executable, "-c", script, str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0 and res.stdout.strip() == "[]", res.stdout + res.stderr[-2000:]
+
+
+def test_usdc_is_the_same_stage_in_binary(tmp_path):
+    """world.usdc read back by usd-core is, as text, exactly world.usda; both written by one folder and checked."""
+    _, _, _, Sdf, _ = pxr_modules()
+    world = generate_preset("person_in_doorway", 0)
+    folder = world.write(tmp_path, formats=["usd", "usdc"], preview=False)
+    data = (folder / "world.usdc").read_bytes()
+    assert data.startswith(b"PXR-USDC") and data == world.export_bytes("usdc")
+    layer = Sdf.Layer.FindOrOpen(str(folder / "world.usdc"))
+    assert layer.ExportToString() == (folder / "world.usda").read_text()
+    with pytest.raises(OutputError, match="export_bytes"):
+        world.export("usdc")
+    meta = json.loads((folder / "world.json").read_text())
+    assert meta["files"]["usdc"]["path"] == "world.usdc" and meta["people"][0]["formats"]["usdc"] == "kinematic_body"
+    from worldgen.verify import check_folder
+
+    assert check_folder(folder).ok
+
+
+def test_usdc_is_the_same_bytes_in_two_processes():
+    script = "import sys, worldgen\nsys.stdout.buffer.write(worldgen.generate('door', 0, n_movers=2).export_bytes('usdc'))\n"
+    outs = [subprocess.run([sys.executable, "-c", script], capture_output=True, timeout=300) for _ in range(2)]
+    assert all(o.returncode == 0 for o in outs) and outs[0].stdout == outs[1].stdout and len(outs[0].stdout) > 1000

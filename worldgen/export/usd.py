@@ -43,7 +43,7 @@ from worldgen.floats import fmt, round_float
 from worldgen.scene import Mesh, Node, Scene
 from worldgen.scene.graph import Joint, Task
 
-__all__ = ["to_usd", "RESERVED", "SHAPE_PRIM", "MIN_MOMENT", "material_name"]
+__all__ = ["to_usd", "to_usdc", "RESERVED", "SHAPE_PRIM", "MIN_MOMENT", "material_name"]
 
 #: Names of /World's own children, and the shape prim's: no node may take them.
 RESERVED = ("PhysicsScene", "PhysicsMaterials", "Movers", "People", "Tasks", SHAPE_PRIM)
@@ -62,6 +62,23 @@ def to_usd(scene: Scene, name: str = "default", tasks: Sequence[Task] = (), dura
     ``tasks`` become named Xforms for scripts to find; ``duration`` (s) is how long looping movers
     are played out for (USD has no looping time samples), at least one period each.
     """
+    return _layer(scene, name, tasks, duration).ExportToString().encode()
+
+
+def to_usdc(scene: Scene, name: str = "default", tasks: Sequence[Task] = (), duration: float = 0.0) -> bytes:
+    """The same stage as :func:`to_usd`, in USD's binary crate form (``.usdc``)."""
+    import tempfile
+    from pathlib import Path
+
+    layer = _layer(scene, name, tasks, duration)
+    with tempfile.TemporaryDirectory(prefix="worldgen-usdc-") as folder:
+        path = Path(folder) / "world.usdc"  # usd-core writes a crate file only to a path, by its extension
+        if not layer.Export(str(path)):
+            raise WorldgenError(f"usd-core could not write {path.name}")
+        return path.read_bytes()
+
+
+def _layer(scene: Scene, name: str, tasks: Sequence[Task], duration: float):
     pxr = require_pxr()
     taken = [n.name for n in scene.nodes if n.name in RESERVED] + [j.name for j in scene.joints if j.name == SHAPE_PRIM]
     if taken:
@@ -85,7 +102,7 @@ def to_usd(scene: Scene, name: str = "default", tasks: Sequence[Task] = (), dura
         root.SetInfo("framesPerSecond", float(TIME_CODES_PER_SECOND))
         root.SetInfo("startTimeCode", 0.0)
         root.SetInfo("endTimeCode", end)
-    return specs.layer.ExportToString().encode()
+    return specs.layer
 
 
 def _physics_scene(specs: Specs, world, scene: Scene) -> None:
