@@ -21,7 +21,8 @@ One text layer (``#usda 1.0``), Z up, metres and kilograms (``upAxis = "Z"``, ``
   hinge on the leaf as it stands, so the angle PhysX reads at the start is world.json's
   ``doors[].angle`` and the limits are the scene's own (degrees, as UsdPhysics measures angles).
   Joint damping is an angular ``PhysicsDriveAPI`` with no stiffness (its damping is per degree).
-  A dynamic node that no revolute joint holds is fixed to its parent with a ``PhysicsFixedJoint``.
+  A dynamic node on a fixed joint, or under a parent with no joint, is fixed to it with a
+  ``PhysicsFixedJoint``; a dynamic root with no joint is a free body (as in the SDF).
 * ``/World/Movers/<name>``, ``/World/People/<name>``, ``/World/Tasks/<task id>/spawn|goal``: see
   :mod:`worldgen.export.usd_motion`.
 
@@ -186,7 +187,8 @@ class _NodeWriter:
             joint = self.joint_of.get(node.name)
             if joint is not None and joint.kind == "revolute":
                 self._revolute(prim, joint)
-            else:
+            elif joint is not None or node.parent is not None:
+                # Held to its parent (or to the world) as the SDF holds it; a root with no joint is a free body.
                 self._fixed(prim, node, joint.name if joint is not None else f"{node.name}_fixed")
 
     def _node(self, parent, node: Node, rigid: bool):
@@ -246,7 +248,8 @@ class _NodeWriter:
             specs.attr(prim, "drive:angular:physics:damping", "Float", round_float(math.radians(joint.damping)))
 
     def _fixed(self, body, node: Node, name: str) -> None:
-        parent = node.parent if node.parent is not None else "world"
+        joint = self.joint_of.get(node.name)
+        parent = joint.parent if joint is not None else node.parent
         prim = self.specs.prim(body, name, "PhysicsFixedJoint")
         self._ends(prim, parent, node.name)
         child_in_parent = np.linalg.inv(self._parent_matrix(parent)) @ self.scene.world_matrix(node.name)
