@@ -97,6 +97,9 @@ class Specs:
         self.Sdf, self.Gf, self.Vt = pxr.Sdf, pxr.Gf, pxr.Vt
         self.T = pxr.Sdf.ValueTypeNames
         self.layer = pxr.Sdf.Layer.CreateAnonymous("world.usda")
+        # Box prims that differ only in their extents are copied from one written here (see shape()).
+        self._templates = pxr.Sdf.Layer.CreateAnonymous("templates.usda")
+        self._template_paths: dict[tuple, Any] = {}
 
     def prim(self, parent, name: str, type_name: str, api: Sequence[str] = ()):
         """A ``def`` prim under ``parent`` (a PrimSpec, or None for the layer's root) with API schemas applied."""
@@ -140,7 +143,25 @@ class Specs:
 
     def shape(self, parent, shape, rgba, material: Optional[str], rigid: bool, name: str = SHAPE_PRIM):
         """The gprim of ``shape`` under ``parent``: a unit Cube scaled to a box's extents, a Cylinder
-        along z, a Sphere, or a Mesh; a collider bound to the physics ``material`` path unless that is None."""
+        along z, a Sphere, or a Mesh; a collider bound to the physics ``material`` path unless that is None.
+
+        A box is copied (``Sdf.CopySpec``, one call into usd-core) from a template with the same colour,
+        material and body, then given its extents: the same specs as writing it field by field, for
+        about half the cost (boxes are most of a world).
+        """
+        if not isinstance(shape, Box):
+            return self._shape(parent, shape, rgba, material, rigid, name)
+        key = (tuple(rgba), material, rigid, name)
+        source = self._template_paths.get(key)
+        if source is None:
+            holder = self.Sdf.PrimSpec(self._templates, f"t{len(self._template_paths)}", self.Sdf.SpecifierDef, "Xform")
+            source = self._template_paths[key] = self._shape(holder, Box((1.0, 1.0, 1.0)), rgba, material, rigid, name).path
+        target = parent.path.AppendChild(name)
+        self.Sdf.CopySpec(self._templates, source, self.layer, target)
+        self.layer.GetAttributeAtPath(target.AppendProperty("xformOp:scale")).default = self.vec3(shape.size)
+        return self.layer.GetPrimAtPath(target)
+
+    def _shape(self, parent, shape, rgba, material: Optional[str], rigid: bool, name: str):
         api = [] if material is None else ["PhysicsCollisionAPI", "MaterialBindingAPI"]
         if isinstance(shape, Box):
             prim = self.prim(parent, name, "Cube", api)
