@@ -16,7 +16,7 @@ from typing import Any, Iterable, Optional, Sequence
 
 import numpy as np
 
-from worldgen.errors import MissingDependencyError, WorldgenError
+from worldgen.errors import WorldgenError, require_optional
 from worldgen.floats import round_float
 from worldgen.scene.shapes import Box, Cylinder, Mesh, Sphere
 
@@ -25,7 +25,7 @@ __all__ = ["SHAPE_PRIM", "INSTALL_HINT", "require_pxr", "usd_available", "Specs"
 #: The prim under a node's, mover's or person's Xform that holds its shape.
 SHAPE_PRIM = "shape"
 #: What to install for USD (the ``usd`` extra of worldgen's pyproject.toml: Pixar's usd-core wheels).
-INSTALL_HINT = "pip install 'worldgen[usd]'"
+INSTALL_HINT = "pip install 'worldgen[usd]'"  # what require_optional's message says, for docs and callers
 
 
 def usd_available() -> bool:
@@ -37,15 +37,11 @@ def usd_available() -> bool:
 
 
 def require_pxr():
-    """The ``pxr`` package with Sdf, Gf and Vt loaded, or :class:`MissingDependencyError` in one line."""
-    try:
-        importlib.import_module("pxr.Sdf")
-        importlib.import_module("pxr.Gf")
-        importlib.import_module("pxr.Vt")
-        return importlib.import_module("pxr")
-    except ImportError:
-        raise MissingDependencyError(
-            f"the usd format needs usd-core (Pixar's pxr), which is not installed: {INSTALL_HINT}") from None
+    """The ``pxr`` package with Sdf, Gf and Vt loaded, or MissingDependencyError naming the ``usd`` extra."""
+    needs = "the usd format needs usd-core (Pixar's pxr)"
+    for module in ("pxr.Sdf", "pxr.Gf", "pxr.Vt"):
+        require_optional(module, "usd", needs)
+    return require_optional("pxr", "usd", needs)
 
 
 def quaternion(roll: float, pitch: float, yaw: float) -> tuple[float, float, float, float]:
