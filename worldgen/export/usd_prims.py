@@ -4,8 +4,9 @@ property specs, rotations as quaternions, one shape as a UsdGeom prim, and the o
 The layer is authored through ``pxr.Sdf`` (specs straight into one layer) rather than through
 ``Usd.Stage`` and the schema classes: the same text comes out, at a third of the cost (a stage
 re-composes after every edit; an ``Sdf.ChangeBlock`` batches the notices). Every number is rounded
-through :func:`worldgen.floats.round_float` before it is written, so the text does not depend on a
-float's last bits; ``Sdf`` writes each double in its shortest round-tripping form.
+as :func:`worldgen.floats.round_float` rounds (quaternions to 12 decimals, see below) before it is
+written, so the text does not depend on a float's last bits; ``Sdf`` writes each double in its
+shortest round-tripping form.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from typing import Any, Iterable, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import WorldgenError, require_optional
-from worldgen.floats import round_float
+from worldgen.floats import DECIMALS, round_float
 from worldgen.scene.shapes import Box, Cylinder, Mesh, Sphere
 
 __all__ = ["SHAPE_PRIM", "INSTALL_HINT", "require_pxr", "usd_available", "Specs", "quaternion", "matrix_quaternion"]
@@ -72,7 +73,9 @@ def matrix_quaternion(r: np.ndarray) -> tuple[float, float, float, float]:
 
 
 def _r(values: Iterable[float]) -> list[float]:
-    return [round_float(v) for v in values]
+    # round_float's rounding (a snapped -0.0 made 0.0 by + 0.0), without its finiteness test: a scene's
+    # numbers are finite by construction, and this runs for every number of every prim.
+    return [round(float(v), DECIMALS) + 0.0 for v in values]
 
 
 #: Decimals of a written quaternion. USD turns an ``orient`` into a matrix through its angle, 2 acos(w),
@@ -125,37 +128,44 @@ class Specs:
         w, x, y, z = _rq(wxyz)
         return (self.Gf.Quatd if double else self.Gf.Quatf)(w, x, y, z)
 
-    def transform(self, prim, position, wxyz=None, scale=None) -> None:
-        """``translate``, then ``orient`` and ``scale`` where given: the op order Isaac Sim expects."""
-        ops = ["xformOp:translate"]
+    def transform(self, prim, position, wxyz) -> None:
+        """``translate`` then ``orient``: the ops (and order) Isaac Sim expects of an Xform."""
         self.attr(prim, "xformOp:translate", "Double3", self.vec3(position))
-        if wxyz is not None:
-            self.attr(prim, "xformOp:orient", "Quatd", self.quat(wxyz))
-            ops.append("xformOp:orient")
-        if scale is not None:
-            self.attr(prim, "xformOp:scale", "Double3", self.vec3(scale))
-            ops.append("xformOp:scale")
-        self.attr(prim, "xformOpOrder", "TokenArray", ops, uniform=True)
+        self.attr(prim, "xformOp:orient", "Quatd", self.quat(wxyz))
+        self.attr(prim, "xformOpOrder", "TokenArray", ["xformOp:translate", "xformOp:orient"], uniform=True)
 
     def shape(self, parent, shape, rgba, material: Optional[str], rigid: bool, name: str = SHAPE_PRIM):
         """The gprim of ``shape`` under ``parent``: a unit Cube scaled to a box's extents, a Cylinder
         along z, a Sphere, or a Mesh; a collider bound to the physics ``material`` path unless that is None.
 
-        A box is copied (``Sdf.CopySpec``, one call into usd-core) from a template with the same colour,
-        material and body, then given its extents: the same specs as writing it field by field, for
-        about half the cost (boxes are most of a world).
+        A box or cylinder is copied (``Sdf.CopySpec``, one call into usd-core) from a template with the
+        same colour, material and body, then given its sizes: the same specs as writing it field by
+        field, for about half the cost (boxes and cylinders are most of a world).
         """
-        if not isinstance(shape, Box):
+        if isinstance(shape, Box):
+            key, template = ("box", tuple(rgba), material, rigid, name), Box((1.0, 1.0, 1.0))
+        elif isinstance(shape, Cylinder):
+            key, template = ("cylinder", tuple(rgba), material, rigid, name), Cylinder(1.0, 1.0)
+        else:
             return self._shape(parent, shape, rgba, material, rigid, name)
-        key = (tuple(rgba), material, rigid, name)
         source = self._template_paths.get(key)
         if source is None:
             holder = self.Sdf.PrimSpec(self._templates, f"t{len(self._template_paths)}", self.Sdf.SpecifierDef, "Xform")
-            source = self._template_paths[key] = self._shape(holder, Box((1.0, 1.0, 1.0)), rgba, material, rigid, name).path
+            source = self._template_paths[key] = self._shape(holder, template, rgba, material, rigid, name).path
         target = parent.path.AppendChild(name)
         self.Sdf.CopySpec(self._templates, source, self.layer, target)
-        self.layer.GetAttributeAtPath(target.AppendProperty("xformOp:scale")).default = self.vec3(shape.size)
+        attribute = self.layer.GetAttributeAtPath
+        if isinstance(shape, Box):
+            attribute(target.AppendProperty("xformOp:scale")).default = self.vec3(shape.size)
+        else:
+            r, h = shape.radius, shape.length
+            attribute(target.AppendProperty("radius")).default = round_float(r)
+            attribute(target.AppendProperty("height")).default = round_float(h)
+            attribute(target.AppendProperty("extent")).default = self._extent((r, r, h / 2))
         return self.layer.GetPrimAtPath(target)
+
+    def _extent(self, half):
+        return self.Vt.Vec3fArray([self.vec3([-h for h in half], "Float3"), self.vec3(half, "Float3")])
 
     def _shape(self, parent, shape, rgba, material: Optional[str], rigid: bool, name: str):
         api = [] if material is None else ["PhysicsCollisionAPI", "MaterialBindingAPI"]
@@ -180,8 +190,7 @@ class Specs:
         else:
             raise WorldgenError(f"the USD exporter has no geometry for shape {shape!r}")
         if half is not None:
-            self.attr(prim, "extent", "Float3Array", self.Vt.Vec3fArray([self.vec3([-h for h in half], "Float3"),
-                                                                         self.vec3(half, "Float3")]))
+            self.attr(prim, "extent", "Float3Array", self._extent(half))
         self.attr(prim, "primvars:displayColor", "Color3fArray", self.Vt.Vec3fArray([self.vec3(rgba[:3], "Float3")]))
         if rgba[3] < 1.0:
             self.attr(prim, "primvars:displayOpacity", "FloatArray", self.Vt.FloatArray([round_float(rgba[3])]))
