@@ -186,7 +186,7 @@ MISTAKES = {
     "bad formats": (["generate", "cluttered", "--formats", "sdf,obj", "--out", "{out}"],
                     r"error: parameter 'formats' must name formats among sdf, mjcf, urdf, usd, usdc, got 'obj'"),
     "empty formats": (["generate", "cluttered", "--formats", ",", "--out", "{out}"],
-                      r"error: parameter 'formats' must name at least one of sdf, mjcf, urdf, got nothing"),
+                      r"error: parameter 'formats' must name at least one of sdf, mjcf, urdf, usd, usdc, got nothing"),
     "bad sdf version": (["generate", "cluttered", "--sdf-version", "1.7", "--out", "{out}"],
                         r"error: Invalid value for '--sdf-version': '1\.7' is not one of '1\.9', '1\.6'\..*"),
     "negative seed": (["generate", "cluttered", "--seed", "-1", "--out", "{out}"],

