@@ -109,9 +109,14 @@ class World:
 
     @property
     def folder_name(self) -> str:
-        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, else ``world_id``,
-        so worlds of several presets over one generator can be told apart in one folder."""
-        return f"{self.preset}--{self.world_id}" if self.preset else self.world_id
+        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, ``L<k>-r<request seed>--``
+        before the id for a world asked for at level k (its own seed is the draw that landed, 19 digits long), else
+        ``world_id``: worlds of several presets, or levels, over one generator can be told apart in one folder."""
+        name = self.world_id
+        if self.difficulty_request:
+            level = str(self.difficulty_request["level"]).split("/")[0]
+            name = f"L{level}-r{self.difficulty_request['seed']}--{name}"
+        return f"{self.preset}--{name}" if self.preset else name
 
     # -- in-memory exports -------------------------------------------------
     def to_sdf(self, version: str = "1.9") -> str:
