@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from support.planner_queries import DATA, space
 
+from worldgen.feasibility.exact import GRAPH_MAX_CIRCLES, ExactPlanner, exact_planner
 from worldgen.feasibility.planner import Planner
 from worldgen.feasibility.roadmap import Roadmap
 
@@ -45,3 +46,15 @@ def test_the_set_has_detours_and_dead_ends():
     assert len(rows) >= 300
     assert sum(1 for q in rows if q[4]) >= 150  # most go round obstacles
     assert any(q[3] is None for q in rows)  # and some have no path
+
+
+def test_one_interface_and_the_choice_by_queries_coming():
+    generator, seed, params, which = _WORLDS[2]  # a person's space among 50 obstacles
+    cs, _ = space(generator, seed, params, which)
+    few, many = exact_planner(cs, 1), exact_planner(cs, 1000)
+    assert isinstance(few, Planner) and isinstance(many, Roadmap)
+    assert isinstance(few, ExactPlanner) and isinstance(many, ExactPlanner)
+    generator, seed, params, which = _WORLDS[3]  # 200 obstacles: too many circles for the graph
+    big, _ = space(generator, seed, params, which)
+    assert big.n_circles > GRAPH_MAX_CIRCLES
+    assert isinstance(exact_planner(big, 10 ** 6), Planner)
