@@ -24,9 +24,9 @@ import numpy as np
 
 from worldgen.feasibility.collision import Colliders
 from worldgen.feasibility.cspace import ConfigSpace
+from worldgen.feasibility.exact import exact_planner
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.passage import narrowest_passage
-from worldgen.feasibility.exact import exact_planner
 from worldgen.feasibility.report import CHECKER, Check, FeasibilityReport, TaskPath
 from worldgen.feasibility.route import waypoints
 from worldgen.feasibility.verify import verify_path
