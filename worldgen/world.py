@@ -43,7 +43,7 @@ class World:
         self.preset: Optional[str] = None
         #: How a world asked for at a difficulty level was reached (worldgen.leveling); None otherwise.
         self.difficulty_request: Optional[dict] = None
-        self._texts: dict[tuple, str] = {}  # export()'s renderings, by (format, SDF version)
+        self._rendered: dict[tuple, bytes] = {}  # each format's bytes, rendered once, by (format, SDF version)
 
     def __repr__(self) -> str:
         try:
@@ -101,14 +101,19 @@ class World:
     def export(self, fmt: str, sdf_version: str = "1.9") -> str:
         """The world's text in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and ``write``
         share it (a World is a value: its scene and params do not change)."""
-        key = (fmt, sdf_version if fmt == "sdf" else None)
-        text = self._texts.get(key)
-        if text is None:
-            text = self._texts[key] = self._render(fmt, sdf_version)
-        return text
+        return self.rendered(fmt, sdf_version).decode()
 
-    def _render(self, fmt: str, sdf_version: str) -> str:
-        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version).decode()
+    def rendered(self, fmt: str, sdf_version: str = "1.9") -> bytes:
+        """The bytes of ``fmt``'s file, rendered once per world: world.json's hashes and the written file
+        are the same bytes."""
+        key = (fmt, sdf_version if fmt == "sdf" else None)
+        data = self._rendered.get(key)
+        if data is None:
+            data = self._rendered[key] = self._render(fmt, sdf_version)
+        return data
+
+    def _render(self, fmt: str, sdf_version: str) -> bytes:
+        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version)
 
     def mesh_files(self) -> dict[str, bytes]:
         """Mesh files the exported formats refer to: relative path -> bytes."""
@@ -123,7 +128,7 @@ class World:
     def rendered_files(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> dict[str, tuple[str, bytes]]:
         """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
         formats = normalise_formats(formats)
-        files = {fmt: (FILE_NAMES[fmt], self.export(fmt, sdf_version).encode()) for fmt in formats}
+        files = {fmt: (FILE_NAMES[fmt], self.rendered(fmt, sdf_version)) for fmt in formats}
         if formats_table.uses_meshes(formats):
             for rel, data in self.mesh_files().items():
                 files[f"mesh:{rel}"] = (rel, data)
