@@ -150,18 +150,27 @@ def world_inputs(occupied, origin, resolution: float, robot_radius: float, waypo
     cell of its own: BARN's C-space is smaller than its map by the kernel). ``kernel`` replaces
     :func:`kernel_cells`; 1 gives the uninflated map and the chain in map cells.
     """
+    grid, half = _grid(occupied, resolution, robot_radius, kernel)
+    return grid, _cells(grid, half, len(occupied), origin, resolution, waypoints)
+
+
+def _grid(occupied, resolution: float, robot_radius: float, kernel: Optional[int]) -> tuple[np.ndarray, int]:
+    """(BARN's C-space of the map, the kernel's half-width): the part of :func:`world_inputs` every path shares."""
     occ = np.asarray(occupied, dtype=bool)[::-1]
     rows, cols = occ.shape
     k = min(kernel_cells(robot_radius, resolution) if kernel is None else kernel, rows, cols)
-    half = k // 2
-    grid = cspace(occ, k)
+    return cspace(occ, k), k // 2
+
+
+def _cells(grid: np.ndarray, half: int, rows: int, origin, resolution: float, waypoints) -> np.ndarray:
+    """The chain of C-space cells of one path's waypoints (see :func:`world_inputs`)."""
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     col = np.floor((w[:, 0] - origin[0]) / resolution).astype(np.int64)
     row = rows - 1 - np.floor((w[:, 1] - origin[1]) / resolution).astype(np.int64)
     cells = chain(np.c_[row, col]) - half
     cells = np.c_[np.clip(cells[:, 0], 0, grid.shape[0] - 1), np.clip(cells[:, 1], 0, grid.shape[1] - 1)]
     keep = np.r_[True, (cells[1:] != cells[:-1]).any(axis=1)]
-    return grid, cells[keep]
+    return cells[keep]
 
 
 def world_metrics(occupied, origin, resolution: float, robot_radius: float, paths,
@@ -169,8 +178,9 @@ def world_metrics(occupied, origin, resolution: float, robot_radius: float, path
     """BARN's five metrics of a world: :func:`barn_metrics` on :func:`world_inputs` of each path
     (polylines; None for a task without one), averaged over the paths; each None without a path
     (tortuosity also where every path starts and ends in one cell)."""
-    per = [barn_metrics(*world_inputs(occupied, origin, resolution, robot_radius, p), disp_radius)
-           for p in paths if p is not None]
+    found = [p for p in paths if p is not None]
+    grid, half = _grid(occupied, resolution, robot_radius, None) if found else (None, 0)  # one C-space for all
+    per = [barn_metrics(grid, _cells(grid, half, len(occupied), origin, resolution, p), disp_radius) for p in found]
     out: dict[str, Optional[float]] = {}
     for name in NAMES:
         values = [v for m in per if (v := m[name]) is not None]
