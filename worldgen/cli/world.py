@@ -201,13 +201,16 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     _check_out(out)
     for s in range(seed, seed + count):
         world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, difficulty=level, **params)
-        world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
+        world.set_provenance(preset=preset.name if preset is not None else None)  # names the folder <preset>--<world_id>
         folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
                              ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
         failed = ",".join(c.name for c in world.feasibility.failed())
         verdict = f"\tinfeasible: {failed}" if failed else ""
-        click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}{verdict}")
+        request = world.difficulty_request  # a level request: the level, its seed and every draw it took
+        tried = (f"level {request['level']}, request seed {request['seed']}\tdraws {len(request['draws'])}" if request
+                 else f"attempts {world.attempts}")
+        click.echo(f"{folder}\tpath {lengths} m\t{tried}{verdict}")
 
 
 @click.command("preview", context_settings=_CONTEXT)
@@ -233,8 +236,14 @@ def check_command(world_dirs: Sequence[Path]) -> None:
 
     Prints "OK DIR" or "FAIL DIR: CHECK: DETAIL" per folder; exit status 1 if any failed.
     """
+    from worldgen.files import METADATA_NAME
     from worldgen.verify import check_folder
 
+    for folder in world_dirs:  # a usage mistake, before any check: a folder of worlds is not a world folder
+        inner = sorted(p.parent.name for p in folder.glob(f"*/{METADATA_NAME}"))
+        if inner and not (folder / METADATA_NAME).exists():
+            raise ParameterError(f"'{folder}' is a folder of {len(inner)} world folders, not a world folder "
+                                 f"(no {METADATA_NAME}); give them: worldgen check {folder}/*")
     failed = 0
     for folder in world_dirs:
         outcome = check_folder(folder)
