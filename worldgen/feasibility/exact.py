@@ -32,7 +32,8 @@ __all__ = ["ExactPlanner", "exact_planner", "GRAPH_ROWS_PER_QUERY", "GRAPH_MAX_C
 #: the benchmark's world (137 circles): the graph costs about 0.67 us per candidate, a query over it about
 #: 0.6 ms less than a lazy one (docs/benchmarks.md, "One tangent graph per walk"); a power of two times the
 #: crowd's 117 candidates per person-second (a walk asks about 0.125 queries per person-second), so that
-#: the crowd's choice is the one it made before this module, to the bit.
+#: the crowd chooses as it did before this module (exactly so wherever people x seconds is exact in floating
+#: point, as for whole and half seconds).
 GRAPH_ROWS_PER_QUERY = 936
 #: ... and only up to this many circles: at 524 circles the build took 1.4 s and 0.5 GB, a query 2.5 ms
 #: against the lazy planner's 2.7.

@@ -72,7 +72,8 @@ CUTOFF = 1.5
 STUCK = 0.1
 #: Exact route queries a walk asks per person and second walked (measured 0.119 in the benchmark's world:
 #: 143 for 20 people over 60 s); :func:`~worldgen.feasibility.exact.exact_planner` picks the planner by it.
-#: A power of two, so that the choice is, to the bit, the one made with the two figures below before.
+#: A power of two, so that the choice is the one made with the two figures below before (exactly so wherever
+#: people x seconds is exact in floating point).
 QUERIES_PER_PERSON_S = 0.125
 #: The same break-even per person-second, and the largest space the graph is built for.
 ROADMAP_ROWS_PER_PERSON_S = GRAPH_ROWS_PER_QUERY * QUERIES_PER_PERSON_S
