@@ -45,7 +45,7 @@ class World:
         self.path: Optional[Path] = None  # the folder once written
         self._preset: Optional[str] = None
         self._difficulty_request: Optional[dict] = None
-        self._rendered: dict[tuple, bytes] = {}  # each format's bytes, rendered once, by (format, SDF version)
+        self._blobs: dict[tuple, bytes] = {}  # export_bytes()'s renderings, by (format, SDF version)
 
     @property
     def preset(self) -> Optional[str]:
@@ -132,21 +132,22 @@ class World:
         return self.export("urdf")
 
     def export(self, fmt: str, sdf_version: str = "1.9") -> str:
-        """The world's text in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and ``write``
-        share it (a World is a value: its scene and params do not change)."""
-        return self.rendered(fmt, sdf_version).decode()
+        """The world's text in ``fmt`` (a text format: not ``usdc``, whose bytes :meth:`export_bytes` gives)."""
+        if fmt in formats_table.TABLE and formats_table.TABLE[fmt].binary:
+            raise OutputError(f"format {fmt!r} is binary, not text: use World.export_bytes({fmt!r})")
+        return self.export_bytes(fmt, sdf_version).decode()
 
-    def rendered(self, fmt: str, sdf_version: str = "1.9") -> bytes:
-        """The bytes of ``fmt``'s file, rendered once per world: world.json's hashes and the written file
-        are the same bytes."""
+    def export_bytes(self, fmt: str, sdf_version: str = "1.9") -> bytes:
+        """The bytes of the world's file in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and
+        ``write`` share them (a World is a value: its scene and params do not change)."""
         key = (fmt, sdf_version if fmt == "sdf" else None)
-        data = self._rendered.get(key)
+        data = self._blobs.get(key)
         if data is None:
-            data = self._rendered[key] = self._render(fmt, sdf_version)
+            data = self._blobs[key] = self._render(fmt, sdf_version)
         return data
 
     def _render(self, fmt: str, sdf_version: str) -> bytes:
-        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version)
+        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version, world=self)
 
     def mesh_files(self) -> dict[str, bytes]:
         """Mesh files the exported formats refer to: relative path -> bytes."""
@@ -161,7 +162,8 @@ class World:
     def rendered_files(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> dict[str, tuple[str, bytes]]:
         """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
         formats = normalise_formats(formats)
-        files = {fmt: (FILE_NAMES[fmt], self.rendered(fmt, sdf_version)) for fmt in formats}
+        formats_table.require_formats(formats)  # a missing extra: one line, before anything is rendered
+        files = {fmt: (FILE_NAMES[fmt], self.export_bytes(fmt, sdf_version)) for fmt in formats}
         if formats_table.uses_meshes(formats):
             for rel, data in self.mesh_files().items():
                 files[f"mesh:{rel}"] = (rel, data)

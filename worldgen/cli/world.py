@@ -18,7 +18,7 @@ import click
 import worldgen
 from worldgen.cli.context import CONTEXT as _CONTEXT
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError, did_you_mean
-from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
+from worldgen.export.formats import ALL_FORMATS, FORMATS, SDF_VERSIONS, normalise_formats, require_formats
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
 from worldgen.ros.bundle import DEFAULT_GZ_RELEASE, GZ_RELEASES
@@ -148,7 +148,7 @@ def parameter_tables(specs) -> str:
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Folder to write DIR/<world_id>/ (DIR/<preset>--<world_id>/ with --preset) into (created if missing).")
 @click.option("--formats", default=",".join(FORMATS), show_default=True,
-              help=f"Comma-separated subset of {', '.join(FORMATS)}; world.json is always written.")
+              help=f"Comma-separated formats among {', '.join(ALL_FORMATS)} (usd needs its extra); world.json always.")
 @click.option("--sdf-version", type=click.Choice(SDF_VERSIONS), default=SDF_VERSIONS[0], show_default=True,
               help="SDFormat version: 1.9 (Gazebo Fortress to Harmonic) or 1.6 (Gazebo classic).")
 @click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
@@ -193,7 +193,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     except InfeasibleError:  # a request known to be undrivable: written anyway only when asked
         if not allow_infeasible:
             raise
-    chosen = normalise_formats(formats)
+    require_formats(chosen := normalise_formats(formats))  # a missing extra (usd): before any world is drawn
     if gz_release is not None and not ros:
         raise ParameterError(f"--gz-release {gz_release} names the Gazebo release of the ROS 2 bundle: add --ros")
     if seed + count - 1 > MAX_SEED:
