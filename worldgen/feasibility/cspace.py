@@ -221,7 +221,7 @@ class ConfigSpace:
                                   self.obstacles.boxes[ids], self.radius))
         seg, o = rows[seg], ids[k]
         seg, o = _unskipped(seg, o, skip1, skip2)
-        ok[seg[self._pairs_hit(a[seg], b[seg], o)]] = False
+        self._drop_hits(a, b, seg, o, ok)
         return ok
 
     @cached_property
@@ -243,39 +243,42 @@ class ConfigSpace:
             pts = a[r] + t[inside][:, None] * d[r]
             seg, o = _unskipped(*grid.pairs(r, pts), skip1, skip2)
             if len(seg):
-                ok[seg[self._pairs_hit(a[seg], b[seg], o)]] = False
+                self._drop_hits(a, b, seg, o, ok)
             first += walk
             walk *= 2  # the segments still going are few: longer strides, fewer rounds
             rows = rows[ok[rows] & (steps[rows] >= first)]
         return ok
 
-    def _pairs_hit(self, a: np.ndarray, b: np.ndarray, o: np.ndarray) -> np.ndarray:
-        """(m,) bool per (segment a[i]b[i], obstacle o[i]) pair: closer than ``radius``.
+    def _drop_hits(self, a: np.ndarray, b: np.ndarray, seg: np.ndarray, o: np.ndarray, ok: np.ndarray) -> None:
+        """Set ``ok[seg[i]]`` False for each (segment ``a[seg[i]]b[seg[i]]``, obstacle ``o[i]``) pair closer
+        than ``radius``.
 
         Most pairs are settled by the obstacle's bounding and core discs; polygon edges are
-        measured only for segments that pass between the two.
+        measured only for segments that pass between the two and that no core has blocked
+        already (most candidate tangents are blocked, and one hit settles a segment).
         """
         obs = self.obstacles
         r = self.radius - TOUCH
-        d = point_segment_distance(self.hull_c[o], a, b)
+        d = point_segment_distance(self.hull_c[o], a[seg], b[seg])
         hit = d < self.core_r[o] - TOUCH  # through the core (for a disc: exactly the test)
+        ok[seg[hit]] = False
         unsure = np.flatnonzero(~hit & (d < self.hull_r[o] - TOUCH) & (o >= obs.n_discs))
+        unsure = unsure[ok[seg[unsure]]]
         if len(unsure) == 0:
-            return hit
+            return
         p = o[unsure] - obs.n_discs
         counts = obs.edge_start[p + 1] - obs.edge_start[p]
+        starts = np.cumsum(counts) - counts
         pair = np.repeat(np.arange(len(unsure)), counts)
-        e = obs.edge_start[p][pair] + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
-        ap, bp = a[unsure][pair], b[unsure][pair]
+        e = obs.edge_start[p][pair] + (np.arange(counts.sum()) - starts[pair])
+        s = seg[unsure][pair]
+        ap, bp = a[s], b[s]
         close = segment_segment_distance(ap, bp, obs.edge_a[e], obs.edge_b[e]) < r
         # A segment wholly inside a polygon crosses no edge: its start lies left of every edge.
         left = _cross(obs.edge_b[e] - obs.edge_a[e], ap - obs.edge_a[e]) >= 0
-        any_close = np.zeros(len(unsure), dtype=bool)
-        np.logical_or.at(any_close, pair, close)
-        inside = np.ones(len(unsure), dtype=bool)
-        np.logical_and.at(inside, pair, left)
-        hit[unsure] = any_close | inside
-        return hit
+        # Every polygon has edges, so each pair's run is non-empty: reduceat over the runs is exact.
+        blocked = np.logical_or.reduceat(close, starts) | np.logical_and.reduceat(left, starts)
+        ok[seg[unsure][blocked]] = False
 
     def neighbour_pairs(self, circle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(row, obstacle id) for each of ``circle`` (m,) and each neighbour of the circle's obstacle."""

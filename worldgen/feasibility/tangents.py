@@ -209,7 +209,7 @@ def grown_edges(cs) -> EdgeIndex:
     b = cs.centre[nxt] + cs.rho[nxt, None] * n
     ok = cs.inside_box(a) & cs.inside_box(b)
     row, o = cs.neighbour_pairs(corner)
-    ok[row[cs._pairs_hit(a[row], b[row], o)]] = False
+    cs._drop_hits(a, b, row, o, ok)
     corner, nxt, n, a, b = corner[ok], nxt[ok], n[ok], a[ok], b[ok]
     length = np.hypot(*(b - a).T)
     one = np.ones(len(corner), dtype=np.int64)
