@@ -76,10 +76,11 @@ def _unskipped(seg: np.ndarray, o: np.ndarray, skip1, skip2) -> tuple[np.ndarray
     return seg[keep], o[keep]
 
 
-def _near(lo: np.ndarray, hi: np.ndarray, boxes: np.ndarray, reach: float) -> np.ndarray:
-    """(m, n) bool: query box m (corners ``lo``/``hi``) within ``reach`` of box n ((n, 4) minx, miny, maxx, maxy)."""
-    return ((lo[:, None, 0] - reach <= boxes[None, :, 2]) & (hi[:, None, 0] + reach >= boxes[None, :, 0])
-            & (lo[:, None, 1] - reach <= boxes[None, :, 3]) & (hi[:, None, 1] + reach >= boxes[None, :, 1]))
+def _near(lo: np.ndarray, hi: np.ndarray, reach_boxes: np.ndarray) -> np.ndarray:
+    """(m, n) bool: query box m (corners ``lo``/``hi``) meets box n of ``reach_boxes`` ((n, 4) minx, miny,
+    maxx, maxy, already grown by the reach)."""
+    return ((lo[:, None, 0] <= reach_boxes[None, :, 2]) & (hi[:, None, 0] >= reach_boxes[None, :, 0])
+            & (lo[:, None, 1] <= reach_boxes[None, :, 3]) & (hi[:, None, 1] >= reach_boxes[None, :, 1]))
 
 
 @dataclass(frozen=True, eq=False)
@@ -210,19 +211,30 @@ class ConfigSpace:
         """
         a = np.asarray(a, dtype=float).reshape(-1, 2)
         b = np.asarray(b, dtype=float).reshape(-1, 2)
-        ok = self.inside_box(a) & self.inside_box(b)
+        # Both ends inside the box exactly when the segment's bounding box is (the same comparisons).
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        x0, y0, x1, y1 = self.box
+        ok = (lo[:, 0] >= x0 - TOUCH) & (lo[:, 1] >= y0 - TOUCH) & (hi[:, 0] <= x1 + TOUCH) & (hi[:, 1] <= y1 + TOUCH)
         if len(self.obstacles) == 0 or not ok.any():
             return ok
         if self._grid is not None and (among is None or len(among) > GRID_FROM):
             return self._grid_clear(a, b, ok, skip1, skip2)
         rows = np.flatnonzero(ok)
-        ids = np.arange(len(self.obstacles)) if among is None else np.asarray(among, dtype=np.int64)
-        seg, k = np.nonzero(_near(np.minimum(a[rows], b[rows]), np.maximum(a[rows], b[rows]),
-                                  self.obstacles.boxes[ids], self.radius))
-        seg, o = rows[seg], ids[k]
+        if len(rows) < len(ok):
+            lo, hi = lo[rows], hi[rows]
+        boxes = self._reach_boxes if among is None else self._reach_boxes[among]
+        seg, k = np.nonzero(_near(lo, hi, boxes))
+        seg, o = rows[seg], (k if among is None else np.asarray(among, dtype=np.int64)[k])
         seg, o = _unskipped(seg, o, skip1, skip2)
         self._drop_hits(a, b, seg, o, ok)
         return ok
+
+    @cached_property
+    def _reach_boxes(self) -> np.ndarray:
+        """(N, 4) the obstacles' boxes grown by ``radius``: a segment whose box misses one's cannot come within
+        ``radius - TOUCH`` of it (the margin TOUCH is far above the rounding of the growing)."""
+        r = self.radius
+        return self.obstacles.boxes + np.array([-r, -r, r, r])
 
     @cached_property
     def _grid(self) -> Optional[SegmentGrid]:
