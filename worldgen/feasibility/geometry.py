@@ -41,18 +41,40 @@ def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def segment_segment_distance(a, b, c, d) -> np.ndarray:
-    """Distance between segments ``ab`` and ``cd`` (0 where they cross); arrays broadcast."""
+    """Distance between segments ``ab`` and ``cd`` (0 where they cross); arrays broadcast.
+
+    The four end-to-segment distances and the four orientation tests share their differences: each is
+    computed once, by the same operations as :func:`point_segment_distance` and a cross product would
+    (the same floats), since the clearance test calls this for every edge it measures.
+    """
+    ax, ay, bx, by = a[..., 0], a[..., 1], b[..., 0], b[..., 1]
+    cx, cy, dx, dy = c[..., 0], c[..., 1], d[..., 0], d[..., 1]
+    abx, aby, cdx, cdy = bx - ax, by - ay, dx - cx, dy - cy
+    acx, acy, adx, ady = cx - ax, cy - ay, dx - ax, dy - ay  # c and d from a
+    cax, cay, cbx, cby = ax - cx, ay - cy, bx - cx, by - cy  # a and b from c
+    den_ab = abx * abx + aby * aby
+    den_cd = cdx * cdx + cdy * cdy
+    den_ab = np.where(den_ab > 0, den_ab, 1.0)
+    den_cd = np.where(den_cd > 0, den_cd, 1.0)
     dist = np.minimum(
-        np.minimum(point_segment_distance(a, c, d), point_segment_distance(b, c, d)),
-        np.minimum(point_segment_distance(c, a, b), point_segment_distance(d, a, b)),
+        np.minimum(_to_segment(cax, cay, cdx, cdy, den_cd), _to_segment(cbx, cby, cdx, cdy, den_cd)),
+        np.minimum(_to_segment(acx, acy, abx, aby, den_ab), _to_segment(adx, ady, abx, aby, den_ab)),
     )
     # A proper crossing: each segment's ends lie on opposite sides of the other's line.
-    o1 = _cross(b - a, c - a)
-    o2 = _cross(b - a, d - a)
-    o3 = _cross(d - c, a - c)
-    o4 = _cross(d - c, b - c)
+    o1 = abx * acy - aby * acx
+    o2 = abx * ady - aby * adx
+    o3 = cdx * cay - cdy * cax
+    o4 = cdx * cby - cdy * cbx
     crossing = (o1 * o2 < 0) & (o3 * o4 < 0)
     return np.where(crossing, 0.0, dist)
+
+
+def _to_segment(apx, apy, abx, aby, den) -> np.ndarray:
+    """:func:`point_segment_distance` from its differences (``den`` the segment's squared length, 1 if 0)."""
+    t = np.minimum(np.maximum((apx * abx + apy * aby) / den, 0.0), 1.0)
+    ex = apx - t * abx
+    ey = apy - t * aby
+    return np.sqrt(ex * ex + ey * ey)
 
 
 @dataclass(frozen=True, eq=False)
