@@ -77,8 +77,7 @@ def _unskipped(seg: np.ndarray, o: np.ndarray, skip1, skip2) -> tuple[np.ndarray
 
 
 def _near(lo: np.ndarray, hi: np.ndarray, reach_boxes: np.ndarray) -> np.ndarray:
-    """(m, n) bool: query box m (corners ``lo``/``hi``) meets box n of ``reach_boxes`` ((n, 4) minx, miny,
-    maxx, maxy, already grown by the reach)."""
+    """(m, n) bool: query box m (corners ``lo``/``hi``) meets box n of ``reach_boxes`` ((n, 4), grown)."""
     return ((lo[:, None, 0] <= reach_boxes[None, :, 2]) & (hi[:, None, 0] >= reach_boxes[None, :, 0])
             & (lo[:, None, 1] <= reach_boxes[None, :, 3]) & (hi[:, None, 1] >= reach_boxes[None, :, 1]))
 
@@ -231,10 +230,8 @@ class ConfigSpace:
 
     @cached_property
     def _reach_boxes(self) -> np.ndarray:
-        """(N, 4) the obstacles' boxes grown by ``radius``: a segment whose box misses one's cannot come within
-        ``radius - TOUCH`` of it (the margin TOUCH is far above the rounding of the growing)."""
-        r = self.radius
-        return self.obstacles.boxes + np.array([-r, -r, r, r])
+        """(N, 4) the boxes grown by ``radius``: a segment whose box misses one's stays ``radius - TOUCH`` away."""
+        return self.obstacles.boxes + np.array([-self.radius, -self.radius, self.radius, self.radius])
 
     @cached_property
     def _grid(self) -> Optional[SegmentGrid]:
@@ -263,12 +260,9 @@ class ConfigSpace:
 
     def _drop_hits(self, a: np.ndarray, b: np.ndarray, seg: np.ndarray, o: np.ndarray, ok: np.ndarray) -> None:
         """Set ``ok[seg[i]]`` False for each (segment ``a[seg[i]]b[seg[i]]``, obstacle ``o[i]``) pair closer
-        than ``radius``.
-
-        Most pairs are settled by the obstacle's bounding and core discs; polygon edges are
-        measured only for segments that pass between the two and that no core has blocked
-        already (most candidate tangents are blocked, and one hit settles a segment).
-        """
+        than ``radius``. Most pairs are settled by the obstacle's bounding and core discs; polygon edges
+        are measured only for segments that pass between the two and that no core has blocked already
+        (most candidate tangents are blocked, and one hit settles a segment)."""
         obs = self.obstacles
         r = self.radius - TOUCH
         d = point_segment_distance(self.hull_c[o], a[seg], b[seg])
