@@ -50,6 +50,31 @@ def test_the_same_request_gives_the_same_world_from_the_cli_in_another_process(t
     assert checked.returncode == 0, checked.stdout + checked.stderr
 
 
+PEOPLE = {"n_people": 4, "people_duration": 20.0}
+
+
+def test_a_level_with_people_walks_them_once_per_landed_draw_and_is_the_same_in_another_process(tmp_path, monkeypatch):
+    from worldgen.people import crowd
+
+    walks = []
+    walk_plan = crowd.walk_plan
+    monkeypatch.setattr(crowd, "walk_plan", lambda *a, **k: walks.append(1) or walk_plan(*a, **k))
+    world = worldgen.generate("cluttered", seed=3, difficulty="6/10", **PEOPLE)
+    draws = world.metadata["difficulty_request"]["draws"]
+    assert len(draws) == 9 and len(walks) == 1  # nine draws judged without people, the people walked on the last
+    assert world.metadata["metrics"]["difficulty_level"] == 6 and len(world.metadata["people"]) == 4
+    # Regenerable like any world: its own seed and params (people included) give it without the request.
+    assert worldgen.generate("cluttered", world.seed, **world.params).content_hash == world.content_hash
+    done = run("generate", "cluttered", "--difficulty", "6/10", "--seed", "3", *(f"--set={k}={v}" for k, v in
+                                                                                  PEOPLE.items()), "--out", tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.rstrip().endswith("level draws 9\tattempts 1"), done.stdout
+    (folder,) = world_dirs(tmp_path)
+    assert (folder / "world.json").read_bytes() == world.read("world.json")
+    checked = run("check", folder)
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+
+
 @pytest.mark.parametrize("generator, params, message", [
     ("cluttered", {"difficulty": "11/10"}, "parameter 'difficulty' must be a level 'k/10' with k in 1..10 (or the integer k), got '11/10'"),
     ("cluttered", {"difficulty": "3/5"}, "parameter 'difficulty' must be a level 'k/10'"),

@@ -17,6 +17,11 @@ lands in the level, each draw a whole world of its own:
 GENERATOR`` prints it) and a generator without a knob (:data:`NO_LEVELS`) are
 refused up front in one line.
 
+With people (``n_people``) a draw is judged on its world without them (``n_people=0``; the level never
+reads the people) and the people are walked only on a draw that landed; where they refuse its attempt (no
+timed path, so the seed passes at a later attempt or at none) the draw is recorded with what it gave and the
+next keeps the knob (docs/metrics.md). Walking them on every draw made a 10-draw request 133 s of CPU.
+
 The world is an ordinary one: its ``seed`` and ``params`` (with the knob's
 value) regenerate it without any of this. world.json's ``difficulty_request``
 records how it was reached: the level asked for, the request's seed and every
@@ -26,6 +31,7 @@ any process.
 
 from __future__ import annotations
 
+import logging
 import re
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Optional
@@ -34,6 +40,9 @@ from worldgen.errors import InfeasibleError, ParameterError, quoted
 from worldgen.floats import finite_or_none
 from worldgen.groundtruth import difficulty, truth
 from worldgen.seeding import level_seed
+
+#: Where a long request says what it is doing (worldgen.cli.progress shows it on a terminal; nothing else does).
+_progress = logging.getLogger("worldgen.progress")
 
 __all__ = ["LEVELS", "MAX_DRAWS", "STEP", "START", "MAX_KNOB", "Knob", "KNOBS", "NO_LEVELS", "reachable",
            "describe_levels", "parse_level", "check_request", "score", "generate_at_level"]
@@ -213,17 +222,34 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
     value = float(knob.start[level - 1] or 0.0) * scale
     low, high, step = knob.low * scale, knob.high * scale, knob.step * scale
     fixed = {**params, **knob.sets(level)}
-    draws = []
+    people = bool(params.get("n_people"))
+    draws: list[dict] = []
     for k in range(MAX_DRAWS):
         draw_seed = level_seed(seed, k)
         n = knob.value(value)
+        _progress.info("%s at level %d/%d, seed %d: draw %d of at most %d (%s=%s)%s", name, level, LEVELS, seed, k + 1,
+                       MAX_DRAWS, param, n, _last(draws))
         try:
-            world = generate(name, draw_seed, **{**fixed, param: n})
+            # With people the level is judged on the draw without them, and they are added only to a draw that
+            # landed (see the module): the people are walked once per landed draw, not once per draw.
+            world = generate(name, draw_seed, **{**fixed, param: n, **({"n_people": 0} if people else {})})
         except InfeasibleError:  # too crowded to place or drive: ease off
             draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
             value = max(low, value - step)
             continue
         got = score(world)
+        if people and got["difficulty_level"] == level:
+            _progress.info("%s at level %d/%d, seed %d: draw %d landed; walking %d people", name, level, LEVELS,
+                           seed, k + 1, params["n_people"])
+            try:
+                world = generate(name, draw_seed, **{**fixed, param: n})
+                got = score(world)
+            except InfeasibleError:  # no attempt of this draw has a timed path among the people
+                got = {"difficulty": None, "difficulty_level": None}
+            if got["difficulty_level"] != level:  # the people refused the landed attempt: same knob, next draw
+                draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"],
+                              "level": got["difficulty_level"]})
+                continue
         draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"], "level": got["difficulty_level"]})
         if got["difficulty_level"] == level:
             world.difficulty_request = {"level": f"{level}/{LEVELS}", "seed": seed, "knob": param, "draws": draws}
@@ -234,6 +260,13 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
     raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws "
                           f"(levels reached: {', '.join(map(str, reached)) or 'none'}); try another seed or a "
                           f"level nearer {_nearest(reached, level)}", {"difficulty_level": MAX_DRAWS})
+
+
+def _last(draws: list) -> str:
+    """", the last at level K" for the progress line (", the last refused" for a draw that could not be built)."""
+    if not draws:
+        return ""
+    return ", the last refused" if draws[-1]["level"] is None else f", the last at level {draws[-1]['level']}"
 
 
 def _nearest(reached: list, level: int) -> str:
