@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 from collections import Counter
-from typing import Any
+from typing import Any, Optional
 
 from worldgen import feasibility
 from worldgen.errors import InfeasibleError, ParameterError
@@ -48,7 +48,7 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             raise ParameterError("parameter 'difficulty' asks for a drivable world; it excludes allow_infeasible")
         from worldgen.leveling import generate_at_level
 
-        return generate_at_level(generate, spec.name, seed, difficulty, params)
+        return generate_at_level(generate, spec.name, seed, difficulty, params, people_on=_people_on)
     try:
         resolved = spec.resolve(params)
     except InfeasibleError:
@@ -107,6 +107,35 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
         f"no feasible '{name}' world for seed {seed} within max_attempts={budget}: {summary}{hint}",
         dict(failures),
     )
+
+
+def _people_on(world: World, params: dict) -> Optional[World]:
+    """What ``generate(world.generator, world.seed, **params)`` gives when ``params`` are ``world``'s with people
+    added and the people pass on the attempt ``world`` passed on without them; None when they do not (the seed
+    then passes at a later attempt or at none). Every earlier attempt failed its static checks, which never read
+    the people, so it fails with them too: the world is the one ``generate`` returns. For a level request
+    (worldgen.leveling), which judges draws without people and walks them only on a draw that landed."""
+    spec = get(world.generator)
+    resolved = spec.resolve(params)
+    robot = robot_from_params(resolved)
+    attempt = world.attempts - 1
+    draft = spec.build(resolved, attempt_rng(world.seed, attempt))
+    draft, plan = _with_common_extras(spec, resolved, draft, robot, world.seed, attempt) if not draft.rejected \
+        else (draft, None)
+    if draft.rejected or plan is None or draft.scene is None:
+        return None
+    scene, report = draft.scene, world.feasibility
+    if scene.content_hash() != world.scene.content_hash():  # never expected: then prove it afresh
+        report = feasibility.check(scene, draft.tasks, robot)
+    from worldgen.people.crowd import walk_plan
+    from worldgen.people.timed import certify
+    _progress.info("%s seed %d: attempt %d: walking %d people", world.generator, world.seed, attempt + 1,
+                   resolved["n_people"])
+    scene = scene.with_movers(scene.movers + walk_plan(scene, draft.tasks, robot, resolved, plan))
+    report = certify(report, scene, draft.tasks, robot, resolved["robot_speed"])
+    if not report.feasible:
+        return None
+    return World(world.generator, world.seed, resolved, scene, draft.tasks, robot, report, attempt + 1, False)
 
 
 def _count(failures: Counter, details: dict, report) -> None:

@@ -18,9 +18,10 @@ GENERATOR`` prints it) and a generator without a knob (:data:`NO_LEVELS`) are
 refused up front in one line.
 
 With people (``n_people``) a draw is judged on its world without them (``n_people=0``; the level never
-reads the people) and the people are walked only on a draw that landed; where they refuse its attempt (no
-timed path, so the seed passes at a later attempt or at none) the draw is recorded with what it gave and the
-next keeps the knob (docs/metrics.md). Walking them on every draw made a 10-draw request 133 s of CPU.
+reads the people) and the people are walked only on a draw that landed, on the attempt it landed on; where
+they refuse it (no timed path) the draw is recorded with no level and the next draw keeps the knob. Such
+refusals have their own budget of :data:`MAX_DRAWS` beside the misses' (docs/metrics.md). Walking them on
+every attempt of every draw made a 10-draw request 133 s of CPU.
 
 The world is an ordinary one: its ``seed`` and ``params`` (with the knob's
 value) regenerate it without any of this. world.json's ``difficulty_request``
@@ -210,9 +211,11 @@ def check_request(name: str, level_value: Any, params: Mapping[str, Any]) -> tup
     return level, knob.param
 
 
-def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any]):
+def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any],
+                      people_on: Optional[Callable] = None):
     """A world of generator ``name`` at the level ``level_value`` asks for (see the module); ``generate`` is
-    :func:`worldgen.generate`."""
+    :func:`worldgen.generate`, ``people_on(world, params)`` the world with people of the same draw and attempt,
+    or None where they refuse it (worldgen.api)."""
     level, param = check_request(name, level_value, params)
     knob = KNOBS[name]
     scale = 1.0
@@ -224,11 +227,14 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
     fixed = {**params, **knob.sets(level)}
     people = bool(params.get("n_people"))
     draws: list[dict] = []
-    for k in range(MAX_DRAWS):
+    refused = 0  # landed draws the people refused: a budget of their own, beside the draws' (see the module)
+    for k in range(2 * MAX_DRAWS):
+        if len(draws) - refused >= MAX_DRAWS or refused >= MAX_DRAWS:
+            break
         draw_seed = level_seed(seed, k)
         n = knob.value(value)
-        _progress.info("%s at level %d/%d, seed %d: draw %d of at most %d (%s=%s)%s", name, level, LEVELS, seed, k + 1,
-                       MAX_DRAWS, param, n, _last(draws))
+        _progress.info("%s at level %d/%d, seed %d: draw %d of at most %d (%s=%s)%s", name, level, LEVELS, seed,
+                       len(draws) - refused + 1, MAX_DRAWS, param, n, _last(draws))
         try:
             # With people the level is judged on the draw without them, and they are added only to a draw that
             # landed (see the module): the people are walked once per landed draw, not once per draw.
@@ -238,18 +244,15 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
             value = max(low, value - step)
             continue
         got = score(world)
-        if people and got["difficulty_level"] == level:
+        if people and got["difficulty_level"] == level and people_on is not None:
             _progress.info("%s at level %d/%d, seed %d: draw %d landed; walking %d people", name, level, LEVELS,
-                           seed, k + 1, params["n_people"])
-            try:
-                world = generate(name, draw_seed, **{**fixed, param: n})
-                got = score(world)
-            except InfeasibleError:  # no attempt of this draw has a timed path among the people
-                got = {"difficulty": None, "difficulty_level": None}
-            if got["difficulty_level"] != level:  # the people refused the landed attempt: same knob, next draw
-                draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"],
-                              "level": got["difficulty_level"]})
+                           seed, len(draws) - refused + 1, params["n_people"])
+            with_people = people_on(world, {**fixed, param: n})
+            if with_people is None:  # no timed path among them on the landed attempt: same knob, next draw
+                draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
+                refused += 1
                 continue
+            world = with_people
         draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"], "level": got["difficulty_level"]})
         if got["difficulty_level"] == level:
             world.difficulty_request = {"level": f"{level}/{LEVELS}", "seed": seed, "knob": param, "draws": draws}
@@ -257,7 +260,8 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         missed = level - (got["difficulty_level"] or level)
         value = min(max(value + step * missed, low), high)
     reached = sorted({d["level"] for d in draws if d["level"] is not None})
-    raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws "
+    also = f" and {refused} landed draws the people refused (no timed path among them)" if refused else ""
+    raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws{also} "
                           f"(levels reached: {', '.join(map(str, reached)) or 'none'}); try another seed or a "
                           f"level nearer {_nearest(reached, level)}", {"difficulty_level": MAX_DRAWS})
 
