@@ -59,6 +59,9 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             raise
         resolved = validate_params(spec.all_params, params)
     robot = robot_from_params(resolved)
+    if resolved.get("n_people") and not allow_infeasible:  # a script no draw can play: refused before drawing
+        from worldgen.people.prechecks import refuse_unplayable
+        refuse_unplayable(spec, resolved, robot)
     failures: Counter[str] = Counter()
     details: dict[str, str] = {}
     last = None
@@ -118,6 +121,8 @@ def _people_on(world: World, params: dict) -> Optional[World]:
     spec = get(world.generator)
     resolved = spec.resolve(params)
     robot = robot_from_params(resolved)
+    from worldgen.people.prechecks import refuse_unplayable
+    refuse_unplayable(spec, resolved, robot)  # a script no draw can play ends the request here, in one line
     attempt = world.attempts - 1
     draft = spec.build(resolved, attempt_rng(world.seed, attempt))
     draft, plan = _with_common_extras(spec, resolved, draft, robot, world.seed, attempt) if not draft.rejected \

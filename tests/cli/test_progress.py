@@ -55,14 +55,14 @@ def test_a_long_request_shows_one_line_updated_in_place_on_a_terminal(tmp_path):
     assert "\r" in term and "\x1b[K" in term and "\n" not in term.strip("\r\n"), term  # one line, redrawn
     assert "cluttered at level 7/10, seed 3: draw" in term and "of at most 40" in term, term
     assert term.endswith("\r\x1b[K"), term  # wiped at the end
-    assert out.count("\n") == 1 and "\x1b" not in out and "level draws 9\tattempts" in out, out
+    assert out.count("\n") == 1 and "\x1b" not in out and "\tdraws 9\tattempts" in out, out
 
 
 def test_nothing_when_stderr_is_piped(tmp_path):
     res = subprocess.run([sys.executable, "-m", "worldgen", *LEVEL, "--out", str(tmp_path)], capture_output=True,
                          text=True, env=_env("0"), cwd=REPO, timeout=120)
     assert res.returncode == 0 and res.stderr == "", res.stderr
-    assert "level draws 9" in res.stdout
+    assert "\tdraws 9\t" in res.stdout
 
 
 def test_a_quick_request_shows_nothing_even_on_a_terminal(tmp_path):
