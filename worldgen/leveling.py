@@ -238,7 +238,7 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         try:
             # With people the level is judged on the draw without them, and they are added only to a draw that
             # landed (see the module): the people are walked once per landed draw, not once per draw.
-            world = generate(name, draw_seed, **{**fixed, param: n, **({"n_people": 0} if people else {})})
+            world = generate(name, draw_seed, **{**(_without_people(fixed) if people else fixed), param: n})
         except InfeasibleError:  # too crowded to place or drive: ease off
             draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
             value = max(low, value - step)
@@ -264,6 +264,13 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
     raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws{also} "
                           f"(levels reached: {', '.join(map(str, reached)) or 'none'}); try another seed or a "
                           f"level nearer {_nearest(reached, level)}", {"difficulty_level": MAX_DRAWS})
+
+
+def _without_people(params: Mapping[str, Any]) -> dict:
+    """``params`` with every people parameter left out (a world without people refuses them)."""
+    from worldgen.params import PEOPLE_PARAMS
+
+    return {k: v for k, v in params.items() if k not in PEOPLE_PARAMS}
 
 
 def _last(draws: list) -> str:
