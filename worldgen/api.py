@@ -175,7 +175,7 @@ def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt:
         from worldgen.people.places import draw_people
         plan, reason = draw_people(scene, draft.tasks, robot, resolved, people_rng(seed, attempt))
         if plan is None:
-            return Draft(scene, draft.tasks, rejected="people_placement", detail=reason), None
+            return Draft(scene, draft.tasks, rejected="people_placement", detail=reason or ""), None
     return (draft if scene is draft.scene else Draft(scene, draft.tasks)), plan
 
 
