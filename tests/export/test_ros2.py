@@ -71,7 +71,7 @@ LAUNCH_API = {"launch": {"LaunchDescription"},
               "launch_ros.actions": {"Node"},
               "ament_index_python.packages": {"get_package_share_directory"}}
 #: nav2_simple_commander's BasicNavigator methods the goal sender may call (nav2_simple_commander/robot_navigator.py).
-NAVIGATOR_API = {"waitUntilNav2Active", "goToPose", "isTaskComplete", "getResult", "cancelTask", "get_clock",
+NAVIGATOR_API = {"setInitialPose", "waitUntilNav2Active", "goToPose", "isTaskComplete", "getResult", "cancelTask", "get_clock",
                  "destroy_node"}
 #: The topics `worldgen judge` reads (issue 18): the bundle must record them all.
 JUDGE_TOPICS = {"/odom", "/tf", "/tf_static", "/cmd_vel", "/clock", "/scan"}
@@ -545,70 +545,172 @@ class _Time:
         return self.nanoseconds
 
 
-def _fake_nav2(monkeypatch, finishes_after: float, result: str, calls: list) -> None:
-    """Stand-ins for rclpy, geometry_msgs and nav2_simple_commander: a navigator whose task completes
-    after ``finishes_after`` simulated seconds (each isTaskComplete call advances 0.1 s) with ``result``."""
+def _msg(**fields):
     import types
 
-    class Navigator:
-        def __init__(self, node_name):
-            self.t = 100.0
-            calls.append(("init", node_name))
+    return types.SimpleNamespace(**fields)
 
-        def __getattr__(self, name):
-            def call(*args):
-                calls.append((name,) + args)
-                if name == "isTaskComplete":
-                    self.t += 0.1
-                    return self.t - self.start >= finishes_after
-                if name == "goToPose":
-                    self.start = self.t
-                    return True
-                return getattr(TaskResult, result, None) if name == "getResult" else None
-            return call
 
-        def get_clock(self):
-            return types.SimpleNamespace(now=lambda: _Time(round(self.t * 1e9)))
+def _pose_stamped():
+    """geometry_msgs/PoseStamped's fields, at their defaults (origin, identity, empty frame)."""
+    return _msg(header=_msg(frame_id="", stamp=0),
+                pose=_msg(position=_msg(x=0.0, y=0.0, z=0.0), orientation=_msg(x=0.0, y=0.0, z=0.0, w=1.0)))
 
+
+class _Commander:
+    """A stand-in for nav2_simple_commander's BasicNavigator (robot_navigator.py at nav2 1.3.13, Jazzy)
+    with its initial-pose behaviour kept: the initial pose starts as the map origin (frame ``map``);
+    ``setInitialPose`` stores a pose and publishes it on ``initialpose`` at once; ``waitUntilNav2Active``
+    waits for AMCL to activate, then publishes the stored pose every second until AMCL answers on
+    ``amcl_pose``. The stand-in AMCL takes every pose that arrives in its global frame, the last one
+    winning (nav2_amcl's initialPoseReceived). The goal's task completes after ``finishes_after``
+    simulated seconds (each isTaskComplete call advances the clock by 0.1 s) with ``result``."""
+
+    finishes_after = 5.0
+    result: object = None
+    crash_in = ""
+
+    def __init__(self, node_name="basic_navigator", namespace=""):
+        self.t = 100.0
+        self.initial_pose = _pose_stamped()
+        self.initial_pose.header.frame_id = "map"
+        self.initial_pose_received = False
+        self.amcl_active = False
+        self.amcl_pose = None
+        self.published: list = []  # (event index, frame, x, y, yaw) of every /initialpose message
+        self.calls: list = [("init", node_name)]
+        _Commander.last = self
+
+    def _call(self, name, *args):
+        self.calls.append((name,) + args)
+        if name == self.crash_in:
+            raise RuntimeError(f"{name} failed")
+
+    def get_clock(self):
+        return _msg(now=lambda: _Time(round(self.t * 1e9)))
+
+    def setInitialPose(self, initial_pose):
+        self._call("setInitialPose", initial_pose)
+        self.initial_pose_received = False
+        self.initial_pose = initial_pose
+        self._setInitialPose()
+
+    def _setInitialPose(self):
+        pose = self.initial_pose.pose
+        yaw = 2 * math.atan2(pose.orientation.z, pose.orientation.w)
+        message = (len(self.calls), self.initial_pose.header.frame_id, pose.position.x, pose.position.y, yaw)
+        self.published.append(message)
+        if message[1] == "map":  # AMCL's global frame; it ignores other frames
+            self.amcl_pose = message[2:]
+            if self.amcl_active:
+                self.initial_pose_received = True  # AMCL answers on amcl_pose
+
+    def waitUntilNav2Active(self, navigator="bt_navigator", localizer="amcl"):
+        self._call("waitUntilNav2Active")
+        self.amcl_active = True
+        while not self.initial_pose_received:
+            self._setInitialPose()
+            self.t += 1.0
+
+    def goToPose(self, pose, behavior_tree=""):
+        self._call("goToPose", pose)
+        self.start = self.t
+        return True
+
+    def isTaskComplete(self):
+        self._call("isTaskComplete")
+        self.t += 0.1
+        return self.t - self.start >= self.finishes_after
+
+    def cancelTask(self):
+        self._call("cancelTask")
+
+    def getResult(self):
+        self._call("getResult")
+        return self.result
+
+    def destroy_node(self):
+        self._call("destroy_node")
+
+
+def _fake_nav2(monkeypatch, calls: list, **behaviour) -> type:
+    """Stand-ins for rclpy, geometry_msgs and nav2_simple_commander (a :class:`_Commander`)."""
+    import types
+
+    navigator = type("BasicNavigator", (_Commander,), dict(behaviour))
     TaskResult = types.SimpleNamespace(SUCCEEDED="S", CANCELED="C", FAILED="F")
-    pose = lambda: types.SimpleNamespace(  # noqa: E731
-        header=types.SimpleNamespace(frame_id="", stamp=None),
-        pose=types.SimpleNamespace(position=types.SimpleNamespace(x=0, y=0, z=0),
-                                   orientation=types.SimpleNamespace(x=0, y=0, z=0, w=1)))
     modules = {"rclpy": {"init": lambda args: calls.append(("rclpy.init", args)), "shutdown": lambda: None},
-               "geometry_msgs": {}, "geometry_msgs.msg": {"PoseStamped": pose},
+               "geometry_msgs": {}, "geometry_msgs.msg": {"PoseStamped": _pose_stamped},
                "nav2_simple_commander": {},
-               "nav2_simple_commander.robot_navigator": {"BasicNavigator": Navigator, "TaskResult": TaskResult}}
+               "nav2_simple_commander.robot_navigator": {"BasicNavigator": navigator, "TaskResult": TaskResult}}
     for name, attrs in modules.items():
         module = types.ModuleType(name)
         module.__dict__.update(attrs)
         monkeypatch.setitem(sys.modules, name, module)
+    return navigator
 
 
-@pytest.mark.parametrize("finishes_after, result, outcome, status", [
-    (5.0, "SUCCEEDED", "succeeded", 0), (5.0, "FAILED", "failed", 1), (1e9, None, "time_limit", 2)])
-def test_the_goal_sender_runs_through(folder, tmp_path, monkeypatch, finishes_after, result, outcome, status):
+def _send_goal(folder, tmp_path, monkeypatch, **behaviour):
     goal_module = load(folder / "ros2" / "send_goal.py", "bundle_send_goal_run")
     calls: list = []
-    _fake_nav2(monkeypatch, finishes_after, result, calls)
+    _fake_nav2(monkeypatch, calls, **behaviour)
     out = tmp_path / "run.result.yaml"
     code = goal_module.main(["--tasks", str(folder / "ros2" / "tasks.yaml"), "--task", "task_1", "--result", str(out),
                              "--world-dir", str(folder), "--run", "4", "--seed", "7",
                              "--ros-args", "-p", "use_sim_time:=true"])
+    return code, calls, _Commander.last, read_yaml(out)
+
+
+@pytest.mark.parametrize("finishes_after, result, outcome, status", [
+    (5.0, "S", "succeeded", 0), (5.0, "F", "failed", 1), (1e9, None, "time_limit", 2)])
+def test_the_goal_sender_runs_through(folder, tmp_path, monkeypatch, finishes_after, result, outcome, status):
+    code, calls, navigator, record = _send_goal(folder, tmp_path, monkeypatch, finishes_after=finishes_after,
+                                                result=result)
     assert code == status
-    names = [c[0] for c in calls]
-    # Active first, then the goal; the ROS arguments reach rclpy.
-    assert names[:4] == ["rclpy.init", "init", "waitUntilNav2Active", "goToPose"]
+    names = [c[0] for c in navigator.calls]
+    # The initial pose first, then active, then the goal; the ROS arguments reach rclpy.
+    assert names[:5] == ["init", "setInitialPose", "waitUntilNav2Active", "goToPose", "isTaskComplete"]
     assert calls[0][1][1:] == ["--ros-args", "-p", "use_sim_time:=true"]
     assert ("cancelTask" in names) == (outcome == "time_limit")
-    record = read_yaml(out)
     spec = read_yaml(folder / "ros2" / "tasks.yaml")["tasks"][1]
     assert record["outcome"] == outcome and record["task"] == "task_1" and (record["run"], record["seed"]) == (4, 7)
     assert record["goal"] == spec["goal"] and record["world_dir"] == str(folder)
     elapsed = record["finished_sim_time"] - record["goal_sent_sim_time"]
     expected = spec["time_limit"] if outcome == "time_limit" else finishes_after
     assert expected <= elapsed <= expected + 0.2  # the limit is simulation time from the goal
-    goal = [c for c in calls if c[0] == "goToPose"][0][1]
+    goal = next(c for c in navigator.calls if c[0] == "goToPose")[1]
     assert (goal.pose.position.x, goal.pose.position.y, goal.header.frame_id) == (
         spec["goal"]["x"], spec["goal"]["y"], "map")
     assert math.isclose(2 * math.atan2(goal.pose.orientation.z, goal.pose.orientation.w), spec["goal"]["yaw"])
+
+
+def test_amcl_starts_at_the_spawn_not_at_the_map_origin(folder, tmp_path, monkeypatch):
+    """nav2's BasicNavigator publishes its initial pose while it waits for nav2 (the map origin unless
+    set): every /initialpose message, the first before any wait, must be the task's spawn."""
+    _, _, navigator, _ = _send_goal(folder, tmp_path, monkeypatch)
+    spawn = read_yaml(folder / "ros2" / "tasks.yaml")["tasks"][1]["spawn"]
+    wait_at = next(i for i, c in enumerate(navigator.calls) if c[0] == "waitUntilNav2Active")
+    assert navigator.published and navigator.published[0][0] <= wait_at  # published before the wait began
+    assert math.hypot(spawn["x"], spawn["y"]) > 0.5  # the origin would be told apart
+    for _, frame, x, y, yaw in navigator.published:
+        assert frame == "map"
+        assert (x, y) == (spawn["x"], spawn["y"]) and math.isclose(yaw, spawn["yaw"], abs_tol=1e-12)
+    x, y, yaw = navigator.amcl_pose
+    assert (x, y) == (spawn["x"], spawn["y"]) and math.isclose(yaw, spawn["yaw"], abs_tol=1e-12)
+    stamp = navigator.calls[1][1].header.stamp
+    assert stamp == round(100.0 * 1e9)  # stamped with the navigator's (simulation) clock
+
+
+@pytest.mark.parametrize("crash_in", ["setInitialPose", "waitUntilNav2Active", "goToPose", "isTaskComplete"])
+def test_a_goal_sender_that_fails_writes_a_crashed_result(folder, tmp_path, monkeypatch, crash_in):
+    code, _, _, record = _send_goal(folder, tmp_path, monkeypatch, crash_in=crash_in)
+    assert code == 4 and record["outcome"] == "crashed"
+    assert record["reason"] == f"RuntimeError: {crash_in} failed" and record["task"] == "task_1"
+
+
+def test_the_first_result_written_wins(folder, tmp_path):
+    goal_module = load(folder / "ros2" / "send_goal.py", "bundle_send_goal_first")
+    path = tmp_path / "r.result.yaml"
+    assert goal_module.write_result(str(path), {"outcome": "timed_out"})
+    assert not goal_module.write_result(str(path), {"outcome": "crashed"})
+    assert read_yaml(path) == {"outcome": "timed_out"} and [p.name for p in tmp_path.iterdir()] == [path.name]
