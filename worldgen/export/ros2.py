@@ -29,7 +29,7 @@ from typing import Any, Mapping, Optional
 
 from worldgen.errors import ParameterError
 
-__all__ = ["BUNDLE_DIR", "GZ_RELEASES", "DEFAULT_GZ_RELEASE", "DEFAULT_ROBOT_NAME", "TOPICS", "RECORDED_TOPICS",
+__all__ = ["BUNDLE_DIR", "GZ_RELEASES", "GZ_SERVERS", "DEFAULT_GZ_RELEASE", "DEFAULT_ROBOT_NAME", "TOPICS", "RECORDED_TOPICS",
            "ros_name", "release_of", "plugins", "with_plugins", "bridge_config", "nav2_overrides", "tasks_spec",
            "bundle", "dumps"]
 
@@ -43,6 +43,16 @@ GZ_RELEASES = {
     "garden": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
     "harmonic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
     "ionic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
+}
+#: Gazebo's server command per release, whether it takes ``--seed`` (gz-sim 8's cmdsim.rb has it; gz-sim 7's
+#: and ign-gazebo 6's do not) and the variable it reads system plugin paths from. The launch file runs it
+#: without a shell: ros_gz_sim's gz_sim.launch.py runs ``ruby $(which gz) sim`` through one, the shell does
+#: not pass launch's SIGINT on, and Gazebo outlives the run (ros2/launch#545).
+GZ_SERVERS = {
+    "fortress": (("ign", "gazebo"), False, "IGN_GAZEBO_SYSTEM_PLUGIN_PATH"),
+    "garden": (("gz", "sim"), False, "GZ_SIM_SYSTEM_PLUGIN_PATH"),
+    "harmonic": (("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH"),
+    "ionic": (("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH"),
 }
 #: Harmonic pairs with ROS 2 Jazzy, the current LTS pair.
 DEFAULT_GZ_RELEASE = "harmonic"
@@ -207,6 +217,8 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
     run loads the world's own world.sdf with Gazebo's default systems, which publish no sensor in
     Garden and later). ``folder_name`` names the bags (default: the world's folder name).
     """
+    from worldgen.files import MAP_YAML_NAME
+
     if gz_release is not None:
         _release(gz_release)
     robot = ros_name(robot_name)
@@ -221,8 +233,10 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
     if gz_release is not None:
         files[f"{BUNDLE_DIR}/world.sdf"] = with_plugins(world.export("sdf", sdf_version), gz_release, "../")
         sdf_file = f"{BUNDLE_DIR}/world.sdf"
+    command, seed, plugin_path = GZ_SERVERS[gz_release or DEFAULT_GZ_RELEASE]
     values = {"WORLD_ID": world.world_id, "WORLD_NAME": world.world_id, "ROS_NAME": name,
-              "FOLDER": folder_name or world.folder_name, "SDF": sdf_file, "ROBOT": robot,
+              "FOLDER": folder_name or world.folder_name, "SDF": sdf_file, "ROBOT": robot, "MAP": MAP_YAML_NAME,
+              "GZ_COMMAND": repr(command), "GZ_SEED": repr(seed), "GZ_PLUGIN_PATH": plugin_path,
               "FIRST_TASK": world.tasks[0].id, "TOPICS": repr(tuple(t.format(robot=robot) for t in RECORDED_TOPICS))}
     launch = _fill(_template("launch.py"), values)
     files[f"{BUNDLE_DIR}/launch/{name}.launch.py"] = launch.encode()
