@@ -72,7 +72,7 @@ def make_bag(root: Path) -> tuple[Path, Path]:
 
 
 def time_one(bag: Path, world: Path, repeats: int) -> dict:
-    from worldgen.ros import judge, write_report
+    from worldgen.judge import judge, write_report
 
     out = bag.parent / "timing" / "report"
 
@@ -105,7 +105,7 @@ def batch_child(bag: str, world: str, n: int, out: str) -> None:
     for i in range(n):
         os.symlink(bag, names / f"run{i:05d}")
     t0 = time.perf_counter()
-    from worldgen.ros import judge, write_report
+    from worldgen.judge import judge, write_report
 
     first: list[float] = []
     first_rss: list[int] = []

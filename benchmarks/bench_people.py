@@ -70,8 +70,8 @@ class _Routing:
 def measure(n_people: int, seeds: range) -> dict:
     import worldgen
     from worldgen.feasibility import check
-    from worldgen.feasibility.crowd import walk_people
-    from worldgen.feasibility.timed import certify
+    from worldgen.people.crowd import walk_people
+    from worldgen.people.timed import certify
     from worldgen.seeding import people_rng
 
     rows = []

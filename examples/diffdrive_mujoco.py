@@ -39,7 +39,8 @@ from lxml import etree
 
 import worldgen
 from worldgen.export.xml import safe_parser
-from worldgen.ros import judge, write_report, write_run
+from worldgen.judge import judge, write_report
+from worldgen.ros import write_run
 
 CRITERIA = """
 navigation:

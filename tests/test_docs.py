@@ -77,7 +77,7 @@ def test_links_between_docs_pages_resolve(page):
 
 
 def test_generators_doc_holds_every_parameter_as_worldgen_list_prints_it():
-    from worldgen.cli import parameter_tables
+    from worldgen.cli.world import parameter_tables
     from worldgen.generators import all_specs
 
     text = (REPO / "docs" / "generators.md").read_text()

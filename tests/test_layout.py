@@ -129,3 +129,105 @@ def test_tests_mirror_the_package_and_share_helpers_only_through_support():
             for name in names:
                 assert not name.split(".")[0].startswith(("test_", "conftest")), \
                     f"{path.relative_to(TESTS)} imports {name}: shared helpers belong in tests/support"
+
+
+# -- rooms and the flow between them ------------------------------------------------------------------
+
+#: The rooms in the order the data flows: a room may import the rooms before it, never one after it.
+#: Top-level modules are rooms of their own. Rooms on one rank may not import each other.
+FLOW = [
+    {"errors"}, {"floats", "files", "seeding", "schema"}, {"params"}, {"scene"}, {"generators"}, {"feasibility"},
+    {"groundtruth"}, {"people"}, {"export"}, {"ros"}, {"world"}, {"leveling"}, {"api"}, {"presets"},
+    {"testing"}, {"verify"}, {"pack"}, {"judge"}, {"envs"}, {"sim"}, {"cli"}, {"__main__"},
+]
+MAX_TOP_LEVEL = 10
+
+
+def room_of(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else "worldgen"
+
+
+def rank(room: str) -> int:
+    for i, rooms in enumerate(FLOW):
+        if room in rooms:
+            return i
+    raise KeyError(room)
+
+
+def against_the_flow(graph: dict[str, set[str]]) -> list[str]:
+    out = []
+    for a, targets in sorted(graph.items()):
+        for b in sorted(targets):
+            ra, rb = room_of(a), room_of(b)
+            if "worldgen" in (ra, rb) or ra == rb:
+                continue  # the package's own __init__ imports nothing but errors; a room within itself is free
+            if rank(rb) >= rank(ra):
+                out.append(f"{a} -> {b}")
+    return out
+
+
+def test_every_room_has_its_place_in_the_flow():
+    rooms = {room_of(m) for m in modules()} - {"worldgen"}
+    placed = set().union(*FLOW)
+    assert rooms <= placed, f"rooms missing from FLOW: {sorted(rooms - placed)}"
+
+
+def test_no_import_runs_against_the_flow():
+    found = against_the_flow(import_graph())
+    assert not found, "imports against the flow (FLOW in this file):\n" + "\n".join(found)
+
+
+def test_the_flow_check_finds_an_import_back_up():
+    assert against_the_flow({"worldgen.feasibility.planner": {"worldgen.people.crowd"}}) == \
+        ["worldgen.feasibility.planner -> worldgen.people.crowd"]
+    assert against_the_flow({"worldgen.people.crowd": {"worldgen.feasibility.planner"}}) == []
+
+
+def test_the_top_level_holds_at_most_ten_modules():
+    top = sorted(p.name for p in PACKAGE.glob("*.py") if p.name != "__init__.py")
+    assert len(top) <= MAX_TOP_LEVEL, f"{len(top)} modules at the top level (at most {MAX_TOP_LEVEL}): {top}"
+
+
+#: How a long function says why it is long: a comment on the line above its ``def`` (or its decorators).
+LONG_REASON = "# long:"
+MAX_FUNCTION_LINES = 60
+
+
+def long_functions_without_reason() -> list[str]:
+    out = []
+    for name, path in sorted(modules().items()):
+        lines = path.read_text().splitlines()
+        for node in ast.walk(ast.parse("\n".join(lines))):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            length = node.end_lineno - node.lineno + 1
+            first = min([node.lineno] + [d.lineno for d in node.decorator_list])
+            above = lines[first - 2].strip() if first >= 2 else ""
+            if length > MAX_FUNCTION_LINES and not above.startswith(LONG_REASON):
+                out.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno} {node.name} ({length} lines)")
+    return out
+
+
+def test_functions_over_60_lines_say_why():
+    found = long_functions_without_reason()
+    assert not found, f"functions over {MAX_FUNCTION_LINES} lines with no '{LONG_REASON} ...' comment above:\n" + \
+        "\n".join(found)
+
+
+def test_file_names_are_spelled_only_in_files_py():
+    """A world's and a pack's file names come from worldgen/files.py: a literal elsewhere is a second spelling
+    that a rename would miss."""
+    files_py = PACKAGE / "files.py"
+    names = {node.value.value for node in ast.parse(files_py.read_text()).body
+             if isinstance(node, ast.Assign) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)
+             and "." in node.value.value}
+    assert "world.json" in names
+    found = []
+    for name, path in sorted(modules().items()):
+        if path == files_py:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Constant) and node.value in names:
+                found.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno} {node.value!r}")
+    assert not found, "file names spelled outside files.py:\n" + "\n".join(found)

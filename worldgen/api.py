@@ -25,6 +25,7 @@ from worldgen.world import World
 __all__ = ["generate"]
 
 
+# long: the pipeline's stages in the order they run (validate, draw, movers, people, prove, record); one reads it top to bottom
 def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, difficulty: Any = None,
              **params: Any) -> World:
     """Generate, check and return one world; no disk I/O.
@@ -72,7 +73,7 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             map_extent = occupancy.extent(draft.scene, resolved["map_resolution"])
         report = feasibility.check(draft.scene, draft.tasks, robot)
         if resolved.get("n_people"):
-            from worldgen.feasibility.timed import certify
+            from worldgen.people.timed import certify
             report = certify(report, draft.scene, draft.tasks, robot, resolved["robot_speed"])
         world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1, allow_infeasible)
         if report.feasible or (resolved.get("infeasible") and _infeasible_on_purpose(report)):
@@ -100,7 +101,7 @@ def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt:
     ``infeasible``: every goal walled in (worldgen.generators.infeasible), unless the generator
     declares its own ``infeasible`` parameter; ``n_movers``: movers on their own
     RNG stream (worldgen.generators.movers), laid out after any goal walls so they avoid them;
-    ``n_people``: people on theirs, walked by the crowd model (worldgen.feasibility.crowd), after
+    ``n_people``: people on theirs, walked by the crowd model (worldgen.people.crowd), after
     the movers (docs/people.md).
     """
     scene = draft.scene
@@ -115,7 +116,7 @@ def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt:
             return Draft(scene, draft.tasks, rejected="mover_placement", detail=reason)
         scene = scene.with_movers(movers)
     if resolved.get("n_people"):
-        from worldgen.feasibility.crowd import walk_people
+        from worldgen.people.crowd import walk_people
         people, reason = walk_people(scene, draft.tasks, robot, resolved, people_rng(seed, attempt))
         if reason:
             return Draft(scene, draft.tasks, rejected="people_placement", detail=reason)

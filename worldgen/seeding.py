@@ -52,7 +52,7 @@ LEVEL_STREAM = 0x6C766C
 #: Key of an environment's curriculum stream (levels it jumps to, levels it replays or edits), beside the
 #: world and noise streams of a reset's seed: a curriculum never moves a plain environment's worlds.
 CURRICULUM_STREAM = 2
-#: Key of an edit's stream ("edt"), beside the edit's own seed (worldgen.editing).
+#: Key of an edit's stream ("edt"), beside the edit's own seed (worldgen.verify.edits).
 EDIT_STREAM = 0x656474
 
 
@@ -94,7 +94,7 @@ def curriculum_rng(entropy: int) -> np.random.Generator:
 
 
 def edit_rng(seed: int) -> np.random.Generator:
-    """The stream of one edit of a level, from the edit's seed (worldgen.editing)."""
+    """The stream of one edit of a level, from the edit's seed (worldgen.verify.edits)."""
     return _stream(seed, EDIT_STREAM)
 
 

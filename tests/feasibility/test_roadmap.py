@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 
 import worldgen
-from worldgen.feasibility import crowd
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.planner import Planner
 from worldgen.feasibility.roadmap import Roadmap
-from worldgen.generators.people import SLACK, draw_people, people_footprints
+from worldgen.people import crowd
+from worldgen.people.places import SLACK, draw_people, people_footprints
 from worldgen.scene.footprint import Footprint
 from worldgen.seeding import people_rng
 

@@ -8,8 +8,8 @@ import pytest
 
 import worldgen
 from worldgen import oracles
+from worldgen.groundtruth.ground import Ground
 from worldgen.testing import social
-from worldgen.testing.ground import Ground
 
 #: A person of radius 0.25 walking from (5, 0) to (0, 0) at 1 m/s, then waiting there; robot radius 0.2.
 META = {"robot": {"radius": 0.2, "height": 0.4, "clearance": 0.05},

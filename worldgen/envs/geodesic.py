@@ -46,6 +46,7 @@ _MOVES = ((1, 0), (0, 1), (1, 1), (1, -1), (2, 1), (1, 2), (2, -1), (1, -2))
 class GeodesicField:
     """Geodesic distance (m) to ``goal`` for the disc of ``cs.radius`` in ``cs``; see the module's docstring."""
 
+    # long: builds the field in one pass (grid, footprint fill, Dijkstra); the steps share a dozen arrays
     def __init__(self, cs, goal, bounds, spacing: float = 0.05):
         from scipy.sparse import csr_matrix
         from scipy.sparse.csgraph import dijkstra

@@ -10,7 +10,7 @@ each episode, from the environment's curriculum stream (:func:`worldgen.seeding.
   (ties in buffer order), and weighs rank ``r`` by ``(1 / r) ** (1 / temperature)``; ``P_C`` weighs each
   level by the episodes since it was last played, ``(c - C_i) / sum_j (c - C_j)`` (uniform when all are 0);
 - else, with probability ``edit_prob`` (buffer not empty), a level drawn by the same ``P`` is **edited**
-  (:func:`worldgen.editing.edit_world`: move, resize, add or remove an obstacle, or move the goal) and
+  (:func:`worldgen.verify.edits.edit_world`: move, resize, add or remove an obstacle, or move the goal) and
   the edit, re-proved by the exact checker, is played; when no proposal passes, a new level instead;
 - else a **new** level: the source's next world (the seed a plain environment would draw).
 
@@ -32,9 +32,9 @@ from typing import Any, Optional
 
 import numpy as np
 
-from worldgen.editing import EDITS, edit_world, replay_edits
 from worldgen.errors import ParameterError, quoted
 from worldgen.seeding import curriculum_rng, draw_seed
+from worldgen.verify.edits import EDITS, edit_world, replay_edits
 
 __all__ = ["LevelReplay", "LevelRecord", "learnability", "check_generator_source"]
 
@@ -47,7 +47,7 @@ def learnability(successes: int, plays: int) -> float:
 
 @dataclass(eq=False)
 class LevelRecord:
-    """One level: its proven ``world`` (generated, or an :class:`~worldgen.editing.EditedWorld`) and its
+    """One level: its proven ``world`` (generated, or an :class:`~worldgen.verify.edits.EditedWorld`) and its
     history. ``generator``, ``params``, ``seed`` and ``edits`` rebuild it (:meth:`rebuild`)."""
 
     world: Any

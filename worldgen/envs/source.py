@@ -102,8 +102,8 @@ def episode_world(world) -> EpisodeWorld:
     """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
     from worldgen.export.metadata import mover_entry
     from worldgen.export.xml import parse_bytes
+    from worldgen.groundtruth.ground import Ground
     from worldgen.scene.doors import door_records
-    from worldgen.testing.ground import Ground
 
     task = _task_of_world(world)
     movers = [mover_entry(m, world.params) for m in world.scene.movers]
@@ -221,8 +221,8 @@ class PackSource:
         from lxml import etree
 
         from worldgen.export.xml import safe_parser
+        from worldgen.groundtruth.ground import load as ground_of
         from worldgen.scene import Robot as _Robot
-        from worldgen.testing.ground import load as ground_of
 
         pw = self.pack[index]
         meta = pw.metadata

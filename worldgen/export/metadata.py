@@ -35,6 +35,7 @@ SCHEMA_ID = "worldgen.world/1"
 _DISC_QUAD_SEGS = 32
 
 
+# long: world.json's top-level keys in the order the contract lists them (docs/world-json.md)
 def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
     """world.json of ``world`` as a plain dict (floats already rounded).
 

@@ -152,6 +152,7 @@ class _Pen:
         self.draw.polygon(self.xy([tip, wings[0], wings[1]]), fill=fill)
 
 
+# long: the layers of the picture in drawing order, each a few lines
 def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
     """The preview of ``meta`` (a world.json dict) as an RGB image ``width`` px wide."""
     lay = layout(meta, width)

@@ -60,7 +60,7 @@ class FeasibilityReport:
     #: for doors: the reference path assumes them open).
     informational: tuple[Check, ...] = ()
     #: With people: per task, the certificate among them (a TimedPath of
-    #: :mod:`worldgen.feasibility.timed`, None where there is none); () without people.
+    #: :mod:`worldgen.people.timed`, None where there is none); () without people.
     timed_paths: tuple = ()
 
     @property

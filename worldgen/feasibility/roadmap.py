@@ -185,7 +185,7 @@ class Roadmap:
         self._ways[k] = got
         return got
 
-    # -- a query --------------------------------------------------------------
+    # long: a query (the A* loop is the hot path; splitting it costs a call per expanded node)
     def shortest(self, start, goal) -> Optional[Route]:
         """The shortest path from ``start`` to ``goal`` ((2,) each, both free), or None if there is none.
 

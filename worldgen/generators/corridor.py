@@ -90,6 +90,7 @@ def _passage(params: Mapping[str, Any], proven: float) -> float:
     return max(proven, 2 * (params["robot_radius"] + params["clearance"]) + 0.2)
 
 
+# long: one check per parameter combination, each a line or two, with its message
 def check(params: Mapping[str, Any]) -> None:
     """Reject parameters no corridor can satisfy; a too-narrow width is an InfeasibleError."""
     lay = layout(params)

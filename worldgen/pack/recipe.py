@@ -154,7 +154,7 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
             r.fail(top["preview"], "preview", f"must be true or false, got {quoted(preview)}")
     ros: Any = False
     if "ros" in top:
-        from worldgen.export.ros2 import GZ_RELEASES, release_of
+        from worldgen.ros.bundle import GZ_RELEASES, release_of
 
         value = r.value(top["ros"])
         try:
@@ -227,6 +227,7 @@ class _Reader:
             return tuple(range(first, first + count))
         self.fail(node, "seeds", f"must be a count, {{start, count}} or {{min, max}}, got {quoted(value)}")
 
+    # long: one recipe entry's keys checked in order, each with its own message
     def entry(self, node, e: int, default_seeds):
         from worldgen.generators import get
 

@@ -36,10 +36,10 @@ from typing import Any, Iterable, Mapping, Optional, Union
 
 from worldgen.errors import ParameterError
 from worldgen.files import SCENARIO_NAME
+from worldgen.groundtruth.ground import load
 from worldgen.testing.criteria import CRITERIA, SCORING, load_criteria
 from worldgen.testing.figures import Run, barn_score
 from worldgen.testing.figures import run as run_figures
-from worldgen.testing.ground import load
 
 __all__ = ["CRITERIA", "AVERAGED_OVER", "Criterion", "Report", "load_criteria", "evaluate", "scenario_of"]
 
@@ -238,6 +238,7 @@ def _figures(judged: list[tuple[Run, bool, Optional[float]]]) -> dict[str, Any]:
     }
 
 
+# long: each run's figures, then the criteria over all of them, in one place so the rows stay aligned
 def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
              reference_speed: Optional[float] = None) -> Report:
     """Figures of every run (each a ``(trajectory, world[, task])`` or a dict), judged against ``criteria``.

@@ -5,7 +5,7 @@ A trajectory is an (n, 3) array-like of ``t, x, y`` rows (seconds, metres), or
 about the footprint, a vertical cylinder, which looks the same at every yaw.
 Times must not decrease.
 
-A world is what :func:`worldgen.testing.ground.load` takes: a :class:`~worldgen.World`, a world of a built pack
+A world is what :func:`worldgen.groundtruth.ground.load` takes: a :class:`~worldgen.World`, a world of a built pack
 (:class:`~worldgen.PackWorld`, folder or archive) or a written world folder (its
 world.json is read). Figures are for the world's first task unless ``task`` names another.
 
@@ -24,7 +24,7 @@ from typing import Any, Optional
 import numpy as np
 
 from worldgen.errors import ParameterError
-from worldgen.testing.ground import Ground, as_trajectory, leaves_of, load
+from worldgen.groundtruth.ground import Ground, as_trajectory, leaves_of, load
 from worldgen.testing.social import disc_gaps, discs, social_figures, timed_samples
 
 __all__ = [

@@ -21,6 +21,7 @@ one run: trajectories, worlds and tasks as accepted there) and
 
 from __future__ import annotations
 
+from worldgen.groundtruth.ground import Ground, as_trajectory, load
 from worldgen.testing.evaluate import evaluate
 from worldgen.testing.figures import (
     DOOR_DEBOUNCE,
@@ -37,7 +38,6 @@ from worldgen.testing.figures import (
     run,
     time_to_goal,
 )
-from worldgen.testing.ground import Ground, as_trajectory, load
 from worldgen.testing.social import PERSONAL_SPACE, min_person_distance, min_time_to_collision, personal_space_time
 
 __all__ = [

@@ -1,7 +1,7 @@
 """The social-navigation figures of one run: how close the robot came to people, how long it stayed in
 their personal space, and how soon it would have hit one (the figures HuNavSim's evaluator reports).
 
-People are world.json's ``people[]`` (:mod:`worldgen.generators.people`), each a disc walking its
+People are world.json's ``people[]`` (:mod:`worldgen.people.places`), each a disc walking its
 ``t, x, y`` rows and waiting at its last point; scripted movers (``dynamic_obstacles[]``, looping) are
 discs too. Positions come from :func:`worldgen.scene.motion.positions_at`, the same interpolation the
 exports drive MuJoCo's mocap bodies with. Every figure is None in a world without people.
@@ -17,7 +17,7 @@ from typing import Optional
 
 import numpy as np
 
-from worldgen.testing.ground import Ground, as_trajectory, load
+from worldgen.groundtruth.ground import Ground, as_trajectory, load
 
 __all__ = ["PERSONAL_SPACE", "PEOPLE_DT", "discs", "disc_gaps", "timed_samples", "min_person_distance", "personal_space_time",
            "min_time_to_collision", "social_figures"]

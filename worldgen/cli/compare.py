@@ -13,11 +13,11 @@ from typing import Any, Optional
 
 import click
 
+from worldgen.cli.context import CONTEXT as _CONTEXT
 from worldgen.errors import ParameterError, read_user_text
 
 __all__ = ["compare_command", "read_runs", "format_comparison"]
 
-_CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
 def read_runs(path) -> list[dict]:

@@ -16,7 +16,7 @@ from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.export import metadata
 from worldgen.export.actor_path import TENSION, actor_waypoints, spline_positions
 from worldgen.export.xml import parse_bytes
-from worldgen.generators.people import KEEP_OUT, LEG_MAX, LEG_MIN, SLACK, draw_people, people_footprints
+from worldgen.people.places import KEEP_OUT, LEG_MAX, LEG_MIN, SLACK, draw_people, people_footprints
 from worldgen.scene.footprint import FootprintIndex
 from worldgen.scene.motion import drive_mocap, mover_names, mover_positions
 from worldgen.seeding import people_rng
@@ -157,7 +157,7 @@ def test_a_standing_person_stands_still_in_every_format(tmp_path):
 
 
 def test_groups_share_speed_and_start_together_and_walk_beside_each_other():
-    from worldgen.generators.people import GROUP_SPACING, GROUP_START
+    from worldgen.people.places import GROUP_SPACING, GROUP_START
 
     base = worldgen.generate("cluttered", seed=1, size=[12.0, 12.0], n_obstacles=4)
     params = dict(base.params, n_people=7, person_radius=0.25, person_speed=[0.8, 1.4], people_duration=30.0,

@@ -1,4 +1,4 @@
-"""``worldgen judge``: a thin click layer over :mod:`worldgen.testing.judge` and :mod:`worldgen.testing.report`.
+"""``worldgen judge``: a thin click layer over :mod:`worldgen.judge.runs` and :mod:`worldgen.judge.report`.
 
 Mistakes raise :class:`~worldgen.errors.WorldgenError`, which ``worldgen.cli.main`` prints as one
 line with exit status 2; criteria that do not hold (or an unreadable bag) exit 1.
@@ -12,9 +12,10 @@ from typing import Optional, Sequence
 
 import click
 
+from worldgen.cli.context import CONTEXT as _CONTEXT
+
 __all__ = ["judge_command"]
 
-_CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
 @click.command("judge", context_settings=_CONTEXT, epilog="""\b
@@ -57,9 +58,9 @@ def judge_command(bags: Sequence[Path], world: Optional[Path], pack: Optional[Pa
     report.md and runs/RUN.png. Exit status 0 when every criterion holds and every bag
     was read, 1 otherwise, 2 on bad input. Needs the ros extra: pip install 'worldgen[ros]'.
     """
-    from worldgen.testing.judge import judge
-    from worldgen.testing.report import write_report
-    from worldgen.testing.rosdeps import require_rosbags
+    from worldgen.judge.report import write_report
+    from worldgen.judge.runs import judge
+    from worldgen.ros.deps import require_rosbags
 
     require_rosbags()
     options = {"pose_topic": pose_topic, "odom_topic": odom_topic, "cmd_topic": cmd_topic,
@@ -68,7 +69,7 @@ def judge_command(bags: Sequence[Path], world: Optional[Path], pack: Optional[Pa
         options["base_frames"] = tuple(base_frames)
     tty = sys.stderr.isatty()
     if tty if progress is None else progress:
-        from worldgen.testing.judge import plan
+        from worldgen.judge.runs import plan
 
         total = len(plan(bags, world=world, pack=pack, runs=runs_table))
         if tty:

@@ -1,10 +1,10 @@
-"""Opening a bag and decoding the few message types the run reader needs (for :mod:`worldgen.testing.bags`).
+"""Opening a bag and decoding the few message types the run reader needs (for :mod:`worldgen.ros.reader`).
 
 Three costs dominate reading a short bag with rosbags, and each is paid once here rather than per bag:
 the typestore (rosbags generates each type's deserialiser on first use: kept per set of definitions,
 so a batch reuses it), metadata.yaml (parsed with PyYAML; an uncompressed one-file rosbag2 folder is
 then read through its storage file), and decoding whole messages (the fields needed are read from the
-CDR bytes by :mod:`worldgen.testing.cdr`, checked against rosbags' decoding on each connection's first
+CDR bytes by :mod:`worldgen.ros.cdr`, checked against rosbags' decoding on each connection's first
 message; a connection where the two differ is decoded by rosbags throughout).
 """
 
@@ -17,8 +17,8 @@ from collections import OrderedDict
 from pathlib import Path
 from typing import Any, Callable, Optional
 
+import worldgen.ros.cdr as cdr
 from worldgen.errors import ParameterError
-from worldgen.testing import cdr
 
 __all__ = ["fail", "unreadable", "typestore", "storage", "bag_metadata", "decoder"]
 
@@ -91,7 +91,7 @@ def _transform(tr) -> cdr.Pose2:
 
 
 def _slow(msgtype: str, msg) -> Any:
-    """What :mod:`worldgen.testing.cdr` returns for the type, from rosbags' decoded message."""
+    """What :mod:`worldgen.ros.cdr` returns for the type, from rosbags' decoded message."""
     if msgtype == "rosgraph_msgs/msg/Clock":
         return _t(msg.clock)
     if msgtype == "tf2_msgs/msg/TFMessage":

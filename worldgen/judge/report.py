@@ -111,9 +111,11 @@ def _map(folder: Path):
     import yaml
     from PIL import Image
 
+    from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
+
     try:
-        meta = yaml.safe_load((folder / "map.yaml").read_text())
-        img = Image.open(folder / str(meta.get("image", "map.pgm")))
+        meta = yaml.safe_load((folder / MAP_YAML_NAME).read_text())
+        img = Image.open(folder / str(meta.get("image", MAP_IMAGE_NAME)))
         img.load()
     except (OSError, ValueError, yaml.YAMLError):
         return None
@@ -125,7 +127,7 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
     from PIL import Image, ImageDraw
 
     from worldgen.export.preview_frame import text_font
-    from worldgen.testing.ground import load
+    from worldgen.groundtruth.ground import load
 
     found = _map(Path(world))
     if found is None:
@@ -173,7 +175,7 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
 
 
 def write_report(result, out) -> Path:
-    """Write the report folder of a :class:`~worldgen.testing.judge.JudgeResult` at ``out``; returns ``out``."""
+    """Write the report folder of a :class:`~worldgen.judge.runs.JudgeResult` at ``out``; returns ``out``."""
     out = Path(out)
     if out.exists() and not (out.is_dir() and ((out / "report.json").is_file() or not any(out.iterdir()))):
         raise OutputError(f"--out '{out}' exists and is not a report folder; give a new folder or an earlier report's")

@@ -1,4 +1,4 @@
-"""Edits of a proven world (worldgen.editing): a thousand of them, every accepted one re-proved by the
+"""Edits of a proven world (worldgen.verify.edits): a thousand of them, every accepted one re-proved by the
 exact checker and re-checked here independently; recorded edits rebuild the same world; an edit that
 blocks the goal is refused."""
 
@@ -12,9 +12,9 @@ import pytest
 from support.checks import footprint_distance, recheck
 
 import worldgen
-from worldgen.editing import EDITS, EditedWorld, apply_edit, edit_world, replay_edits
 from worldgen.errors import ParameterError
 from worldgen.feasibility.report import CHECKER, REQUIRED_CHECKS
+from worldgen.verify.edits import EDITS, EditedWorld, apply_edit, edit_world, replay_edits
 
 
 def test_a_thousand_edits_each_accepted_one_proven_and_rechecked_independently():

@@ -45,8 +45,8 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError
-from worldgen.testing.bagio import bag_metadata, decoder, fail, storage, typestore, unreadable
-from worldgen.testing.rosdeps import require_rosbags
+from worldgen.ros.bagio import bag_metadata, decoder, fail, storage, typestore, unreadable
+from worldgen.ros.deps import require_rosbags
 
 __all__ = ["BagRun", "read_run", "bag_metadata", "peek_metadata", "START_RULES", "GOAL_TOPICS", "MOTION_START"]
 
@@ -150,7 +150,7 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
         raise fail(path, "does not exist")
     spawn = None
     if world is not None:
-        from worldgen.testing.ground import load
+        from worldgen.groundtruth.ground import load
         spawn = np.asarray(load(world).task(task)["spawn"], dtype=float)[[0, 1, 5]]
     try:
         source, meta = storage(path)

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from worldgen.testing import cdr
+import worldgen.ros.cdr as cdr
 
 rosbags = pytest.importorskip("rosbags")
 

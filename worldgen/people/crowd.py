@@ -33,7 +33,7 @@ position, and every point between two rows of the written trajectory, keeps the 
 every obstacle. People may still touch each other: the model makes it rare, nothing forbids it.
 
 Members of a group (``groups``) feel the group force of Moussaïd et al. (2010) on top
-(:mod:`worldgen.feasibility.groups`).
+(:mod:`worldgen.people.groups`).
 
 :func:`simulate` is a pure function of its arguments: no randomness, same inputs, same rows.
 """
@@ -48,11 +48,11 @@ import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
-from worldgen.feasibility.groups import GroupForce, group_force
 from worldgen.feasibility.planner import Planner
 from worldgen.feasibility.roadmap import Roadmap
 from worldgen.floats import round_float
-from worldgen.generators.people import PERSON_HEIGHT, SLACK, draw_people, people_footprints
+from worldgen.people.groups import GroupForce, group_force
+from worldgen.people.places import PERSON_HEIGHT, SLACK, draw_people, people_footprints
 from worldgen.scene import Mover, Robot, Scene, Task
 
 __all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF", "ROADMAP_ROWS_PER_PERSON_S",
@@ -281,7 +281,7 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
              group_model: GroupForce = GroupForce()) -> np.ndarray:
     """(steps + 1, n, 2) positions of the people at t = 0, dt, 2 dt, ... up to ``duration``.
 
-    ``obstacles`` are what people walk round (:func:`worldgen.generators.people.people_footprints`
+    ``obstacles`` are what people walk round (:func:`worldgen.people.places.people_footprints`
     as :class:`Obstacles2D`), ``starts`` (n, 2) free for the disc of ``radius + 2 SLACK``,
     ``places`` (n, k, 2) each person's places in order (NaN rows end a shorter list), ``speeds`` (n,)
     preferred speeds (m/s), ``depart`` (n,) when each sets off (s; until then it stands still),
@@ -376,7 +376,7 @@ def _keep_off(walls: _Walls, p: np.ndarray, p_new: np.ndarray, room: np.ndarray,
 
 def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping[str, Any],
                 rng: np.random.Generator) -> tuple[tuple[Mover, ...], Optional[str]]:
-    """The people of ``params`` drawn (:func:`~worldgen.generators.people.draw_people`) and walked:
+    """The people of ``params`` drawn (:func:`~worldgen.people.places.draw_people`) and walked:
     (movers with ``person=True``, None), or ((), reason) when they do not fit."""
     plan, reason = draw_people(scene, tasks, robot, params, rng)
     if plan is None:

@@ -198,7 +198,7 @@ def test_mcap_bags_decode_with_the_official_mcap_reader(world, tmp_path):
 def test_reading_needs_rosbags_and_says_what_to_install(monkeypatch, tmp_path):
     import sys
 
-    from worldgen.testing.rosdeps import MissingRosbagsError
+    from worldgen.ros.deps import MissingRosbagsError
     monkeypatch.setitem(sys.modules, "rosbags", None)
     with pytest.raises(MissingRosbagsError, match=r"pip install 'worldgen\[ros\]'$"):
         read_run(tmp_path / "x")

@@ -11,7 +11,7 @@ import pytest
 import worldgen
 from worldgen.errors import InfeasibleError
 from worldgen.export import metadata
-from worldgen.feasibility.timed import CELLS_PER_STEP, DT, MARGIN, SPARE, person_speed, timed_path
+from worldgen.people.timed import CELLS_PER_STEP, DT, MARGIN, SPARE, person_speed, timed_path
 
 #: The fine step (s) of the independent check.
 H = 0.002

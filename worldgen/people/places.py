@@ -15,12 +15,12 @@ obstacle, a task or a mover:
   smaller): a group shares its speed and its places (each member's place beside the group's, side by
   side across the leg, :data:`GROUP_SPACING` apart where the floor is free), and its members start
   within :data:`GROUP_START` of the first one; the crowd model holds them together
-  (:func:`worldgen.feasibility.crowd.group_force`);
+  (:func:`worldgen.people.crowd.group_force`);
 - with ``people_scenario`` other than ``walk``, the first person (``group_passing``: the first G)
   instead walks the human-encounter scenario of that name against the first task (:func:`_scripted`).
 
 Walking between the places, around the obstacles and each other, is the crowd model's
-(:mod:`worldgen.feasibility.crowd`); the robot's spawn and goal discs are obstacles to it too
+(:mod:`worldgen.people.crowd`); the robot's spawn and goal discs are obstacles to it too
 (:func:`people_footprints`), so nobody walks over a robot standing there.
 """
 
@@ -48,7 +48,7 @@ PERSON_HEIGHT = 1.75
 #: rounding of the written rows, far below anything a person would notice.
 SLACK = 1e-3
 #: How much farther (m) than touching people keep from a robot standing at its spawn or goal: more than
-#: the certificate's margin (worldgen.feasibility.timed: 0.01 m + (robot + person speed) x 0.025 s, 0.07 m
+#: the certificate's margin (worldgen.people.timed: 0.01 m + (robot + person speed) x 0.025 s, 0.07 m
 #: at 0.5 m/s) for robot speeds up to 1.7 m/s, so that a robot waiting at its spawn is in nobody's way.
 KEEP_OUT = 0.1
 #: The human-encounter scenarios (``people_scenario``; see :func:`_scripted`): head-on, the person
@@ -109,6 +109,7 @@ def people_footprints(scene: Scene, tasks: Sequence[Task], robot: Robot) -> list
     return prints + keep_out
 
 
+# long: each person's start, goal and stay drawn in turn from one stream; the order is the stream's
 def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping[str, Any],
                 rng: np.random.Generator) -> tuple[Optional[PeoplePlan], Optional[str]]:
     """(plan, None) for ``params['n_people']`` people, or (None, reason) when they do not fit."""

@@ -2,7 +2,7 @@
 
 M. Moussaïd, N. Perozo, S. Garnier, D. Helbing and G. Theraulaz, "The walking behaviour of pedestrian
 social groups and its impact on crowd dynamics", PLoS ONE 5(4): e10047 (2010). A member ``i`` of a
-group of ``N >= 2`` feels, besides the social force model's terms (:mod:`worldgen.feasibility.crowd`),
+group of ``N >= 2`` feels, besides the social force model's terms (:mod:`worldgen.people.crowd`),
 
     f_i^group = f_i^vis + f_i^att + f_i^rep
 

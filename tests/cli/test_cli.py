@@ -340,7 +340,7 @@ def test_an_unknown_name_is_one_line_with_did_you_mean(args, line, tmp_path):
 def test_make_demo_ends_with_what_to_try_next_and_each_suggestion_works(tmp_path):
     if shutil.which("make") is None:
         pytest.skip("make is not installed here")
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     venv = Path(sys.executable).parent.parent
     # The installed venv as it is (-o: never reinstall it), worlds into tmp.
     r = subprocess.run(["make", "-s", "-C", str(root), "-o", str(venv / ".installed"), "demo", f"VENV={venv}",

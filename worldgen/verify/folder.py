@@ -25,7 +25,7 @@ ones would only repeat it in other words):
                  ``trajectory`` (straight between rows, standing after the last),
                  never closer than ``robot.radius + robot.clearance + radius``
                  plus what the two could close between samples
-                 (:mod:`worldgen.verify_timed`);
+                 (:mod:`worldgen.verify.timed`);
 ``reproduce``    when this worldgen version wrote the world: a fresh export gives
                  world.json and every listed file byte for byte (another version
                  may format files differently, so there this check is skipped and
@@ -164,7 +164,7 @@ def _regenerate(meta: dict):
     except WorldgenError as exc:
         raise _Fail("regenerate", f"{meta['generator']} seed {meta['seed']} with the recorded params: {exc}") from None
     if meta.get("edits"):  # a curriculum's edited level: the generated world, then its edits, each re-proved
-        from worldgen.editing import replay_edits
+        from worldgen.verify.edits import replay_edits
 
         try:
             world = replay_edits(world, meta["edits"])
@@ -226,7 +226,7 @@ def _feasibility(meta: dict, world) -> None:
 
 
 def _timed(meta: dict, world) -> None:
-    from worldgen.verify_timed import TimedPathError, check_timed
+    from worldgen.verify.timed import TimedPathError, check_timed
 
     try:
         check_timed(meta, world)

@@ -1,20 +1,14 @@
-"""The ``worldgen`` command: a thin click layer over the Python API.
+"""The commands about single worlds: ``list``, ``generate``, ``preview``, ``check`` and ``presets``.
 
-It parses, calls :func:`worldgen.generate` and :meth:`World.write`, and turns
-every :class:`~worldgen.errors.WorldgenError` (and every click usage error)
-into one line on stderr, ``error: ...``, with exit status 2 for a usage mistake
-and 3 when no such world exists (docs/cli.md): a user's mistake never shows a
-traceback. Anything else that escapes is a bug and keeps its
-traceback on purpose.
+Each parses its arguments and calls the Python API; errors travel up to :func:`worldgen.cli.main.main`,
+which turns them into one line and an exit status (docs/cli.md).
 """
 
 from __future__ import annotations
 
-import errno
 import json
 import os
 import shutil
-import sys
 import textwrap
 from pathlib import Path
 from typing import Any, Optional, Sequence
@@ -22,16 +16,16 @@ from typing import Any, Optional, Sequence
 import click
 
 import worldgen
-from worldgen.errors import EXIT_USAGE, InfeasibleError, OutputError, ParameterError, WorldgenError, did_you_mean
+from worldgen.cli.context import CONTEXT as _CONTEXT
+from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError, did_you_mean
 from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
-from worldgen.export.ros2 import DEFAULT_GZ_RELEASE, GZ_RELEASES
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
+from worldgen.ros.bundle import DEFAULT_GZ_RELEASE, GZ_RELEASES
 from worldgen.seeding import MAX_SEED
 
-__all__ = ["main", "cli", "parse_settings", "describe_param"]
-
-_CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
+__all__ = ["list_command", "generate_command", "preview_command", "check_command", "presets_command",
+           "parse_settings", "describe_param", "parameter_tables"]
 
 
 def _examples() -> str:
@@ -42,18 +36,7 @@ def _examples() -> str:
     return "\b\nExamples:\n" + "\n".join(f"  {ex}" for ex in lines) if lines else ""
 
 
-@click.group(context_settings=_CONTEXT,
-             epilog="Run 'worldgen list' for the generators, 'worldgen list GENERATOR' for its parameters.")
-@click.version_option(worldgen.__version__, "--version", prog_name="worldgen", message="%(prog)s %(version)s")
-def cli() -> None:
-    """Seeded, feasibility-checked test worlds for robot simulation.
-
-    Each world is written as SDF, MJCF and URDF plus world.json, the ground
-    truth (spawn, goal, shortest path, clearances) a test asserts against.
-    """
-
-
-@cli.command("list", context_settings=_CONTEXT)
+@click.command("list", context_settings=_CONTEXT)
 @click.argument("name", required=False, metavar="[GENERATOR]")
 @click.argument("param_names", nargs=-1, metavar="[PARAMETER]...")
 @click.option("--json", "as_json", is_flag=True, help="Print every generator (or GENERATOR) in full as JSON (stable key order).")
@@ -153,7 +136,7 @@ def parameter_tables(specs) -> str:
     return "\n".join(lines)
 
 
-@cli.command("generate", context_settings=_CONTEXT, epilog=_examples())
+@click.command("generate", context_settings=_CONTEXT, epilog=_examples())
 @click.argument("generator", required=False)
 @click.option("--preset", "preset_name", metavar="NAME",
               help="Start from preset NAME (see 'worldgen presets') or a preset .yaml file instead of a "
@@ -227,7 +210,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}{verdict}")
 
 
-@cli.command("preview", context_settings=_CONTEXT)
+@click.command("preview", context_settings=_CONTEXT)
 @click.argument("world_dirs", nargs=-1, required=True, metavar="WORLD_DIR...",
                 type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.option("--width", type=int, default=800, show_default=True, help="Image width in px (400 to 4000).")
@@ -242,7 +225,7 @@ def preview_command(world_dirs: Sequence[Path], width: int) -> None:
         click.echo(str(write_preview(folder, width)))
 
 
-@cli.command("check", context_settings=_CONTEXT)
+@click.command("check", context_settings=_CONTEXT)
 @click.argument("world_dirs", nargs=-1, required=True, metavar="WORLD_DIR...",
                 type=click.Path(exists=True, file_okay=False, path_type=Path))
 def check_command(world_dirs: Sequence[Path]) -> None:
@@ -261,7 +244,7 @@ def check_command(world_dirs: Sequence[Path]) -> None:
         raise click.exceptions.Exit(1)
 
 
-@cli.command("presets", context_settings=_CONTEXT)
+@click.command("presets", context_settings=_CONTEXT)
 @click.option("--json", "as_json", is_flag=True, help="Print every preset in full as JSON (stable key order).")
 def presets_command(as_json: bool) -> None:
     """List the shipped presets: name and description (use with 'generate --preset NAME')."""
@@ -276,21 +259,6 @@ def presets_command(as_json: bool) -> None:
     width = max((len(p.name) for p in found), default=0)
     for p in found:
         click.echo(f"{p.name.ljust(width)}  {p.description}")
-
-
-# `worldgen pack ...` lives in worldgen/pack/commands.py; only wired in here.
-from worldgen.pack.commands import pack_group  # noqa: E402
-
-cli.add_command(pack_group)
-
-# `worldgen compare A B` lives in worldgen/testing/compare_command.py; only wired in here.
-from worldgen.testing.compare_command import compare_command  # noqa: E402
-
-cli.add_command(compare_command)
-# `worldgen judge` lives in worldgen/testing/commands.py; only wired in here.
-from worldgen.testing.commands import judge_command  # noqa: E402
-
-cli.add_command(judge_command)
 
 
 def parse_settings(params: Sequence[Param], settings: Sequence[str], generator: str) -> dict[str, Any]:
@@ -366,35 +334,3 @@ def _check_out(out: Path) -> None:
     if not os.access(base, os.W_OK | os.X_OK):
         raise OutputError(f"--out '{out}' is not writable (no write permission on '{base}')")
 
-
-def _one_line(text: str) -> str:
-    return " ".join(str(text).split())
-
-
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Run the command line; return the exit status (0 ok, 1 a check failed, 2 a usage mistake, 3 no such world)."""
-    try:
-        rv = cli.main(args=list(argv) if argv is not None else None, prog_name="worldgen", standalone_mode=False)
-        return rv if isinstance(rv, int) else 0
-    except click.exceptions.NoArgsIsHelpError as exc:  # bare `worldgen`: help is the answer
-        click.echo(exc.ctx.get_help() if exc.ctx else str(exc))
-        return 0
-    except click.ClickException as exc:
-        ctx = getattr(exc, "ctx", None)  # usage errors carry the command they are about; other errors do not
-        hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
-        click.echo(f"error: {_one_line(exc.format_message())}{hint}", err=True)
-        return EXIT_USAGE
-    except WorldgenError as exc:
-        click.echo(f"error: {_one_line(str(exc))}", err=True)
-        return exc.exit_status
-    except click.Abort:
-        click.echo("error: aborted", err=True)
-        return 130
-    except OSError as exc:
-        if exc.errno == errno.EPIPE:  # `worldgen list | head`: the reader left, nothing is wrong
-            return 0
-        raise
-
-
-if __name__ == "__main__":
-    sys.exit(main())

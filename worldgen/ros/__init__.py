@@ -1,7 +1,8 @@
 """ROS 2 runs in and out, without a ROS install (optional extra ``ros``: ``pip install 'worldgen[ros]'``).
 
     >>> import numpy as np, worldgen
-    >>> from worldgen.ros import judge, read_run, write_report, write_run
+    >>> from worldgen.judge import judge, write_report
+    >>> from worldgen.ros import read_run, write_run
     >>> world = worldgen.generate("cluttered", seed=7, size=[8, 8], n_obstacles=6)
     >>> folder = world.write("worlds", preview=False)
     >>> path = np.array(world.metadata["tasks"][0]["path"]["waypoints"])      # the reference path
@@ -18,18 +19,16 @@
     >>> write_report(result, "report").name
     'report'
 
-The public face of :mod:`worldgen.testing.bags` (the reader) and
-:mod:`worldgen.testing.bagwrite` (the writer); both import rosbags only when called,
-and say in one line what to install when it is missing. ``worldgen judge`` turns
-many bags into a report (docs/judge.md).
+The room of ROS 2: bags in (:mod:`worldgen.ros.reader`, with :mod:`~worldgen.ros.bagio` and the fast
+field decoder :mod:`~worldgen.ros.cdr`), bags out (:mod:`worldgen.ros.writer`), the optional rosbags
+(:mod:`~worldgen.ros.deps`) and the bundle a world carries for a ROS 2 run (:mod:`~worldgen.ros.bundle`).
+Reader and writer import rosbags only when called, and say in one line what to install when it is
+missing. Judging runs against worlds is :mod:`worldgen.judge`'s (docs/judge.md).
 """
 
 from __future__ import annotations
 
-from worldgen.testing.bags import START_RULES, BagRun, read_run
-from worldgen.testing.bagwrite import DISTROS, STORAGES, write_run
-from worldgen.testing.judge import JudgeResult, judge
-from worldgen.testing.report import write_report
+from worldgen.ros.reader import START_RULES, BagRun, read_run
+from worldgen.ros.writer import DISTROS, STORAGES, write_run
 
-__all__ = ["read_run", "write_run", "BagRun", "START_RULES", "STORAGES", "DISTROS", "judge", "JudgeResult",
-           "write_report"]
+__all__ = ["read_run", "write_run", "BagRun", "START_RULES", "STORAGES", "DISTROS"]

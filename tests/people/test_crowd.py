@@ -14,10 +14,10 @@ import pytest
 import shapely
 
 import worldgen
-from worldgen.feasibility.crowd import DT, SocialForce, _keep_off, _Walls, simulate
 from worldgen.feasibility.geometry import Obstacles2D
-from worldgen.feasibility.groups import GroupForce, group_force
-from worldgen.generators.people import PERSON_HEIGHT, people_footprints
+from worldgen.people.crowd import DT, SocialForce, _keep_off, _Walls, simulate
+from worldgen.people.groups import GroupForce, group_force
+from worldgen.people.places import PERSON_HEIGHT, people_footprints
 from worldgen.scene.footprint import Footprint
 
 REPO = Path(__file__).resolve().parents[2]

@@ -1,4 +1,4 @@
-"""The ROS 2 bundle (worldgen.export.ros2): what can be checked without ROS 2 or Gazebo installed.
+"""The ROS 2 bundle (worldgen.ros.bundle): what can be checked without ROS 2 or Gazebo installed.
 
 ROS 2 and Gazebo cannot be installed on the machines these tests run on (Debian 12), so the bundle's
 files are checked for structure and against lists pinned from the ROS packages' documentation and
@@ -27,7 +27,7 @@ from support.reftools_sdf import check_sdf
 
 import worldgen
 from worldgen.errors import ParameterError
-from worldgen.export import ros2
+from worldgen.ros import bundle as ros2
 
 #: ros_gz_bridge's YAML keys (ros_gz_bridge/src/bridge_config.cpp, README "Example 5: Configuring the Bridge
 #: via YAML"); the bundle writes the five that name a topic pair and its direction.
@@ -413,7 +413,7 @@ def test_bad_releases_and_options_are_one_line_errors(world):
 # -- wiring, determinism --------------------------------------------------------
 
 _DIGEST = ("import hashlib, worldgen\n"
-           "from worldgen.export.ros2 import bundle\n"
+           "from worldgen.ros.bundle import bundle\n"
            "w = worldgen.generate('cluttered', seed=7, size=[6, 6], n_obstacles=6, n_tasks=2)\n"
            "print(hashlib.sha256(repr(sorted(bundle(w).items())).encode()).hexdigest())\n")
 

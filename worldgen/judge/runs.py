@@ -4,7 +4,7 @@ Usage (an example that runs is in :mod:`worldgen.ros`)::
 
     result = judge(["runs/r0", "runs/r1"], "criteria.yaml", world="worlds/cluttered-s0-1f3a9c0b")
     result.passed, result.report["summary"]["unreadable"]
-    write_report(result, "report/")          # worldgen.testing.report
+    write_report(result, "report/")          # worldgen.judge.report
 
 Which world a bag ran in, in order of precedence:
 
@@ -36,6 +36,7 @@ from typing import Any, Callable, Iterator, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError, read_user_text
+from worldgen.files import MANIFEST_NAME, METADATA_NAME
 from worldgen.testing.figures import Ground
 
 __all__ = ["Item", "JudgeResult", "judge", "plan", "PLOT_POINTS", "DEFAULT_CRITERIA"]
@@ -104,7 +105,7 @@ def plan(bags: Sequence, *, world=None, pack=None, runs=None) -> list[Item]:
     folder = None
     if world is not None:
         folder = Path(world)
-        if not (folder / "world.json").is_file():
+        if not (folder / METADATA_NAME).is_file():
             raise ParameterError(f"--world '{folder}' is not a world folder (no world.json)")
     elif pack is None:
         raise ParameterError("say where the worlds are: --world DIR, --pack DIR (worlds named in the bags' metadata) "
@@ -119,7 +120,7 @@ def _index(pack) -> dict[str, Path]:
     root = Path(pack)
     if not root.is_dir() and not root.is_file():
         raise ParameterError(f"--pack '{root}' does not exist")
-    if (root / "manifest.json").is_file() or root.is_file():
+    if (root / MANIFEST_NAME).is_file() or root.is_file():
         from worldgen.pack import Pack
 
         opened = Pack.open(root)
@@ -163,7 +164,7 @@ def _table(table: Path, pack) -> list[Item]:
         if not bag or not world:
             raise ParameterError(f"runs table '{table}' line {i}: bag and world must not be empty")
         candidate = table.parent / world
-        if (candidate / "world.json").is_file():
+        if (candidate / METADATA_NAME).is_file():
             folder = candidate
         elif pack is not None:
             folder = _pack_world(pack, world, packs)
@@ -187,17 +188,18 @@ def _decimate(traj: np.ndarray, n: int = PLOT_POINTS) -> np.ndarray:
     return traj[np.minimum(keep, len(traj) - 1), :3].copy()
 
 
+# long: reading each bag, judging it and assembling the rows share the per-world cache
 def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, runs=None,
           start: str = "command", read_options: Optional[dict] = None,
           progress: Optional[Callable[[int], None]] = None) -> JudgeResult:
     """Read every bag, judge the readable runs with :func:`worldgen.testing.evaluate.evaluate`, and return the report.
 
-    ``read_options`` go to :func:`worldgen.testing.bags.read_run` (topic and frame names,
+    ``read_options`` go to :func:`worldgen.ros.reader.read_run` (topic and frame names,
     ``spawn_tolerance``, ``distro``...). ``progress(k)`` is called after each bag. Without
     ``criteria`` the gate is :data:`DEFAULT_CRITERIA`: every run meets its scenario, so a batch of
     crashed runs never passes for want of a criteria file.
     """
-    from worldgen.testing.bags import read_run
+    from worldgen.ros.reader import read_run
     from worldgen.testing.evaluate import evaluate, load_criteria
 
     if criteria is None:
@@ -235,7 +237,7 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
                 folder, task = item.world, item.task
                 named = {}
                 if folder is None or task is None:
-                    from worldgen.testing.bags import peek_metadata
+                    from worldgen.ros.reader import peek_metadata
                     named = peek_metadata(item.bag)
                 if folder is None:
                     if not named.get("worldgen.world_id"):

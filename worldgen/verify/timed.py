@@ -1,7 +1,7 @@
 """``worldgen check``'s ``timed`` check: a world's certificate among people, re-proved from world.json.
 
 The timed path (``tasks[].timed_path``, docs/people.md) is checked on its own terms, without the code
-that found it (:mod:`worldgen.feasibility.timed`): rows from the spawn at t = 0 to the goal at
+that found it (:mod:`worldgen.people.timed`): rows from the spawn at t = 0 to the goal at
 ``arrival_time``, times increasing, no faster than ``robot.max_speed``; every row on the recorded path
 (``tasks[].path.waypoints``) and each two consecutive rows on one leg of it, so the robot between them
 stays on the path and never cuts a corner; the rows' polyline clear of the static geometry by FCL (the

@@ -38,7 +38,7 @@ from typing import Callable, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import ParameterError
-from worldgen.testing.rosdeps import require_rosbags
+from worldgen.ros.deps import require_rosbags
 
 __all__ = ["write_run", "STORAGES", "DISTROS", "WALL_EPOCH_NS", "DEFAULT_TOPICS"]
 
@@ -111,6 +111,7 @@ def _check(trajectory, topics, storage, distro) -> np.ndarray:
     return traj
 
 
+# long: every topic's messages written in one pass over the trajectory, inside one writer context
 def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, commands=None,
               topics: Sequence[str] = DEFAULT_TOPICS, storage: str = "mcap", distro: str = "jazzy",
               drift: float = 0.0, scan: Optional[Callable[[float, float, float], np.ndarray]] = None,

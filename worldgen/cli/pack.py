@@ -12,9 +12,10 @@ from typing import Optional
 
 import click
 
+from worldgen.cli.context import CONTEXT as _CONTEXT
+
 __all__ = ["pack_group"]
 
-_CONTEXT = {"help_option_names": ["-h", "--help"], "max_content_width": 100}
 
 
 @click.group("pack", context_settings=_CONTEXT)

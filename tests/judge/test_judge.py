@@ -80,7 +80,7 @@ def test_a_collision_fails_the_gate_and_is_drawn(setup, tmp_path):
     assert setup["obstacle"] in {c["entity"] for c in crash["collisions"]}
     assert "FAILED navigation.success_rate: required >= 1, measured 0.5, failed by 0.5" in r.stdout
     # The picture marks the contact in the contact colour, the trajectory of a failed run in the failure colour.
-    from worldgen.testing.report import COLOURS
+    from worldgen.judge.report import COLOURS
     with Image.open(out / crash["picture"]) as img:
         colours = {c for _, c in img.convert("RGB").getcolors(1 << 20)}
     assert COLOURS["contact"] in colours and COLOURS["path"] in colours and COLOURS["spawn"] in colours
@@ -163,7 +163,7 @@ def test_help_has_an_example():
 
 
 def test_decimated_picture_keeps_the_ends():
-    from worldgen.testing.judge import _decimate
+    from worldgen.judge.runs import _decimate
     t = np.linspace(0, 100, 5001)
     traj = np.column_stack([t, np.cos(t / 10), np.sin(t / 10), t * 0])
     d = _decimate(traj, 100)
