@@ -37,7 +37,8 @@ BRIDGE_DIRECTIONS = {"BIDIRECTIONAL", "GZ_TO_ROS", "ROS_TO_GZ"}
 #: ROS type -> Gazebo type pairs the bridge converts (the table in ros_gz_bridge's README, the rows the bundle uses).
 BRIDGE_TYPES = {"rosgraph_msgs/msg/Clock": "Clock", "tf2_msgs/msg/TFMessage": "Pose_V",
                 "ros_gz_interfaces/msg/Contacts": "Contacts", "geometry_msgs/msg/Twist": "Twist",
-                "nav_msgs/msg/Odometry": "Odometry", "sensor_msgs/msg/LaserScan": "LaserScan"}
+                "nav_msgs/msg/Odometry": "Odometry", "sensor_msgs/msg/LaserScan": "LaserScan",
+                "sensor_msgs/msg/Imu": "IMU", "sensor_msgs/msg/JointState": "Model"}
 #: (package, executable) the launch file starts as Nodes: ros_gz_sim's `create` (ros_gz_sim/src/create.cpp),
 #: ros_gz_bridge's `parameter_bridge` (its README), robot_state_publisher.
 NODES = {("ros_gz_sim", "create"), ("ros_gz_bridge", "parameter_bridge"),
@@ -433,6 +434,7 @@ def test_generate_with_ros_end_to_end(tmp_path):
     names = sorted(str(p.relative_to(folder)) for p in (folder / "ros2").rglob("*") if p.is_file())
     launch_name = f"ros2/launch/{ros2.ros_name(folder.name)}.launch.py"
     assert names == sorted(["ros2/bridge.yaml", "ros2/tasks.yaml", "ros2/nav2/task_0.yaml", "ros2/world.sdf",
+                            "ros2/robot.sdf", "ros2/robot.urdf",
                             "ros2/send_goal.py", "ros2/run_loop.py", launch_name])
     assert "gz-sim-sensors-system" in (folder / "ros2" / "world.sdf").read_text()
     ast.parse((folder / launch_name).read_text())

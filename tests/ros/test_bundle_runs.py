@@ -214,11 +214,13 @@ def test_a_robot_from_a_topic_is_spawned_from_it(description, tmp_path):
     ({"seed": "1.5"}, "seed must be a whole number >= 0, got '1.5'"),
     ({"robot": "/no/robot.urdf"}, "robot must be a URDF or SDF file, got '/no/robot.urdf' (no such file)"),
     ({"robot_topic": "/robot_description"}, "give robot:=FILE (URDF or SDF) or robot_topic:=TOPIC"),
+    ({"robot_description": "/no/r.urdf"}, "robot_description must be a URDF or SDF file, got '/no/r.urdf'"),
+    ({"robot": "", "robot_topic": "/d", "robot_state_publisher": "true"}, "robot_state_publisher:=true needs a URDF"),
     ({"storage": "zip"}, "storage must be one of mcap, sqlite3, got 'zip'"),
     ({"wall_limit": "0"}, "wall_limit must be a number of seconds > 0, got '0'"),
     ({"wall_limit": "nan"}, "wall_limit must be a number of seconds > 0, got 'nan'"),
     ({"params_file": "/no/nav2.yaml"}, "params_file must be a nav2 parameters file, got '/no/nav2.yaml'"),
-    ({"robot_state_publisher": "yes"}, "robot_state_publisher must be true or false, got 'yes'"),
+    ({"robot_state_publisher": "yes"}, "robot_state_publisher must be true, false or auto, got 'yes'"),
 ])
 def test_a_bad_argument_stops_the_launch_before_anything_is_written(description, tmp_path, bad, message):
     _, described = description
@@ -378,7 +380,7 @@ def test_an_interrupted_run_is_run_again_on_resume(world, folder, tmp_path, fake
 @pytest.mark.parametrize("args, message", [
     (["--runs", "0", "--robot", "R"], "--runs must be >= 1"),
     (["--robot", "/no/robot.urdf"], "--robot must be a URDF or SDF file, got '/no/robot.urdf' (no such file)"),
-    (["--robot", "R", "--robot-topic", "/d"], "give --robot FILE or --robot-topic TOPIC, one of them"),
+    (["--robot", "R", "--robot-topic", "/d"], "give --robot FILE or --robot-topic TOPIC, not both"),
     (["--robot", "R", "--launch-arg", "storage=mcap"], "--launch-arg must be KEY:=VALUE, got 'storage=mcap'"),
 ])
 def test_the_loop_checks_its_arguments_before_writing(folder, tmp_path, args, message):
@@ -392,3 +394,17 @@ def test_the_loop_checks_its_arguments_before_writing(folder, tmp_path, args, me
                                 "--out", str(tmp_path / "bags"), str(tmp_path)], capture_output=True, text=True, timeout=60)
     assert no_bundle.returncode == 2 and "must hold one ros2/launch/*.launch.py" in no_bundle.stderr
     assert not (tmp_path / "bags").exists()
+
+
+def test_the_bundles_own_robot_is_spawned_unless_the_run_names_another(folder, description, tmp_path):
+    _, described = description
+    context, started = launch_run(described, _configs(tmp_path, robot=""))
+    create = next(cmd for e, cmd in started if e.kwargs.get("executable") == "create")
+    assert create[create.index("-file") + 1] == str(folder / "ros2" / "robot.sdf")
+    state = next(e for e, _ in started if e.kwargs.get("executable") == "robot_state_publisher")
+    urdf = perform(state.kwargs["parameters"][0]["robot_description"].value, context)
+    assert urdf == (folder / "ros2" / "robot.urdf").read_text()
+    (tmp_path / "mine.sdf").write_text("<sdf version='1.9'/>")
+    _, started = launch_run(described, _configs(tmp_path, robot=str(tmp_path / "mine.sdf")))
+    kinds = [e.kwargs.get("executable") for e, _ in started]
+    assert "robot_state_publisher" not in kinds  # auto: a robot of the user's own, no URDF named
