@@ -8,7 +8,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
-from worldgen.errors import OutputError
+from worldgen.errors import OutputError, ParameterError
 from worldgen.export import formats as formats_table
 from worldgen.export.formats import FILE_NAMES, FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.files import METADATA_NAME, PREVIEW_NAME, refuse_other_world, write_folder_atomically
@@ -16,6 +16,9 @@ from worldgen.scene import Robot, Scene, Task
 
 __all__ = ["World", "FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats"]
 
+
+#: set_provenance's "leave it as it is".
+_UNCHANGED: Any = object()
 
 class World:
     """One world. Nothing here touches the disk until :meth:`write`.
@@ -40,10 +43,35 @@ class World:
         self.attempts = attempts
         self.allow_infeasible = bool(allow_infeasible)
         self.path: Optional[Path] = None  # the folder once written
-        self.preset: Optional[str] = None
-        #: How a world asked for at a difficulty level was reached (worldgen.leveling); None otherwise.
-        self.difficulty_request: Optional[dict] = None
+        self._preset: Optional[str] = None
+        self._difficulty_request: Optional[dict] = None
         self._texts: dict[tuple, str] = {}  # export()'s renderings, by (format, SDF version)
+
+    @property
+    def preset(self) -> Optional[str]:
+        """The preset this world came from (world.json ``preset``, the folder name), or None."""
+        return self._preset
+
+    @property
+    def difficulty_request(self) -> Optional[dict]:
+        """How a world asked for at a difficulty level was reached (worldgen.leveling), or None."""
+        return self._difficulty_request
+
+    def set_provenance(self, *, preset: Any = _UNCHANGED, difficulty_request: Any = _UNCHANGED) -> "World":
+        """Record where this world came from: the one place its preset and its level request are set.
+
+        Neither is part of the world's identity (``content_hash``); both are written to world.json. Returns
+        the world, so a caller can chain it after ``generate``.
+        """
+        if preset is not _UNCHANGED:
+            if preset is not None and not isinstance(preset, str):
+                raise ParameterError(f"a world's preset must be a preset's name or None, got {preset!r}")
+            self._preset = preset
+        if difficulty_request is not _UNCHANGED:
+            if difficulty_request is not None and not isinstance(difficulty_request, dict):
+                raise ParameterError(f"a world's difficulty_request must be a dict or None, got {difficulty_request!r}")
+            self._difficulty_request = difficulty_request
+        return self
 
     def __repr__(self) -> str:
         try:

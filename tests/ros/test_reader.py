@@ -198,9 +198,9 @@ def test_mcap_bags_decode_with_the_official_mcap_reader(world, tmp_path):
 def test_reading_needs_rosbags_and_says_what_to_install(monkeypatch, tmp_path):
     import sys
 
-    from worldgen.ros.deps import MissingRosbagsError
+    from worldgen.errors import MissingDependencyError
     monkeypatch.setitem(sys.modules, "rosbags", None)
-    with pytest.raises(MissingRosbagsError, match=r"pip install 'worldgen\[ros\]'$"):
+    with pytest.raises(MissingDependencyError, match=r"pip install 'worldgen\[ros\]'$"):
         read_run(tmp_path / "x")
 
 

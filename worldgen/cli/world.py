@@ -201,7 +201,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     _check_out(out)
     for s in range(seed, seed + count):
         world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, difficulty=level, **params)
-        world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
+        world.set_provenance(preset=preset.name if preset is not None else None)  # names the folder <preset>--<world_id>
         folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
                              ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)

@@ -17,7 +17,7 @@ test hook that drives into whatever stands between them.
 The run is written with :func:`worldgen.ros.write_run` (mcap, Jazzy definitions): ``/clock``, ``/odom``
 and ``/tf`` (the pose since the spawn, no drift), ``/cmd_vel`` (the controller's commands) and
 ``/ground_truth`` (the simulator's pose in the map frame, what ``read_run`` reads first), then judged
-with :func:`worldgen.ros.judge` against the world's scenario (default criteria: the run meets it).
+with :func:`worldgen.judge.judge` against the world's scenario (default criteria: the run meets it).
 """
 
 from __future__ import annotations
@@ -165,7 +165,8 @@ def _backend(sim: str, folder: Path, meta: dict):
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,
           speed: float = SPEED) -> Outcome:
     """Drive ``world`` (a world folder) in ``sim``, write the bag into the new folder ``out``/<bag name>, judge it."""
-    from worldgen.ros import judge, write_run
+    from worldgen.judge import judge
+    from worldgen.ros import write_run
 
     if sim not in SIMS:
         raise ParameterError(f"option '--sim' must be one of {', '.join(SIMS)}, got {sim!r}")

@@ -23,7 +23,7 @@ import warnings
 from numbers import Integral
 from typing import Any, Optional, Sequence, Union
 
-from worldgen.errors import MissingDependencyError, ParameterError
+from worldgen.errors import ParameterError, require_optional
 from worldgen.floats import finite_or_none  # None where scipy gives NaN or an infinity: JSON has neither
 
 __all__ = [
@@ -51,12 +51,8 @@ MIN_SAMPLE = 2
 
 
 def require_scipy():
-    """The ``scipy.stats`` module, or :class:`MissingDependencyError` with one line saying what to install."""
-    try:
-        import scipy.stats
-    except ImportError:
-        raise MissingDependencyError(f"worldgen's statistics need scipy, which is not installed: {INSTALL_HINT}") from None
-    return scipy.stats
+    """The ``scipy.stats`` module, or :class:`MissingDependencyError` naming the ``stats`` extra."""
+    return require_optional("scipy.stats", "stats", "worldgen's statistics need scipy")
 
 
 def _check_counts(k: int, n: int) -> None:

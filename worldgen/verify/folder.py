@@ -170,14 +170,14 @@ def _regenerate(meta: dict):
             world = replay_edits(world, meta["edits"])
         except WorldgenError as exc:
             raise _Fail("regenerate", f"edits: {exc}") from None
-    world.preset = meta.get("preset")  # not a parameter: where the world came from (world.json and folder name)
+    world.set_provenance(preset=meta.get("preset"))  # not a parameter: where the world came from (world.json and folder name)
     request = meta.get("difficulty_request")  # not a parameter either: how a world at a level was drawn
     if request:
         last = request["draws"][-1] if request.get("draws") else {}
         if (last.get("seed"), last.get(request.get("knob"))) != (meta["seed"], meta["params"].get(request.get("knob"))):
             raise _Fail("regenerate", "difficulty_request's last draw is not this world's seed and "
                                       f"{request.get('knob')}")
-        world.difficulty_request = request
+        world.set_provenance(difficulty_request=request)
     if world.content_hash != meta["content_hash"]:
         raise _Fail("regenerate", f"content_hash {_h(world.content_hash)} regenerated, "
                                   f"{_h(meta['content_hash'])} recorded{_versions(meta)}")
