@@ -5,8 +5,10 @@ signals that one process: SIGINT, SIGTERM after ``sigterm_timeout`` (5 s by defa
 ``sigkill_timeout`` more (5 s) (launch/actions/execute_local.py, Humble to Jazzy). Here the exact command
 the Fortress bundle's launch file builds runs with the shipped robot spawned (its gpu_lidar renders),
 is stopped that way, and nothing it started may outlive it: its process group (the test starts it in
-its own session to be able to look) and every descendant seen while it ran must be gone. The same
-server started as ros_gz_sim's gz_sim.launch.py starts it, through a shell, leaves Gazebo running.
+its own session to be able to look) and every descendant seen while it ran must be gone. With the
+lidar rendering, Gazebo sometimes ignores SIGINT and SIGTERM (4 of 12 stops measured here, the others
+ended on SIGINT): then launch's SIGKILL ends it, which reaches it because no shell stands between. The
+same server started as ros_gz_sim's gz_sim.launch.py starts it, through a shell, leaves Gazebo running.
 """
 
 from __future__ import annotations
@@ -135,8 +137,8 @@ def test_the_bundles_gazebo_server_stops_with_launch_and_leaves_nothing(run_setu
         seen = _descendants(proc.pid) | {proc.pid}
         ended_on = _stop_as_launch_does(proc)
         time.sleep(0.5)
-        assert ended_on == "SIGINT", log.read_text()[-2000:]  # measured: gone 0.1 s after SIGINT
-        assert group_members(proc.pid) == [] and not [p for p in seen if _alive(p)]
+        assert ended_on in ("SIGINT", "SIGTERM", "SIGKILL")  # SIGINT mostly; the escalation when it hangs
+        assert group_members(proc.pid) == [] and not [p for p in seen if _alive(p)], log.read_text()[-2000:]
     finally:
         if group_members(proc.pid):
             os.killpg(proc.pid, signal.SIGKILL)
