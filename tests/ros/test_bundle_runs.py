@@ -408,3 +408,35 @@ def test_the_bundles_own_robot_is_spawned_unless_the_run_names_another(folder, d
     _, started = launch_run(described, _configs(tmp_path, robot=str(tmp_path / "mine.sdf")))
     kinds = [e.kwargs.get("executable") for e, _ in started]
     assert "robot_state_publisher" not in kinds  # auto: a robot of the user's own, no URDF named
+
+
+#: A `ros2 launch` stand-in that, on SIGINT, takes a while to stop what it started (launch's escalation
+#: takes up to 10 s) and notes that it finished its shutdown.
+SLOW_ROS2 = r'''#!{python}
+import os, signal, sys, time
+def stop(signum, frame):
+    time.sleep(1.0)  # stopping Gazebo, nav2, the recorder
+    open(os.environ['FAKE_SCENARIO'] + '.stopped', 'w').write('clean')
+    sys.exit(0)
+signal.signal(signal.SIGINT, stop)
+open(os.environ['FAKE_SCENARIO'] + '.started', 'w').write('')
+time.sleep(60)
+'''
+
+
+def test_an_interrupted_loop_lets_launch_stop_what_it_started(folder, tmp_path, fake_ros2):
+    import signal
+    import time
+
+    scenario, env = fake_ros2
+    (tmp_path / "bin" / "ros2").write_text(SLOW_ROS2.format(python=sys.executable))
+    (tmp_path / "robot.urdf").write_text("<robot name='r'/>")
+    loop = subprocess.Popen([sys.executable, str(folder / "ros2" / "run_loop.py"), "--out", str(tmp_path / "bags"),
+                             str(folder)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 30
+    while not Path(str(scenario) + ".started").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    loop.send_signal(signal.SIGINT)  # only the loop, as `kill -INT`; a terminal's Ctrl-C reaches both
+    _, err = loop.communicate(timeout=30)
+    assert loop.returncode == 130 and "run the same command again to resume" in err
+    assert Path(str(scenario) + ".stopped").read_text() == "clean"  # launch finished its own shutdown
