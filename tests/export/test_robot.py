@@ -136,3 +136,22 @@ def test_bytes_are_the_same_in_a_fresh_process(world):
 def test_bad_arguments_name_what_is_allowed(world, kw):
     with pytest.raises(ParameterError, match=next(iter(kw))):
         robot_export.robot_sdf(world, **kw)
+
+
+def test_the_urdf_is_the_sdf_tree(world):
+    """Every link of the URDF sits where the SDF puts it, relative to base_link (same tree, same numbers)."""
+    sdf = parse_bytes(robot_export.robot_sdf(world).encode()).getroot()
+    urdf = parse_bytes(robot_export.robot_urdf(world).encode()).getroot()
+    base = _floats(sdf.findtext(".//link[@name='base_link']/pose"))
+    assert float(urdf.find("joint[@name='base_footprint_joint']/origin").get("xyz").split()[2]) == base[2]
+    for joint in urdf.iter("joint"):
+        child, parent = joint.find("child").get("link"), joint.find("parent").get("link")
+        if parent != "base_link":
+            continue
+        xyz = _floats(joint.find("origin").get("xyz"))
+        rpy = _floats(joint.find("origin").get("rpy"))
+        pose = _floats(sdf.findtext(f".//link[@name='{child}']/pose"))
+        assert [p - b for p, b in zip(pose[:3], base[:3])] == pytest.approx(xyz, abs=1e-6), child
+        assert pose[3:] == pytest.approx(rpy, abs=1e-6), child
+        sdf_joint = sdf.find(f".//joint[@name='{joint.get('name')}']")
+        assert sdf_joint.get("type") == {"continuous": "revolute", "fixed": "fixed"}[joint.get("type")]

@@ -114,3 +114,48 @@ def test_a_folder_without_world_json_and_an_existing_run_are_refused(worlds, tmp
     assert run_cli("drive", worlds["minimal"], "--out", tmp_path / "o").returncode == 0
     again = run_cli("drive", worlds["minimal"], "--out", tmp_path / "o")
     assert again.returncode == 2 and "exists already" in again.stderr
+    (tmp_path / "file").write_text("x")
+    onto_a_file = run_cli("drive", worlds["minimal"], "--out", tmp_path / "file")
+    assert onto_a_file.returncode == 2 and "is not a folder" in onto_a_file.stderr
+
+
+def test_gazebo_missing_is_one_line_naming_how_to_install(worlds, tmp_path, monkeypatch):
+    monkeypatch.setenv("WORLDGEN_GAZEBO_SETUP", str(tmp_path / "no-such-setup.sh"))
+    result = run_cli("drive", worlds["minimal"], "--sim", "gazebo", "--out", tmp_path / "o")
+    assert result.returncode == 2 and "Traceback" not in result.stderr, result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1 and "install Gazebo" in result.stderr
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_unwritable_cache_is_one_line(tmp_path, monkeypatch):
+    from worldgen.errors import OutputError
+    from worldgen.sim import bridge
+
+    if bridge.shutil.which("g++") is None or bridge.shutil.which("pkg-config") is None:
+        pytest.skip("no compiler here: the build stops before the cache")
+    blocker = tmp_path / "cache"
+    blocker.write_text("a file where the cache folder would go")
+    monkeypatch.setenv("XDG_CACHE_HOME", str(blocker))
+    try:
+        with pytest.raises(OutputError, match="XDG_CACHE_HOME"):
+            bridge.build_bridge()
+    except bridge.GazeboMissingError:
+        pytest.skip("no ign-transport headers here")
+
+
+def test_movers_follow_their_scripts_in_mujoco(tmp_path):
+    from worldgen.envs.movers import MoverScript
+    from worldgen.sim.mujoco import MujocoBackend
+
+    folder = worldgen.generate("cluttered", seed=2, n_movers=3).write(tmp_path, preview=False)
+    meta = json.loads((folder / "world.json").read_text())
+    backend = MujocoBackend(folder / meta["files"]["mjcf"]["path"], meta)
+    spawn = meta["tasks"][0]["spawn"]
+    backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
+    t, *_ = backend.step(0.0, 0.0, 500)
+    script = MoverScript(meta["dynamic_obstacles"])
+    # The last placement was for the last step's start, one step before t.
+    expected = script.positions(np.array([t - backend.dt]))[0]
+    placed = backend._sim.data.mocap_pos[backend._sim.mocap, :2]
+    assert placed == pytest.approx(expected, abs=1e-9)
+    assert not np.allclose(expected, script.positions(np.zeros(1))[0])  # they did move

@@ -79,3 +79,14 @@ def test_only_known_harmless_lines_are_dropped_from_the_problems():
            "\x1b[1;31m[Err] [Physics.cc:761] \x1b[0mFailed to find plugin\n[Msg] Loaded level [3]\n"
            "[Wrn] [SdfEntityCreator.cc:1] something\n")
     assert problems_in(log) == ["[Err] [Physics.cc:761] Failed to find plugin", "[Wrn] [SdfEntityCreator.cc:1] something"]
+
+
+def test_the_dynamic_poses_of_a_world_with_actors_are_refused_before_they_crash_gazebo(tmp_path):
+    import worldgen
+    from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboServer
+
+    folder = worldgen.generate("cluttered", seed=3, n_movers=1).write(tmp_path, preview=False)
+    server = GazeboServer(folder / "world.sdf", install=GazeboInstall(tmp_path / "setup.sh", {}, "6.18.0"))
+    assert server.actors == 1
+    with pytest.raises(GazeboError, match="dynamic_pose/info would crash Gazebo"):
+        server.poses(dynamic=True)

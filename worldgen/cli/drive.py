@@ -23,7 +23,7 @@ Examples:
 """)
 @click.argument("world", type=click.Path(path_type=Path), metavar="WORLD")
 @click.option("--sim", type=click.Choice(["gazebo", "mujoco"]), default="mujoco", show_default=True,
-              help="The simulator: Gazebo Fortress headless (docs/gazebo.md), or MuJoCo.")
+              help="The simulator: Gazebo Fortress headless, or MuJoCo (docs/drive.md).")
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Where the run's bag folder is written (DIR/<world id>-<task>-<sim>).")
 @click.option("--task", metavar="ID", help="The task to drive [default: the world's first].")
@@ -54,7 +54,8 @@ def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: 
         first = collisions[0]
         what = f"collision with {first['entity']} at t = {first['time']:.2f} s (first of {len(collisions)})"
     else:
-        what = run.get("reason") or f"ended at {outcome.ended}"
+        stopped = {"stuck": "stuck", "time_limit": "time limit", "goal": "at the goal"}[outcome.ended]
+        what = f"{run.get('reason') or 'judged a failure'} (the drive stopped: {stopped})"
     click.echo(f"{sim}: {'PASS' if outcome.passed else 'FAIL'}: {what} ({outcome.sim_seconds:.2f} s simulated, "
                f"{outcome.wall['drive']:.2f} s wall)")
     click.echo(f"bag: {outcome.bag}")

@@ -22,7 +22,8 @@ from pathlib import Path
 
 from lxml import etree
 
-from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboMissingError, GazeboServer, locate
+from worldgen.errors import OutputError
+from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate
 
 __all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "GazeboBackend", "world_step"]
 
@@ -51,16 +52,20 @@ def build_bridge(env: dict[str, str] | None = None) -> Path:
     exe = cache_dir() / f"drive_bridge-{digest}"
     if exe.exists():
         return exe
-    exe.parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(dir=exe.parent) as tmp:
-        src = Path(tmp) / SOURCE_NAME
-        src.write_bytes(source)
-        out = Path(tmp) / "drive_bridge"
-        cmd = [compiler, "-O2", "-std=c++17", "-pthread", str(src), "-o", str(out), *flags.stdout.split()]
-        built = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
-        if built.returncode != 0:
-            raise GazeboError(f"building the Gazebo drive bridge failed: {built.stderr.strip()[:500]}")
-        os.replace(out, exe)  # a rename: a parallel run never starts half a binary
+    try:
+        exe.parent.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryDirectory(dir=exe.parent) as tmp:
+            src = Path(tmp) / SOURCE_NAME
+            src.write_bytes(source)
+            out = Path(tmp) / "drive_bridge"
+            cmd = [compiler, "-O2", "-std=c++17", "-pthread", str(src), "-o", str(out), *flags.stdout.split()]
+            built = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
+            if built.returncode != 0:
+                raise GazeboError(f"building the Gazebo drive bridge failed: {built.stderr.strip()[:500]}")
+            os.replace(out, exe)  # a rename: a parallel run never starts half a binary
+    except OSError as exc:
+        raise OutputError(f"cannot build the Gazebo drive bridge in '{exe.parent}' ({exc.strerror or exc}); "
+                          "set XDG_CACHE_HOME to a writable folder") from None
     return exe
 
 
@@ -86,19 +91,22 @@ class GazeboBackend:
         self._robot_sdf, self._robot_name = robot_sdf, robot_name
         self._server: GazeboServer | None = None
         self._bridge: subprocess.Popen | None = None
+        self._model = None
 
     def start(self, spawn: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
         """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
         install = locate()
-        # A partition of its own: another Gazebo on the machine (a parallel test, a user's) never shares our topics.
-        env = {**install.env, "IGN_PARTITION": f"worldgen_drive_{os.getpid()}_{id(self)}"}
-        self._server = GazeboServer(self.world_sdf, install=GazeboInstall(install.setup, env, install.version)).start()
-        exe = build_bridge(self._server.install.env)
-        self._server.spawn(self._robot_sdf, name=self._robot_name, pose=spawn)
+        exe = build_bridge(install.env)
+        self._server = GazeboServer(self.world_sdf, install=install).start()
+        # The server's environment carries its own IGN_PARTITION: the bridge must share it.
+        env = self._server.env
+        self._model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
+        self._model.write(self._robot_sdf)
+        self._model.flush()
         self._bridge = subprocess.Popen(
-            [str(exe), self._server.world, "/cmd_vel", "/ground_truth/odom", str(round(self.dt * 1e9))],
-            env=self._server.install.env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-            text=True, bufsize=1)
+            [str(exe), self._server.world, "/cmd_vel", "/ground_truth/odom", str(round(self.dt * 1e9)), self._model.name,
+             self._robot_name, *(repr(float(v)) for v in spawn)],
+            env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
         first = self._read()
         if first != "ready":
             raise GazeboError(f"the drive bridge did not connect: {first}")
@@ -140,6 +148,9 @@ class GazeboBackend:
             if self._bridge.stdout is not None:
                 self._bridge.stdout.close()
             self._bridge = None
+        if self._model is not None:
+            self._model.close()
+            self._model = None
         if self._server is not None:
             self._server.stop()
             self._server = None

@@ -1,10 +1,12 @@
 """``worldgen drive``: a robot drives a task's reference path in a simulator, the run is recorded as a rosbag2
 bag and judged, the loop of a Gazebo + nav2 test closed without ROS.
 
-    >>> from worldgen.sim.drive import drive                               # doctest: +SKIP
-    >>> outcome = drive("worlds/cluttered-s0-55fec0f6", "runs", sim="mujoco")
-    >>> outcome.passed, outcome.verdict
-    (True, 'reached the goal ...')
+    >>> import worldgen
+    >>> from worldgen.sim.drive import drive
+    >>> folder = worldgen.generate("minimal", seed=2).write("worlds", preview=False)
+    >>> outcome = drive(folder, "runs", sim="mujoco")            # or sim="gazebo"
+    >>> outcome.passed, outcome.ended, outcome.run["collisions"], outcome.bag.name
+    (True, 'goal', [], 'minimal-s2-...-task_0-mujoco')
 
 The controller is pure pursuit with differential-drive (unicycle) kinematics, fed back from the
 simulator's own pose of the robot every control step: a forward speed along the heading and a turn
@@ -31,7 +33,7 @@ from typing import Optional
 
 import numpy as np
 
-from worldgen.errors import ParameterError
+from worldgen.errors import OutputError, ParameterError
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "Pursuit", "Outcome",
            "drive", "run_loop"]
@@ -166,7 +168,6 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
           speed: float = SPEED) -> Outcome:
     """Drive ``world`` (a world folder) in ``sim``, write the bag into the new folder ``out``/<bag name>, judge it."""
     from worldgen.judge import judge
-    from worldgen.ros import write_run
 
     if sim not in SIMS:
         raise ParameterError(f"option '--sim' must be one of {', '.join(SIMS)}, got {sim!r}")
@@ -178,6 +179,8 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     bag = Path(out) / f"{meta['world_id']}-{chosen['id']}-{sim}{'-straight' if straight else ''}"
     if bag.exists():
         raise ParameterError(f"option '--out': '{bag}' exists already; a run is written into a new folder")
+    if Path(out).exists() and not Path(out).is_dir():
+        raise OutputError(f"output folder '{out}' is not a folder")
     wall = {}
     started = time.perf_counter()
     backend = _backend(sim, folder, meta)
@@ -186,17 +189,30 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     finally:
         backend.close()
     wall["drive"] = time.perf_counter() - started
-    spawn = chosen["spawn"]
-    bag.parent.mkdir(parents=True, exist_ok=True)
-    write_run(bag, trajectory, spawn=(spawn[0], spawn[1], spawn[5]), commands=commands,
-              topics=("clock", "odom", "tf", "cmd_vel", "ground_truth"), world_id=meta["world_id"], task=chosen["id"],
-              run=bag.name)
+    _write_bag(bag, trajectory, commands, meta, chosen)
     wall["record"] = time.perf_counter() - started - wall["drive"]
     result = judge([bag], world=folder)
     wall["judge"] = time.perf_counter() - started - wall["drive"] - wall["record"]
     run = result.report["runs"][0]
     return Outcome(bag, ended, bool(result.passed), _verdict(run, ended), run,
                    float(trajectory[-1, 0] - trajectory[0, 0]), wall)
+
+
+def _write_bag(bag: Path, trajectory, commands, meta: dict, task: dict) -> None:
+    """The run as a rosbag2 folder at ``bag``, complete or absent: written aside, then moved in whole."""
+    import tempfile
+
+    from worldgen.files import write_folder_atomically
+    from worldgen.ros import write_run
+
+    spawn = task["spawn"]
+    with tempfile.TemporaryDirectory(prefix="worldgen-drive-") as tmp:
+        write_run(Path(tmp) / bag.name, trajectory, spawn=(spawn[0], spawn[1], spawn[5]), commands=commands,
+                  topics=("clock", "odom", "tf", "cmd_vel", "ground_truth"), world_id=meta["world_id"],
+                  task=task["id"], run=bag.name)
+        blobs = {str(p.relative_to(Path(tmp) / bag.name)): p.read_bytes()
+                 for p in sorted((Path(tmp) / bag.name).rglob("*")) if p.is_file()}
+    write_folder_atomically(bag.parent, bag.name, blobs)
 
 
 def _verdict(run: dict, ended: str) -> str:

@@ -1,10 +1,12 @@
 // drive_bridge: a lockstep link between a Python controller and a paused Gazebo (Fortress) server.
 //
-//   drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS
+//   drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW
 //
 // Fortress's ign-transport has no Python bindings, and one `ign service` call costs a process start
 // (about 0.1 s), so a controller at 50 Hz cannot drive through the `ign` command. This program stays up
-// for a whole run and speaks lines on stdin/stdout:
+// for a whole run. It first spawns the model in MODEL_SDF (a file) as NAME at (X, Y, Z, YAW) through
+// /world/WORLD/create (one request, answered within 30 s; the server is up and paused), which saves the
+// `ign service` process a spawn would otherwise cost. Then it speaks lines on stdin/stdout:
 //
 //   in:  "s N V W"   publish Twist(linear.x = V, angular.z = W) on CMD_TOPIC, run N physics steps
 //                    (WorldControl multi_step on /world/WORLD/control, the world stays paused), wait
@@ -20,6 +22,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdint>
+#include <fstream>
 #include <iostream>
 #include <mutex>
 #include <sstream>
@@ -27,6 +30,7 @@
 #include <thread>
 
 #include <ignition/msgs/boolean.pb.h>
+#include <ignition/msgs/entity_factory.pb.h>
 #include <ignition/msgs/odometry.pb.h>
 #include <ignition/msgs/twist.pb.h>
 #include <ignition/msgs/world_control.pb.h>
@@ -66,18 +70,45 @@ int Fail(const std::string &_why)
   std::cout << "error: " << _why << std::endl;
   return 1;
 }
+
+// Create the model through the world's create service; false when it refuses or does not answer in 30 s.
+// One request only: a request given up early could still be served, and a second one would then be
+// refused for the name taken.
+bool Spawn(ignition::transport::Node &_node, const std::string &_world, char **_argv)
+{
+  std::ifstream file(_argv[5]);
+  std::stringstream text;
+  text << file.rdbuf();
+  ignition::msgs::EntityFactory request;
+  request.set_sdf(text.str());
+  request.set_name(_argv[6]);
+  request.set_allow_renaming(false);
+  const double yaw = std::stod(_argv[10]);
+  auto *pose = request.mutable_pose();
+  pose->mutable_position()->set_x(std::stod(_argv[7]));
+  pose->mutable_position()->set_y(std::stod(_argv[8]));
+  pose->mutable_position()->set_z(std::stod(_argv[9]));
+  pose->mutable_orientation()->set_z(std::sin(yaw / 2));
+  pose->mutable_orientation()->set_w(std::cos(yaw / 2));
+  const std::string service = "/world/" + _world + "/create";
+  ignition::msgs::Boolean reply;
+  bool result = false;
+  return _node.Request(service, request, 30000, reply, result) && result && reply.data();
+}
 }  // namespace
 
 int main(int argc, char **argv)
 {
-  if (argc != 5)
+  if (argc != 11)
   {
-    std::cerr << "usage: drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS" << std::endl;
+    std::cerr << "usage: drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW" << std::endl;
     return 2;
   }
   const std::string world = argv[1];
   const int64_t stepNs = std::stoll(argv[4]);
   ignition::transport::Node node;
+  if (!Spawn(node, world, argv))
+    return Fail(std::string("the world did not create the model ") + argv[6]);
   auto publisher = node.Advertise<ignition::msgs::Twist>(argv[2]);
   if (!publisher || !node.Subscribe(argv[3], OnPose))
     return Fail("cannot advertise or subscribe");

@@ -34,7 +34,7 @@ from worldgen.sim import textproto
 from worldgen.sim.procs import group_members, run_tool, stop_group
 
 __all__ = ["GazeboMissingError", "GazeboError", "GazeboInstall", "GazeboServer", "locate", "SETUP_ENV",
-           "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "problems_in"]
+           "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name"]
 
 #: The environment variable naming an install's setup script, and the script used without it.
 SETUP_ENV = "WORLDGEN_GAZEBO_SETUP"
@@ -47,6 +47,9 @@ INSTALL_HINT = ("install Gazebo Fortress (on Debian 12: apt-get install libsdfor
 HARMLESS: dict[str, str] = {
     "Library error: libignition-tools-backward.so not found":
         "ign-tools' optional backtrace helper, absent from Debian's ign-tools; printed by every ign call",
+    "Error launching Remotery: Can't bind a socket for the server":
+        "ign-common's profiler (Remotery, compiled into the 6.18 build) listens on TCP port 1500 (measured: "
+        "whatever RMT_PORT says) and finds it taken when another Gazebo runs on the machine; profiling only",
 }
 
 _ANSI = re.compile(r"\x1b\[[0-9;]*m")
@@ -115,11 +118,29 @@ def _physics_args(env: dict[str, str]) -> list[str]:
     return ["--physics-engine", _DART_DEBIAN.name]
 
 
-def problems_in(log: str) -> list[str]:
-    """The error and warning lines of a Gazebo log, without colour codes and without :data:`HARMLESS` lines."""
-    out = []
+#: Lines a skin-less actor (worldgen's movers and people) makes Gazebo 6.18 print, once per actor, each with
+#: why it says nothing wrong about the world; :func:`problems_in` drops each at most once per actor.
+ACTOR_NOTES: dict[str, str] = {
+    "Link's parent entity": "the Physics system visits an actor's link, finds no model for it and skips it: "
+                            "actors have no physics in Gazebo Sim (the script moves them)",
+    "Collision's parent entity": "the same for the actor link's collision element",
+    "Invalid mesh filename extension": "the rendering scene tries the actor's skin, sdformat's placeholder name "
+                                       "__default__ (worldgen writes no skin), then draws the actor's links along "
+                                       "the script instead (gz-sim pull request 1947)",
+    "Actor skin mesh": "the same skin lookup, reported a second time",
+}
+
+
+def problems_in(log: str, actors: int = 0) -> list[str]:
+    """The error and warning lines of a Gazebo log, without colour codes, without :data:`HARMLESS` lines and
+    without up to ``actors`` of each :data:`ACTOR_NOTES` line."""
+    out, left = [], {note: actors for note in ACTOR_NOTES}
     for line in _ANSI.sub("", log).splitlines():
         if any(known in line for known in HARMLESS):
+            continue
+        note = next((n for n in ACTOR_NOTES if n in line), None)
+        if note is not None and left[note] > 0:
+            left[note] -= 1
             continue
         if "[Err]" in line or "[Wrn]" in line or "error" in line.lower():
             out.append(line.strip())
@@ -130,15 +151,15 @@ def _without_harmless(text: str) -> str:
     return "\n".join(x for x in text.splitlines() if not any(k in x for k in HARMLESS))
 
 
-def world_name(sdf_path: Path) -> str:
-    """The ``<world name>`` of an SDF file (parsed without entities or network)."""
+def world_name(sdf_path: Path) -> tuple[str, int]:
+    """The ``<world name>`` of an SDF file and how many ``<actor>``s it holds (parsed without entities or network)."""
     from lxml import etree
 
     parser = etree.XMLParser(resolve_entities=False, no_network=True)
     world = etree.parse(str(sdf_path), parser).getroot().find("world")
     if world is None or not world.get("name"):
         raise GazeboError(f"{sdf_path} holds no <world name=...>")
-    return str(world.get("name"))
+    return str(world.get("name")), len(world.findall("actor"))
 
 
 class GazeboServer:
@@ -153,7 +174,10 @@ class GazeboServer:
                  verbosity: int = 3, real_time_factor: float | None = None, start_timeout: float = 60.0):
         self.world_sdf = Path(world_sdf).resolve()
         self.install = install or locate()
-        self.world = world_name(self.world_sdf)
+        # Gazebo's transport finds peers machine-wide: a partition of its own keeps this server and its
+        # ign calls apart from any other Gazebo on the machine (same world name, /stats, /clock).
+        self.env = dict(self.install.env, IGN_PARTITION=f"worldgen-{os.getpid()}-{id(self):x}")
+        self.world, self.actors = world_name(self.world_sdf)
         self.headless_rendering = headless_rendering
         self.verbosity = verbosity
         self.real_time_factor = real_time_factor
@@ -162,6 +186,7 @@ class GazeboServer:
         self._proc: subprocess.Popen | None = None
         self._logdir = tempfile.TemporaryDirectory(prefix="worldgen-gazebo-")
         self._iterations = 0
+        self._scene: dict | None = None  # the last scene/info reply, until a spawn changes the scene
 
     # -- life cycle --------------------------------------------------------------------------------------------
     def command(self) -> list[str]:
@@ -175,7 +200,7 @@ class GazeboServer:
         logdir = Path(self._logdir.name)
         started = time.monotonic()
         with open(logdir / "stdout", "wb") as out, open(logdir / "stderr", "wb") as err:
-            self._proc = subprocess.Popen(self.command(), env=self.install.env, stdin=subprocess.DEVNULL, stdout=out,
+            self._proc = subprocess.Popen(self.command(), env=self.env, stdin=subprocess.DEVNULL, stdout=out,
                                           stderr=err, start_new_session=True, cwd=str(self.world_sdf.parent))
         try:
             self._wait_up(started)
@@ -190,12 +215,16 @@ class GazeboServer:
         while time.monotonic() - started < self.start_timeout:
             if self._proc is None or self._proc.poll() is not None:
                 raise GazeboError(f"Gazebo exited while loading {self.world_sdf}: {self.problems()[:5]}")
+            # One long wait rather than short polls: a requester that gives up before a busy server answers
+            # makes the server print "error sending response: Host unreachable".
+            remaining = self.start_timeout - (time.monotonic() - started)
             try:
                 reply = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty", "ignition.msgs.Scene",
-                                     "", timeout=2.0)
+                                     "", timeout=max(1.0, remaining))
             except GazeboError:
                 continue
             if reply:
+                self._scene = reply
                 return
         raise GazeboError(f"Gazebo did not serve world {self.world!r} within {self.start_timeout:.0f} s")
 
@@ -223,21 +252,43 @@ class GazeboServer:
                      for s in ("stdout", "stderr"))  # type: ignore[return-value]
 
     def problems(self) -> list[str]:
-        """Gazebo's error and warning lines so far (stdout and stderr), without the known harmless ones."""
+        """Gazebo's error and warning lines so far (stdout and stderr), without the known harmless ones (those
+        of :data:`ACTOR_NOTES` once per actor of the world)."""
         out, err = self.log()
-        return problems_in(out + "\n" + err)
+        return problems_in(out + "\n" + err, self.actors)
 
     # -- talking to it ---------------------------------------------------------------------------------------
     def _ign(self, args: list[str], timeout: float) -> str:
         try:
-            return run_tool(["ign"] + args, self.install.env, timeout=timeout)
+            return run_tool(["ign"] + args, self.env, timeout=timeout)
         except subprocess.TimeoutExpired:
             raise GazeboError(f"'ign {' '.join(args[:3])}' got no answer within {timeout:.0f} s") from None
 
-    def echo(self, topic: str, n: int = 1, timeout: float = 20.0) -> list[dict]:
-        """The next ``n`` messages on a topic, parsed (:mod:`worldgen.sim.textproto`)."""
-        text = _without_harmless(self._ign(["topic", "-e", "-t", topic, "-n", str(n)], timeout))
-        return [textproto.parse(m) for m in textproto.split_messages(text)]
+    def echo(self, topic: str, n: int = 1, timeout: float = 20.0, step: int = 0) -> list[dict]:
+        """The next ``n`` messages on a topic, parsed (:mod:`worldgen.sim.textproto`).
+
+        ``step`` > 0 keeps the world stepping that many iterations at a time until they came: for a topic
+        published only while simulation time moves (a sensor), as the server waits paused otherwise."""
+        args = ["ign", "topic", "-e", "-t", topic, "-n", str(n)]
+        if not step:
+            return self._parse_echo(self._ign(args[1:], timeout))
+        with tempfile.TemporaryFile() as sink:
+            proc = subprocess.Popen(args, env=self.env, stdin=subprocess.DEVNULL, stdout=sink,
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+            deadline = time.monotonic() + timeout
+            try:
+                while proc.poll() is None and time.monotonic() < deadline:
+                    self.step(step)
+            finally:
+                if proc.poll() is None:
+                    stop_group(proc, grace=0.5)
+                    raise GazeboError(f"no {n} message(s) on {topic} within {timeout:.0f} s of stepping")
+            sink.seek(0)
+            return self._parse_echo(sink.read().decode("utf-8", errors="replace"))
+
+    @staticmethod
+    def _parse_echo(text: str) -> list[dict]:
+        return [textproto.parse(m) for m in textproto.split_messages(_without_harmless(text))]
 
     def service(self, name: str, reqtype: str, reptype: str, req: str, timeout: float = 10.0) -> dict:
         """Call a service; its reply parsed. Raises :class:`GazeboError` when it does not answer."""
@@ -252,6 +303,11 @@ class GazeboServer:
     def stats(self) -> dict:
         """One ``/world/<name>/stats`` message (iterations, sim_time, real_time_factor, paused)."""
         return self.echo(f"/world/{self.world}/stats", 1)[0]
+
+    def stats_time(self) -> float:
+        """The world's simulation time (s), from one ``stats`` message."""
+        sim = textproto.first(self.stats(), "sim_time", {})
+        return float(textproto.first(sim, "sec", 0)) + float(textproto.first(sim, "nsec", 0)) * 1e-9
 
     def step(self, iterations: int, timeout: float = 120.0) -> int:
         """Run ``iterations`` physics steps, then stay paused; returns the world's iteration count."""
@@ -269,10 +325,12 @@ class GazeboServer:
         raise GazeboError(f"world {self.world!r} did not reach iteration {target} within {timeout:.0f} s")
 
     def scene_names(self) -> dict[int, str]:
-        """Entity id -> scoped name (``model``, ``model::link``) of every model and link, from ``scene/info``.
-
-        Asked again on each call, so a model spawned since is included."""
-        scene = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty", "ignition.msgs.Scene", "")
+        """Entity id -> scoped name (``model``, ``model::link``) of every model and link, from ``scene/info``
+        (asked once, and again after a spawn)."""
+        if self._scene is None:
+            self._scene = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty",
+                                       "ignition.msgs.Scene", "")
+        scene = self._scene
         names: dict[int, str] = {}
 
         def walk(model: dict, prefix: str) -> None:
@@ -291,6 +349,12 @@ class GazeboServer:
         """Scoped name (``model``, ``model::link``) -> (x, y, z, qx, qy, qz, qw) from one ``pose/info`` (or
         ``dynamic_pose/info``) message. A model's pose is in the world frame, a link's in its model's frame
         (as Gazebo publishes them); entities that are neither (lights, visuals) are left out."""
+        if dynamic and self.actors:
+            # SceneBroadcaster::PoseUpdate (gz-sim 6.18 and 8.9) reads the Static component of every link's
+            # parent once dynamic_pose/info has a subscriber; an actor's link has the actor as its parent,
+            # which has none: the server dies of a null dereference (measured here, SIGSEGV).
+            raise GazeboError(f"dynamic_pose/info would crash Gazebo: world {self.world!r} has actors "
+                              "(docs/gazebo.md); read pose/info, which carries the moving bodies too")
         topic = f"/world/{self.world}/{'dynamic_pose' if dynamic else 'pose'}/info"
         message = self.echo(topic, 1, timeout)[0]
         names = self.scene_names()
@@ -305,6 +369,7 @@ class GazeboServer:
         x, y, z, yaw = pose
         req = (f"sdf: {json.dumps(sdf)}, name: {json.dumps(name)}, allow_renaming: false, pose: {{position: "
                f"{{x: {x!r}, y: {y!r}, z: {z!r}}}, orientation: {{z: {math.sin(yaw / 2)!r}, w: {math.cos(yaw / 2)!r}}}}}")
+        self._scene = None
         reply = self.service(f"/world/{self.world}/create", "ignition.msgs.EntityFactory", "ignition.msgs.Boolean", req)
         if textproto.first(reply, "data") is not True and textproto.first(reply, "data") != "true":
             raise GazeboError(f"Gazebo refused to create {name!r}: {reply}")

@@ -1,5 +1,6 @@
 """The robot in MuJoCo, as the drive loop steps it: the environment's differential-drive body
-(:mod:`worldgen.envs.robot`) added to a world folder's MJCF, with real contacts against walls and obstacles.
+(:mod:`worldgen.envs.robot`) added to a world folder's MJCF, with real contacts against walls, obstacles,
+door leaves and movers; the movers (mocap bodies) follow world.json's ``dynamic_obstacles`` scripts.
 
 Deterministic: the same world and commands give the same poses, bit for bit, in any process.
 """
@@ -9,8 +10,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 from lxml import etree
 
+from worldgen.envs.movers import MoverScript
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.export.xml import safe_parser
 
@@ -33,6 +36,7 @@ class MujocoBackend:
         self._root = root
         self._floor = sorted(e["name"] for e in meta["entities"] if e["role"] == "floor")
         self._movers = [m["name"] for m in meta.get("dynamic_obstacles", [])]
+        self._script = MoverScript(meta.get("dynamic_obstacles", []))
         self._sim = None
         self.dt = 0.0
 
@@ -42,6 +46,8 @@ class MujocoBackend:
         x, y, _, yaw = spawn
         self._sim = compile_world(self._root, (x, y, yaw), self._floor, self._movers)
         self.dt = float(self._sim.model.opt.timestep)
+        if len(self._script):
+            self._script.place(self._sim.data, self._sim.mocap, self._script.positions(np.zeros(1))[0])
         mujoco.mj_forward(self._sim.model, self._sim.data)
         return (float(self._sim.data.time), *self._sim.pose())
 
@@ -51,7 +57,11 @@ class MujocoBackend:
         sim = self._sim
         assert sim is not None
         sim.data.ctrl[sim.ctrl] = (v, 0.0, w)
-        for _ in range(int(n)):
+        # Movers (mocap bodies) follow world.json's scripts, placed before every physics step.
+        where = self._script.positions(sim.data.time + self.dt * np.arange(int(n))) if len(self._script) else None
+        for k in range(int(n)):
+            if where is not None:
+                self._script.place(sim.data, sim.mocap, where[k])
             mujoco.mj_step(sim.model, sim.data)
         x, y, yaw = sim.pose()
         # The hinge's angle winds past +-pi; a heading is an angle in (-pi, pi].
