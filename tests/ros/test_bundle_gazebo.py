@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 
 import pytest
-from support import missing_tool
+from support.gazebo import gazebo_install
 
 import worldgen
 from worldgen.export.robot import robot_sdf
@@ -35,12 +35,7 @@ _DART = Path("/usr/lib/x86_64-linux-gnu/ign-physics-5/engine-plugins/libignition
 
 @pytest.fixture(scope="module")
 def install():
-    from worldgen.sim.gazebo import GazeboMissingError, locate
-
-    try:
-        return locate()
-    except GazeboMissingError as exc:
-        missing_tool(f"Gazebo ({exc})")
+    return gazebo_install()
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +47,8 @@ def run_setup(install, tmp_path_factory):
     spec = importlib.util.spec_from_file_location("gz_launch", path)
     launch = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(launch)
-    env = dict(install.env)
+    # A transport partition of its own: another Gazebo on this machine (a parallel test) is not this one.
+    env = dict(install.env, IGN_PARTITION=f"worldgen-bundle-{os.getpid()}")
     if _DART.exists():  # Debian 12 ships DART's plugin without the unversioned name Gazebo asks for
         engines = tmp_path_factory.mktemp("engines")
         (engines / "libignition-physics-dartsim-plugin.so").symlink_to(_DART)
