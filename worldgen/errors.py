@@ -15,6 +15,8 @@ __all__ = [
     "SceneError",
     "OutputError",
     "MissingDependencyError",
+    "SimulatorMissingError",
+    "SimulatorError",
     "BagError",
     "CallOrderError",
     "require_optional",
@@ -79,6 +81,19 @@ class MissingDependencyError(WorldgenError, ImportError):
 
     Raised only by :func:`require_optional`, the one way any room asks for an optional extra.
     """
+
+
+class SimulatorMissingError(WorldgenError):
+    """A simulator that a feature runs (Gazebo, for ``worldgen.sim``) is not installed; the message says where
+    it was looked for and how to install it. A system program, not a Python extra, hence not a
+    :class:`MissingDependencyError`."""
+
+
+class SimulatorError(WorldgenError):
+    """A simulator ran but did not do what was asked (a world that never came up, a service that did not
+    answer), or printed what cannot be read."""
+
+    exit_status = EXIT_FAILED
 
 
 class BagError(WorldgenError, ValueError):

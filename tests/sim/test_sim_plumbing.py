@@ -5,6 +5,7 @@ import sys
 
 import pytest
 
+from worldgen.errors import SimulatorError
 from worldgen.sim import textproto
 from worldgen.sim.gazebo import GazeboMissingError, locate, problems_in
 from worldgen.sim.procs import group_members, run_tool, stop_group
@@ -46,7 +47,7 @@ def test_several_printed_messages_split_and_bad_text_is_refused():
     assert [textproto.parse(m)["data"] for m in textproto.split_messages("data: true\n\ndata: false\n")] == \
         [["true"], ["false"]]
     for bad in ("pose {", "}", "x: 1 {", '"floating"'):
-        with pytest.raises(ValueError):
+        with pytest.raises(SimulatorError):
             textproto.parse(bad)
 
 

@@ -29,7 +29,7 @@ import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from worldgen.errors import MissingDependencyError, WorldgenError
+from worldgen.errors import SimulatorError, SimulatorMissingError
 from worldgen.sim import textproto
 from worldgen.sim.procs import group_members, run_tool, stop_group
 
@@ -58,14 +58,12 @@ _DART_DEFAULT = "libignition-physics-dartsim-plugin.so"
 _DART_DEBIAN = Path("/usr/lib/x86_64-linux-gnu/ign-physics-5/engine-plugins/libignition-physics5-dartsim-plugin.so.5")
 
 
-class GazeboMissingError(MissingDependencyError):
+class GazeboMissingError(SimulatorMissingError):
     """No usable Gazebo install: the message names where it looked and how to install one."""
 
 
-class GazeboError(WorldgenError):
+class GazeboError(SimulatorError):
     """Gazebo ran but did not do what was asked (the world did not come up, a service did not answer)."""
-
-    exit_status = 1
 
 
 @dataclass(frozen=True)

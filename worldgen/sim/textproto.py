@@ -3,12 +3,15 @@
 A message is a dict from field name to a list of values (a field may repeat: ``pose`` in a
 ``Pose_V``); a value is a number, a string, a bare enum word, or a nested message (a dict). Keeping
 every field a list means a repeated field with one element reads the same as one with many. Several
-messages printed one after another (``ign topic -e -n 3``) are split by :func:`split_messages`.
+messages printed one after another (``ign topic -e -n 3``) are split by :func:`split_messages`. Text
+that is not the format raises :class:`~worldgen.errors.SimulatorError`.
 """
 
 from __future__ import annotations
 
 import re
+
+from worldgen.errors import SimulatorError
 
 __all__ = ["parse", "split_messages", "first", "pose_of", "poses_by_name"]
 
@@ -24,7 +27,7 @@ def _tokens(text: str):
             return
         m = _TOKEN.match(text, pos)
         if not m:
-            raise ValueError(f"not protobuf text at offset {pos}: {text[pos:pos + 40]!r}")
+            raise SimulatorError(f"not protobuf text at offset {pos}: {text[pos:pos + 40]!r}")
         pos = m.end()
         yield m
 
@@ -45,14 +48,14 @@ def parse(text: str) -> dict:
     for m in _tokens(text):
         if m.group("open"):
             if pending is None:
-                raise ValueError("a '{' with no field name before it")
+                raise SimulatorError("a '{' with no field name before it")
             child: dict = {}
             stack[-1].setdefault(pending, []).append(child)
             stack.append(child)
             pending = None
         elif m.group("close"):
             if len(stack) == 1:
-                raise ValueError("an unmatched '}'")
+                raise SimulatorError("an unmatched '}'")
             stack.pop()
         elif pending is None and m.group("key") is not None:
             pending = m.group("key")
@@ -60,9 +63,9 @@ def parse(text: str) -> dict:
             stack[-1].setdefault(pending, []).append(_value(m))
             pending = None
         else:
-            raise ValueError(f"a value with no field name: {m.group(0)!r}")
+            raise SimulatorError(f"a value with no field name: {m.group(0)!r}")
     if len(stack) != 1 or pending is not None:
-        raise ValueError("the message ends inside a field")
+        raise SimulatorError("the message ends inside a field")
     return stack[0]
 
 
