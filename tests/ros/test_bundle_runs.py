@@ -394,6 +394,12 @@ def test_the_loop_checks_its_arguments_before_writing(folder, tmp_path, args, me
                                 "--out", str(tmp_path / "bags"), str(tmp_path)], capture_output=True, text=True, timeout=60)
     assert no_bundle.returncode == 2 and "must hold one ros2/launch/*.launch.py" in no_bundle.stderr
     assert not (tmp_path / "bags").exists()
+    no_ros = subprocess.run([sys.executable, str(folder / "ros2" / "run_loop.py"), "--out", str(tmp_path / "bags"),
+                             str(folder)], capture_output=True, text=True, timeout=60,
+                            env={**os.environ, "PATH": str(tmp_path / "empty")})
+    assert no_ros.returncode == 2 and no_ros.stderr == (
+        "error: ros2 is not on the PATH: source your ROS 2 setup first (e.g. /opt/ros/jazzy/setup.bash)\n")
+    assert not (tmp_path / "bags").exists()
 
 
 def test_the_bundles_own_robot_is_spawned_unless_the_run_names_another(folder, description, tmp_path):
