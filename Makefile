@@ -52,11 +52,11 @@ test: $(TEST_STAMP)
 	$(VENV)/bin/mypy
 	$(PY) -m pytest -q
 
-## test-gazebo: only the tests that load and step every kind of world in a real Gazebo server (tests/sim,
+## test-gazebo: only the tests that run a real Gazebo server (every kind of world loaded and stepped, tests/sim;
 ## marker `gazebo`; also part of `make test`); Gazebo from WORLDGEN_GAZEBO_SETUP or /opt/gz-fortress2
 ## (docs/gazebo.md)
 test-gazebo: $(TEST_STAMP)
-	$(PY) -m pytest -q -m gazebo tests/sim
+	$(PY) -m pytest -q -m gazebo tests
 
 ## bench: per-stage medians for cluttered worlds against the serialisation floor, a 1,000-world pack
 ## with --jobs 2, the RL environment's steps/s and reset split, BARN's metrics against worldgen's

@@ -4,7 +4,7 @@
 
 The world: cluttered, seed 3, size 12 x 12 m (a 10.35 m reference path). Each run is the real command
 in a fresh process, `worldgen drive WORLD --sim gazebo --out DIR`, timed from start to exit: Python's
-imports, Gazebo's start-up (headless, unthrottled, paused), the spawn, the lockstep drive at 50 Hz
+imports, Gazebo's start-up (headless, unthrottled, paused), the spawn, the lockstep drive at 20 Hz
 through the C++ bridge (built once before timing), the bag and the judge. Median of --repeats.
 Without Gazebo the Gazebo row says so and the MuJoCo row still runs.
 

@@ -45,7 +45,7 @@ class World:
         self.path: Optional[Path] = None  # the folder once written
         self._preset: Optional[str] = None
         self._difficulty_request: Optional[dict] = None
-        self._texts: dict[tuple, str] = {}  # export()'s renderings, by (format, SDF version)
+        self._blobs: dict[tuple, bytes] = {}  # export_bytes()'s renderings, by (format, SDF version)
 
     @property
     def preset(self) -> Optional[str]:
@@ -109,9 +109,14 @@ class World:
 
     @property
     def folder_name(self) -> str:
-        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, else ``world_id``,
-        so worlds of several presets over one generator can be told apart in one folder."""
-        return f"{self.preset}--{self.world_id}" if self.preset else self.world_id
+        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, ``L<k>-r<request seed>--``
+        before the id for a world asked for at level k (its own seed is the draw that landed, 19 digits long), else
+        ``world_id``: worlds of several presets, or levels, over one generator can be told apart in one folder."""
+        name = self.world_id
+        if self.difficulty_request:
+            level = str(self.difficulty_request["level"]).split("/")[0]
+            name = f"L{level}-r{self.difficulty_request['seed']}--{name}"
+        return f"{self.preset}--{name}" if self.preset else name
 
     # -- in-memory exports -------------------------------------------------
     def to_sdf(self, version: str = "1.9") -> str:
@@ -127,16 +132,22 @@ class World:
         return self.export("urdf")
 
     def export(self, fmt: str, sdf_version: str = "1.9") -> str:
-        """The world's text in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and ``write``
-        share it (a World is a value: its scene and params do not change)."""
-        key = (fmt, sdf_version if fmt == "sdf" else None)
-        text = self._texts.get(key)
-        if text is None:
-            text = self._texts[key] = self._render(fmt, sdf_version)
-        return text
+        """The world's text in ``fmt`` (a text format: not ``usdc``, whose bytes :meth:`export_bytes` gives)."""
+        if fmt in formats_table.TABLE and formats_table.TABLE[fmt].binary:
+            raise OutputError(f"format {fmt!r} is binary, not text: use World.export_bytes({fmt!r})")
+        return self.export_bytes(fmt, sdf_version).decode()
 
-    def _render(self, fmt: str, sdf_version: str) -> str:
-        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version).decode()
+    def export_bytes(self, fmt: str, sdf_version: str = "1.9") -> bytes:
+        """The bytes of the world's file in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and
+        ``write`` share them (a World is a value: its scene and params do not change)."""
+        key = (fmt, sdf_version if fmt == "sdf" else None)
+        data = self._blobs.get(key)
+        if data is None:
+            data = self._blobs[key] = self._render(fmt, sdf_version)
+        return data
+
+    def _render(self, fmt: str, sdf_version: str) -> bytes:
+        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version, world=self)
 
     def mesh_files(self) -> dict[str, bytes]:
         """Mesh files the exported formats refer to: relative path -> bytes."""
@@ -151,7 +162,8 @@ class World:
     def rendered_files(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> dict[str, tuple[str, bytes]]:
         """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
         formats = normalise_formats(formats)
-        files = {fmt: (FILE_NAMES[fmt], self.export(fmt, sdf_version).encode()) for fmt in formats}
+        formats_table.require_formats(formats)  # a missing extra: one line, before anything is rendered
+        files = {fmt: (FILE_NAMES[fmt], self.export_bytes(fmt, sdf_version)) for fmt in formats}
         if formats_table.uses_meshes(formats):
             for rel, data in self.mesh_files().items():
                 files[f"mesh:{rel}"] = (rel, data)

@@ -84,7 +84,7 @@ def _digest(bag: Path) -> str:
     return hashlib.sha256(b"".join(p.read_bytes() for p in sorted(bag.rglob("*")) if p.is_file())).hexdigest()
 
 
-def test_the_cli_drives_end_to_end_and_repeats_its_bytes(tmp_path):
+def test_the_cli_drives_end_to_end_and_repeats_its_bytes(tmp_path, blocked):
     assert run_cli("generate", "minimal", "--seed", "2", "--out", tmp_path / "w").returncode == 0
     folder = next((tmp_path / "w").iterdir())
     first = run_cli("drive", folder, "--sim", "mujoco", "--out", tmp_path / "a")
@@ -93,7 +93,7 @@ def test_the_cli_drives_end_to_end_and_repeats_its_bytes(tmp_path):
     assert run_cli("drive", folder, "--sim", "mujoco", "--out", tmp_path / "b").returncode == 0
     bag_a, bag_b = (next((tmp_path / d).iterdir()) for d in ("a", "b"))
     assert _digest(bag_a) == _digest(bag_b)
-    straight = run_cli("drive", folder, "--sim", "mujoco", "--out", tmp_path / "c", "--straight")
+    straight = run_cli("drive", blocked, "--sim", "mujoco", "--out", tmp_path / "c", "--straight")
     assert straight.returncode == 1 and "FAIL: collision with" in straight.stdout, straight.stdout + straight.stderr
 
 

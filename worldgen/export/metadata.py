@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 from functools import lru_cache
 from importlib import resources
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping
 
 import numpy as np
 import shapely
@@ -58,7 +58,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
         "entities": [_entity(scene, node) for node in scene.nodes],
         "doors": door_records(scene),
-        "dynamic_obstacles": [mover_entry(m, world.params) for m in scene.movers if not m.person],
+        "dynamic_obstacles": [mover_entry(m, world.params, files) for m in scene.movers if not m.person],
         "tasks": [task_entry(world, task, path) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
@@ -102,7 +102,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
 
 def _add_people(meta: dict, world, people) -> None:
     """world.json's ``people``, ``robot.max_speed`` and each task's ``timed_path`` (docs/people.md)."""
-    meta["people"] = [person_entry(m, world.params) for m in people]
+    meta["people"] = [person_entry(m, world.params, meta["files"]) for m in people]
     meta["robot"]["max_speed"] = world.params["robot_speed"]
     timed = list(getattr(world.feasibility, "timed_paths", ()))
     timed += [None] * max(0, len(meta["tasks"]) - len(timed))
@@ -121,23 +121,23 @@ def dumps(meta: Mapping[str, Any]) -> str:
     return _emit(meta, "") + "\n"
 
 
-def mover_entry(mover, params: Mapping[str, Any]) -> dict:
+def mover_entry(mover, params: Mapping[str, Any], files: Iterable[str] = ()) -> dict:
     """The mover's ``dynamic_obstacles[]`` entry of world.json, for a world of ``params`` (which say
-    whether the SDF carries movers)."""
+    whether the SDF carries movers) written with the ``files`` keys (which say whether the USD does)."""
     return {
         "name": mover.name,
         "radius": mover.radius,
         "height": mover.height,
         "trajectory": [list(row) for row in mover.trajectory],
         "loop": mover.loop,
-        "formats": movers_note(params),
+        "formats": movers_note(params, files),
     }
 
 
-def person_entry(person, params: Mapping[str, Any]) -> dict:
+def person_entry(person, params: Mapping[str, Any], files: Iterable[str] = ()) -> dict:
     """A person's ``people[]`` entry of world.json: a mover's, without ``loop`` (a person walks once
     and then stands where it stopped)."""
-    entry = mover_entry(person, params)
+    entry = mover_entry(person, params, files)
     del entry["loop"]
     return entry
 

@@ -80,7 +80,7 @@ from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matri
 from worldgen.scene.graph import Joint
 from worldgen.scene.mover import MOVER_RGBA, Mover
 
-__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "HOLD_SECONDS", "to_sdf"]
+__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "HOLD_SECONDS", "script_rows", "to_sdf"]
 
 TEMPLATE = "world.sdf"
 #: Smallest principal moment written (kg m^2): floats keep 6 decimals, and a
@@ -323,6 +323,15 @@ def _write_geometry(out: XmlText, geometry) -> None:
 
 # -- movers: one <actor> each ------------------------------------------------
 
+def script_rows(trajectory, loop: bool) -> np.ndarray:
+    """The (k, 3) ``t, x, y`` rows an actor's script plays: a looping mover's own, or a non-looping one's
+    followed by a stay of :data:`HOLD_SECONDS` at its last row (see :func:`_sdf_actor`)."""
+    rows = np.asarray(trajectory, dtype=float)
+    if loop:
+        return rows
+    return np.vstack([rows, [rows[-1, 0] + HOLD_SECONDS, rows[-1, 1], rows[-1, 2]]])
+
+
 def _write_actors(out: XmlText, scene: Scene) -> None:
     """Write one ``<actor>`` per mover at the end of the SDF ``<world>`` (``out`` is at its children's depth)."""
     for mover in scene.movers:
@@ -347,9 +356,7 @@ def _sdf_actor(out: XmlText, mover: Mover) -> None:
     # so SceneManager's ActorTrajectoryAt sees a script of total time 0, treats it as looping and wraps
     # time by 0 for ever (docs/gazebo.md). So every script loops, and one that should not ends with the
     # mover standing at its last row for HOLD_SECONDS, a stay the waypoints keep to like any other.
-    rows = np.asarray(mover.trajectory, dtype=float)
-    if not mover.loop:
-        rows = np.vstack([rows, [rows[-1, 0] + HOLD_SECONDS, rows[-1, 1], rows[-1, 2]]])
+    rows = script_rows(mover.trajectory, mover.loop)
     out.open("script")
     out.leaf("loop", "true")
     out.leaf("delay_start", "0")

@@ -2,7 +2,8 @@
 
 The one place that reads a World's parameters for lidar, map and metrics, so
 that world.json and the written map files always agree. A world's occupancy map
-is made once and remembered (worlds are written after their metadata is built).
+and difficulty figures are made once and remembered (worlds are written after their metadata is built,
+and a world asked for at a level is scored before it).
 """
 
 from __future__ import annotations
@@ -25,6 +26,9 @@ MAP_KEYS = ("map_pgm", "map_yaml")
 
 _DEFAULTS = {p.name: p.default for p in COMMON_PARAMS}
 _MAPS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+#: The difficulty figures of each world, computed once: a world asked for at a level was scored with them
+#: (worldgen.leveling) before its world.json is built.
+_DIFFICULTY: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def _param(world, name: str):
@@ -95,7 +99,10 @@ def map_files(world) -> dict[str, tuple[str, bytes]]:
 
 def difficulty(world) -> dict:
     """worldgen's five exact figures of world.json's ``metrics`` (after BARN's; not BARN's numbers)."""
-    return metrics.difficulty(planning_scene(world), world.robot, world.tasks, world.feasibility.paths)
+    if world not in _DIFFICULTY:
+        _DIFFICULTY[world] = metrics.difficulty(planning_scene(world), world.robot, world.tasks,
+                                                world.feasibility.paths)
+    return dict(_DIFFICULTY[world])
 
 
 def barn(world) -> dict:

@@ -2,7 +2,7 @@
 backend the drive loop steps (:class:`GazeboBackend`).
 
 Fortress's ign-transport has no Python bindings, and each ``ign service`` call starts a process (about
-0.1 s), so a 50 Hz controller talks to Gazebo through one long-lived program instead: it publishes the
+0.1 s), so a 20 Hz controller talks to Gazebo through one long-lived program instead: it publishes the
 twist, runs N physics steps through ``/world/<name>/control`` (the world stays paused between calls) and
 answers with the pose the robot's OdometryPublisher stamped at the end of them. The program is compiled
 against ign-transport 11 and ign-msgs 8 (``pkg-config``) into the user's cache folder under a name
@@ -79,14 +79,15 @@ def world_step(sdf_path: Path) -> float:
 class GazeboBackend:
     """The robot in a headless Gazebo: :meth:`start` spawns it, :meth:`step` drives it N physics steps.
 
-    ``robot_sdf`` is the model (worldgen.export.robot, with its ground truth published every step);
+    ``robot_sdf`` is the model (worldgen.export.robot, with its ground truth published at the end of every command);
     poses come back from the simulator, (t, x, y, yaw) in the world frame.
     """
 
     name = "gazebo"
 
-    def __init__(self, world_sdf: Path, robot_sdf: str, *, robot_name: str = "robot"):
+    def __init__(self, world_sdf: Path, robot_sdf: str, *, robot_name: str = "robot", first_steps: int = 1):
         self.world_sdf = Path(world_sdf)
+        self.first_steps = first_steps  # steps until the first pose: the model's OdometryPublisher's period
         self.dt = world_step(self.world_sdf)
         self._robot_sdf, self._robot_name = robot_sdf, robot_name
         self._server: GazeboServer | None = None
@@ -110,7 +111,7 @@ class GazeboBackend:
         first = self._read()
         if first != "ready":
             raise GazeboError(f"the drive bridge did not connect: {first}")
-        return self.step(0.0, 0.0, 1)
+        return self.step(0.0, 0.0, self.first_steps)
 
     def _read(self) -> str:
         assert self._bridge is not None and self._bridge.stdout is not None

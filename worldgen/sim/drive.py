@@ -36,13 +36,14 @@ import numpy as np
 from worldgen.errors import OutputError, ParameterError
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "Pursuit", "Outcome",
-           "drive", "run_loop"]
+           "drive", "run_loop", "steps_per_command"]
 
 #: Simulators ``worldgen drive --sim`` knows.
 SIMS = ("gazebo", "mujoco")
 SPEED = 0.5            # m/s forward
 LOOKAHEAD = 0.3        # m along the path ahead of the robot's projection on it
-CONTROL_PERIOD = 0.02  # s between commands (50 Hz)
+#: s between commands: 20 Hz, nav2 controller_server's default controller_frequency.
+CONTROL_PERIOD = 0.05
 STUCK_SECONDS = 2.0
 STUCK_MOVE = 0.02      # m
 
@@ -96,13 +97,18 @@ class Outcome:
     wall: dict = field(default_factory=dict)
 
 
+def steps_per_command(dt: float) -> int:
+    """Physics steps of ``dt`` s between two commands: :data:`CONTROL_PERIOD` rounded to whole steps."""
+    return max(1, round(CONTROL_PERIOD / dt))
+
+
 def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED) -> tuple[np.ndarray, np.ndarray, str]:
     """Drive ``task`` in a started-or-not ``backend``: the (n, 4) trajectory, (m, 3) commands and why it ended."""
     spawn, goal = task["spawn"], np.asarray(task["goal"][:2], dtype=float)
     path = [spawn[:2], goal] if straight else task["path"]["waypoints"]
     pursuit = Pursuit(path, speed)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
-    per = max(1, round(CONTROL_PERIOD / backend.dt))
+    per = steps_per_command(backend.dt)
     limit = t + float(task["time_limit"])
     rows, commands = [(t, x, y, yaw)], []
     still_since, still_at, ended = t, (x, y), "time_limit"
@@ -159,9 +165,12 @@ def _backend(sim: str, folder: Path, meta: dict):
     from worldgen.sim.bridge import GazeboBackend, world_step
 
     sdf = _file(folder, meta, "sdf")
-    # The ground truth is published every physics step: the bridge waits for the one ending each command.
-    robot = robot_sdf(meta, gz_release="fortress", sensors=False, odom_rate=1.0 / world_step(sdf))
-    return GazeboBackend(sdf, robot)
+    # The ground truth is published once a command, at its last step: OdometryPublisher publishes when the
+    # time since its last message reaches its period, so a period half a step short of a command's steps
+    # lands on every command's end (the first at the end of the first), and no other message wakes the bridge.
+    dt = world_step(sdf)
+    robot = robot_sdf(meta, gz_release="fortress", sensors=False, odom_rate=1.0 / ((steps_per_command(dt) - 0.5) * dt))
+    return GazeboBackend(sdf, robot, first_steps=steps_per_command(dt))
 
 
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,

@@ -3,7 +3,7 @@
 //   drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW
 //
 // Fortress's ign-transport has no Python bindings, and one `ign service` call costs a process start
-// (about 0.1 s), so a controller at 50 Hz cannot drive through the `ign` command. This program stays up
+// (about 0.1 s), so a controller at 20 Hz cannot drive through the `ign` command. This program stays up
 // for a whole run. It first spawns the model in MODEL_SDF (a file) as NAME at (X, Y, Z, YAW) through
 // /world/WORLD/create (one request, answered within 30 s; the server is up and paused), which saves the
 // `ign service` process a spawn would otherwise cost. Then it speaks lines on stdin/stdout:

@@ -64,6 +64,11 @@ def stop_group(proc: subprocess.Popen, grace: float = 3.0) -> int | None:
     if proc.poll() is None or group_members(pgid):
         _signal_group(pgid, signal.SIGKILL)
     try:
-        return proc.wait(timeout=10)
+        status = proc.wait(timeout=10)
     except subprocess.TimeoutExpired:
         return None
+    # A killed grandchild stays listed (not yet a zombie) for a moment while the kernel tears it down.
+    deadline = time.monotonic() + 5.0
+    while group_members(pgid) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return status

@@ -236,14 +236,14 @@ def _timed(meta: dict, world) -> None:
 
 def _reproduce(folder: Path, meta: dict, world, entries) -> str:
     import worldgen
-    from worldgen.export.formats import FILE_NAMES, FORMATS
+    from worldgen.export.formats import ALL_FORMATS, FILE_NAMES
 
     if meta.get("worldgen_version") != worldgen.__version__:
         return f"written by worldgen {meta.get('worldgen_version')}, not compared byte for byte"
     listed = {key for key, _, _ in entries}
-    formats = [f for f in FORMATS if f in listed]
+    formats = [f for f in ALL_FORMATS if f in listed]
     if not formats:
-        raise _Fail("reproduce", "world.json lists none of the formats " + ", ".join(FORMATS))
+        raise _Fail("reproduce", "world.json lists none of the formats " + ", ".join(ALL_FORMATS))
     sdf_version = _sdf_version(folder / FILE_NAMES["sdf"]) if "sdf" in listed else "1.9"
     blobs = world.folder_blobs(formats, sdf_version, preview=False)
     fresh = json.loads(blobs.pop(METADATA_NAME))
