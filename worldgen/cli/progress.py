@@ -4,8 +4,9 @@ The library never writes to the terminal: long requests log what they are doing 
 :data:`LOGGER` (a level request its draws, ``worldgen.generate`` the attempt under way one level below,
 ``worldgen check`` its stages), which is silent unless someone listens. :func:`shown` listens while a
 command runs, and only when stderr is a terminal: from :data:`AFTER` seconds on it keeps one line up to
-date (the request's latest message, the attempt's after it, the time so far), redrawn every
-:data:`TICK` s even when no message comes, and wipes it before any result is printed and at the end.
+date (the request's latest message, the attempt's after it, the time so far), redrawn as a message comes
+(at most once a :data:`TICK`) and every :data:`TICK` s even when none comes, and wipes it before any result
+is printed and at the end.
 Piped or redirected, nothing is written. ``WORLDGEN_PROGRESS_AFTER`` (seconds) overrides :data:`AFTER`.
 """
 
@@ -38,7 +39,7 @@ class _Line(logging.Handler):
     def __init__(self, stream: TextIO, after: float):
         super().__init__(logging.INFO)
         self.stream, self.after, self.start = stream, after, time.monotonic()
-        self.request, self.attempt, self.drawn = "", "", False
+        self.request, self.attempt, self.drawn, self.last = "", "", False, -TICK
         self.guard, self.stop = threading.Lock(), threading.Event()  # not self.lock: logging.Handler has its own
         self.thread = threading.Thread(target=self._run, name="worldgen-progress", daemon=True)
 
@@ -49,6 +50,9 @@ class _Line(logging.Handler):
                 self.request, self.attempt = text, ""
             else:
                 self.attempt = text
+            fresh = time.monotonic() - self.last >= TICK
+        if fresh:  # a new stage shows at once (at most one redraw a tick), not only at the next tick
+            self.draw()
 
     def _run(self) -> None:
         while not self.stop.wait(TICK):
@@ -65,7 +69,7 @@ class _Line(logging.Handler):
             width = shutil.get_terminal_size((100, 24)).columns
             self.stream.write("\r" + text[:max(width - 1, 20)] + "\x1b[K")
             self.stream.flush()
-            self.drawn = True
+            self.drawn, self.last = True, time.monotonic()
 
     def clear(self) -> None:
         """Wipes the line (at the end)."""
