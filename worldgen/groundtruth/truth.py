@@ -18,9 +18,8 @@ from worldgen.params import COMMON_PARAMS
 from worldgen.scene import Pose
 from worldgen.scene.doors import open_scene
 
-__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "barn",
-           "barn_inputs",
-           "MAP_KEYS"]
+__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "start_occupancy_map", "doors_start_shut",
+           "occupancy_block", "map_files", "difficulty", "barn", "barn_inputs", "MAP_KEYS"]
 
 #: world.json ``files`` keys of the map's two files.
 MAP_KEYS = ("map_pgm", "map_yaml")
@@ -69,6 +68,21 @@ def occupancy_map(world) -> occupancy.OccupancyMap:
         _MAPS[world] = occupancy.build(planning_scene(world), float(_param(world, "map_height")),
                                        float(_param(world, "map_resolution")))
     return _MAPS[world]
+
+
+def doors_start_shut(world) -> bool:
+    """Whether a door leaf starts anywhere but at its open limit (closed or ajar): then the scene as it
+    starts differs from :func:`planning_scene`, and so does its map."""
+    from worldgen.scene.doors import door_joints, state_of
+
+    return any(state_of(joint) != "open" for joint in door_joints(world.scene))
+
+
+def start_occupancy_map(world) -> occupancy.OccupancyMap:
+    """The occupancy map of the scene as it starts (every door leaf where it starts), with map.pgm's
+    height, resolution and extent: what a localiser meets at the spawn. world.json's map stays
+    :func:`occupancy_map` (the planning scene); the ROS 2 bundle gives nav2 this one."""
+    return occupancy.build(world.scene, float(_param(world, "map_height")), float(_param(world, "map_resolution")))
 
 
 def occupancy_block(world) -> dict:
