@@ -282,8 +282,9 @@ class ConfigSpace:
         close = segment_segment_distance(ap, bp, obs.edge_a[e], obs.edge_b[e]) < r
         # A segment wholly inside a polygon crosses no edge: its start lies left of every edge.
         left = _cross(obs.edge_b[e] - obs.edge_a[e], ap - obs.edge_a[e]) >= 0
-        # Every polygon has edges, so each pair's run is non-empty: reduceat over the runs is exact.
-        blocked = np.logical_or.reduceat(close, starts) | np.logical_and.reduceat(left, starts)
+        # Per pair: any edge close, or every edge with the start on its left (counted, as ufunc.at would).
+        n = len(unsure)
+        blocked = (np.bincount(pair, close, n) > 0) | (np.bincount(pair, ~left, n) == 0)
         ok[seg[unsure][blocked]] = False
 
     def neighbour_pairs(self, circle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
