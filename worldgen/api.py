@@ -73,8 +73,9 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             map_extent = occupancy.extent(draft.scene, resolved["map_resolution"])
         report = feasibility.check(draft.scene, draft.tasks, robot)
         if resolved.get("n_people"):
+            from worldgen.people.behaviours import behaviours_of
             from worldgen.people.timed import certify
-            report = certify(report, draft.scene, draft.tasks, robot, resolved["robot_speed"])
+            report = certify(report, draft.scene, draft.tasks, robot, resolved["robot_speed"], behaviours_of(resolved))
         world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1, allow_infeasible)
         if report.feasible or (resolved.get("infeasible") and _infeasible_on_purpose(report)):
             return world

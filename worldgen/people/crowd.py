@@ -51,6 +51,7 @@ from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.planner import Planner
 from worldgen.feasibility.roadmap import Roadmap
 from worldgen.floats import round_float
+from worldgen.people.behaviours import widest_tube
 from worldgen.people.groups import GroupForce, group_force
 from worldgen.people.places import PERSON_HEIGHT, SLACK, draw_people, people_footprints
 from worldgen.scene import Mover, Robot, Scene, Task
@@ -381,7 +382,7 @@ def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     plan, reason = draw_people(scene, tasks, robot, params, rng)
     if plan is None:
         return (), reason
-    obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot))
+    obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot, widest_tube(params)))
     track = simulate(obstacles, scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius, plan.duration,
                      depart=plan.depart, groups=plan.groups)
     times = np.array([round_float(k * DT) for k in range(len(track))])
