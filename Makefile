@@ -9,7 +9,7 @@ ROS_STAMP := $(VENV)/.installed-ros
 TRAIN_STAMP := $(VENV)/.installed-train
 DEMO_OUT ?= demo-worlds
 
-.PHONY: demo test bench bench-learning fuzz clean
+.PHONY: demo test test-gazebo bench bench-learning fuzz clean
 
 $(STAMP): pyproject.toml
 	test -x $(PY) || $(PYTHON) -m venv $(VENV)
@@ -52,12 +52,19 @@ test: $(TEST_STAMP)
 	$(VENV)/bin/mypy
 	$(PY) -m pytest -q
 
+## test-gazebo: only the tests that run a real Gazebo server (every kind of world loaded and stepped, tests/sim;
+## marker `gazebo`; also part of `make test`); Gazebo from WORLDGEN_GAZEBO_SETUP or /opt/gz-fortress2
+## (docs/gazebo.md)
+test-gazebo: $(TEST_STAMP)
+	$(PY) -m pytest -q -m gazebo tests
+
 ## bench: per-stage medians for cluttered worlds against the serialisation floor, a 1,000-world pack
 ## with --jobs 2, the RL environment's steps/s and reset split, BARN's metrics against worldgen's
 ## (ratios over 40 worlds per generator) and barn_metrics' speed, `worldgen judge` on a 60 s bag and
 ## its peak memory over batches of 10 to 1,000 bags, the difficulty score against the probes' failures
 ## over 1,600 worlds, worlds made to a level, the reactive probe's success per level, a curriculum
-## reset against a plain one, and worlds with people (10, 20, 50) generated and certified; tables on
+## reset against a plain one, worlds with people (10, 20, 50) generated and certified, and `worldgen
+## drive` of a 10 m path in Gazebo (skipped without it) and MuJoCo; tables on
 ## stdout with each target met or missed,
 ## JSON in benchmarks/results/
 bench: $(RL_STAMP) $(ROS_STAMP)
@@ -71,6 +78,7 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	nice -n 10 $(PY) benchmarks/bench_ladder.py
 	$(PY) benchmarks/bench_curriculum.py
 	$(PY) benchmarks/bench_people.py
+	$(PY) benchmarks/bench_drive.py
 
 ## bench-learning: PPO (stable-baselines3) on one core learns worldgen/Navigation-v0 with the default
 ## reward and with `walkthrough`, against random, heuristic and path-follower baselines on held-out

@@ -163,7 +163,7 @@ def test_unknown_generator():
 def test_export_option_mistakes(world, tmp_path):
     with pytest.raises(ParameterError, match=r"^parameter 'sdf_version' must be one of 1\.9, 1\.6, got '2\.0'$"):
         world.to_sdf("2.0")
-    with pytest.raises(ParameterError, match=r"^parameter 'formats' must name formats among sdf, mjcf, urdf, got 'obj'$"):
+    with pytest.raises(ParameterError, match=r"^parameter 'formats' must name formats among sdf, mjcf, urdf, usd, usdc, got 'obj'$"):
         world.write(tmp_path, formats="sdf,obj")
     assert list(tmp_path.iterdir()) == []
     blocker = tmp_path / "file"
@@ -222,3 +222,18 @@ def test_every_generator_and_the_command_work_with_only_the_core_dependencies(tm
     )
     run = subprocess.run([sys.executable, "-c", script, str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert run.returncode == 0 and run.stdout.strip() == "ok", run.stderr[-2000:]
+
+
+def test_a_worlds_provenance_is_set_in_one_place():
+    """preset and difficulty_request are read-only: World.set_provenance is the one setter, and neither changes
+    the world's identity."""
+    world = worldgen.generate("minimal", seed=0)
+    before = world.content_hash
+    with pytest.raises(AttributeError):
+        world.preset = "somewhere"  # type: ignore[misc]
+    assert world.set_provenance(preset="drl_arena") is world and world.preset == "drl_arena"
+    assert world.folder_name == f"drl_arena--{world.world_id}" and world.content_hash == before
+    with pytest.raises(ParameterError, match="preset"):
+        world.set_provenance(preset=3)
+    world.set_provenance(difficulty_request={"level": "3/10"})
+    assert world.preset == "drl_arena" and world.difficulty_request == {"level": "3/10"}

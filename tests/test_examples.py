@@ -40,8 +40,8 @@ def test_diffdrive_example_report(tmp_path):
     assert run.returncode == 0, run.stdout + run.stderr
     report = json.loads((tmp_path / "report" / "report.json").read_text())
     assert report["passed"] is True and report["summary"]["runs"] == 20 and report["summary"]["collision_count"] == 0
-    assert report["summary"]["unreadable"] == 0 and {r["source"] for r in report["runs"]} == {"tf"}
-    assert (tmp_path / "report" / "report.csv").read_text().startswith("run,bag,readable,world_id,task,")
+    assert report["summary"]["unjudged"] == 0 and {r["source"] for r in report["runs"]} == {"tf"}
+    assert (tmp_path / "report" / "report.csv").read_text().startswith("run,bag,outcome,readable,world_id,task,")
     assert len(list((tmp_path / "bags").iterdir())) == 20
     assert run.stdout.splitlines()[-2] == "20 runs, 20 succeeded: PASS"
 

@@ -45,6 +45,12 @@ def test_the_same_request_gives_the_same_world_from_the_cli_in_another_process(t
     (folder,) = world_dirs(tmp_path)
     meta = json.loads((folder / "world.json").read_text())
     assert meta["world_id"] == worldgen.generate("cluttered", seed=3, difficulty="7/10").world_id
+    # The folder and the summary line say the level and the request's seed (the world's own seed is the
+    # draw that landed, 19 digits), and every draw the request took (was 'attempts 1' after 9 draws).
+    draws = len(meta["difficulty_request"]["draws"])
+    assert folder.name == f"L7-r3--{meta['world_id']}"
+    assert done.stdout == f"{folder}\tpath {meta['tasks'][0]['path']['length']:.3f} m\tlevel 7/10, request seed 3" \
+                          f"\tdraws {draws}\n"
     assert meta["metrics"]["difficulty_level"] == 7 and meta["difficulty_request"]["level"] == "7/10"
     checked = run("check", folder)  # a received world at a level re-verifies, its request included
     assert checked.returncode == 0, checked.stdout + checked.stderr

@@ -615,7 +615,7 @@ def test_pack_folders_of_preset_entries(tmp_path):
         assert w.folder == "worlds/" + (f"{meta['preset']}--" if "preset" in meta else "") + w.world_id
         assert w.path.is_dir()
     index = (tmp_path / "pack" / "index.csv").read_text().splitlines()
-    assert [line.split(",")[4] for line in index[1:]] == folders
+    assert [line.split(",")[6] for line in index[1:]] == folders  # after seed, level, request_seed
     verified = run("pack", "verify", tmp_path / "pack")
     assert verified.returncode == 0, verified.stdout + verified.stderr
 

@@ -82,6 +82,8 @@ def test_every_module_ships_and_imports(wheel_venv, tmp_path):
     assert first.startswith(str(wheel_venv)), f"imported worldgen from {first}, not the wheel"
     assert set(names) == source_modules()
     assert (Path(first).parent / "py.typed").is_file(), "the wheel must carry py.typed (PEP 561)"
+    # worldgen drive --sim gazebo compiles this source on first use
+    assert (Path(first).parent / "sim" / "drive_bridge.cc").is_file(), "the wheel must carry the Gazebo bridge source"
 
 
 @pytest.mark.parametrize("args", [

@@ -55,6 +55,9 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             raise
         resolved = validate_params(spec.all_params, params)
     robot = robot_from_params(resolved)
+    if resolved.get("n_people") and not allow_infeasible:  # a script no draw can play: refused before drawing
+        from worldgen.people.prechecks import refuse_unplayable
+        refuse_unplayable(spec, resolved, robot)
     failures: Counter[str] = Counter()
     details: dict[str, str] = {}
     last = None

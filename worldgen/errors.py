@@ -15,6 +15,11 @@ __all__ = [
     "SceneError",
     "OutputError",
     "MissingDependencyError",
+    "SimulatorMissingError",
+    "SimulatorError",
+    "BagError",
+    "CallOrderError",
+    "require_optional",
     "quoted",
     "did_you_mean",
     "read_user_text",
@@ -63,6 +68,10 @@ class InfeasibleError(WorldgenError):
         self.failures = dict(failures or {})
 
 
+class CallOrderError(WorldgenError, RuntimeError):
+    """A method called before what it needs (``step()`` before ``reset()``)."""
+
+
 class OutputError(WorldgenError, OSError):
     """The output folder cannot be written (missing permission, not a folder, ...)."""
 
@@ -70,9 +79,42 @@ class OutputError(WorldgenError, OSError):
 class MissingDependencyError(WorldgenError, ImportError):
     """An optional dependency that a feature needs is not installed; the message says what to install.
 
-    Here rather than beside one feature, so every stage with an optional extra (testing's statistics,
-    the environments) raises the same class.
+    Raised only by :func:`require_optional`, the one way any room asks for an optional extra.
     """
+
+
+class SimulatorMissingError(WorldgenError):
+    """A simulator that a feature runs (Gazebo, for ``worldgen.sim``) is not installed; the message says where
+    it was looked for and how to install it. A system program, not a Python extra, hence not a
+    :class:`MissingDependencyError`."""
+
+
+class SimulatorError(WorldgenError):
+    """A simulator ran but did not do what was asked (a world that never came up, a service that did not
+    answer), or printed what cannot be read."""
+
+    exit_status = EXIT_FAILED
+
+
+class BagError(WorldgenError, ValueError):
+    """A recorded run (a bag) cannot be used: missing, not a bag, truncated, or holding no pose source.
+
+    The reader library's own exceptions never reach a caller: they are re-raised as this, with the reason.
+    """
+
+
+def require_optional(module: str, extra: str, needs: str):
+    """The imported ``module``, or :class:`MissingDependencyError` saying what to install, in one line.
+
+    ``extra`` is the optional extra of worldgen's pyproject.toml that brings it; ``needs`` says who
+    needs it (``"worldgen.envs needs Gymnasium"``). A module blocked in ``sys.modules`` counts as missing.
+    """
+    import importlib
+
+    try:
+        return importlib.import_module(module)
+    except ImportError:
+        raise MissingDependencyError(f"{needs}, which is not installed: pip install 'worldgen[{extra}]'") from None
 
 
 def quoted(value, limit: int = QUOTE_LIMIT) -> str:

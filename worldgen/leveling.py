@@ -226,8 +226,8 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         got = score(world)
         draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"], "level": got["difficulty_level"]})
         if got["difficulty_level"] == level:
-            world.difficulty_request = {"level": f"{level}/{LEVELS}", "seed": seed, "knob": param, "draws": draws}
-            return world
+            return world.set_provenance(difficulty_request={"level": f"{level}/{LEVELS}", "seed": seed, "knob": param,
+                                                            "draws": draws})
         missed = level - (got["difficulty_level"] or level)
         value = min(max(value + step * missed, low), high)
     reached = sorted({d["level"] for d in draws if d["level"] is not None})

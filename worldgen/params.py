@@ -152,6 +152,13 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
         p = by_name[name]
         resolved[name] = p.check(given.get(name, p.default))
     if not resolved.get("n_people"):
+        # People's parameters without people would be accepted and do nothing: a mistake to say.
+        idle = [n for n in PEOPLE_PARAMS if n != "n_people" and n in by_name and given.get(n) is not None
+                and resolved[n] != by_name[n].check(by_name[n].default)]
+        if idle:
+            raise ParameterError(f"parameter '{idle[0]}' sets how people walk, and this world has none: set n_people "
+                                 f"(1 or more) too, or leave it out; got {idle[0]}={quoted(given[idle[0]])} and "
+                                 f"n_people={quoted(resolved.get('n_people', 0))}")
         # A world without people records none of their parameters, so that every world made before
         # people existed keeps its params, content_hash and bytes (docs/people.md).
         for name in PEOPLE_PARAMS:

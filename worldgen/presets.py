@@ -130,5 +130,4 @@ def generate_preset(name: str, seed: int = 0, *, allow_infeasible: bool = False,
 
     preset = load(name)
     world = generate(preset.generator, seed, allow_infeasible=allow_infeasible, **preset.merged(overrides))
-    world.preset = preset.name
-    return world
+    return world.set_provenance(preset=preset.name)

@@ -8,13 +8,14 @@ stream                          key                           used by
 ==============================  ============================  =====================================
 draw ``k`` of a world           ``(k,)``                      ``api.generate``, every generator
 its movers                      ``(k, MOVER_STREAM)``         ``generators.movers``
-its people                      ``(k, PEOPLE_STREAM)``        ``generators.people``
+its people                      ``(k, PEOPLE_STREAM)``        ``people.places``
 an environment's worlds         ``(WORLD_STREAM,)``           ``envs.navigation`` (reset's seed)
 an environment's sensor noise   ``(NOISE_STREAM,)``           ``envs.navigation`` (reset's seed)
 draw ``k`` towards a level      ``(LEVEL_STREAM, k)``         ``leveling`` (a world asked for at a level)
 an environment's curriculum     ``(CURRICULUM_STREAM,)``      ``envs.curriculum``, ``envs.replay`` (reset's seed)
-an edit of a level              ``(EDIT_STREAM,)``            ``editing`` (the edit's own seed)
+an edit of a level              ``(EDIT_STREAM,)``            ``verify.edits`` (the edit's own seed)
 a recipe's sampled parameter    ``[seed, entry, tag(name)]``  ``pack.recipe`` (entropy, no key)
+a baseline policy's actions     ``()``                        ``envs.policies`` (the policy's seed)
 ==============================  ============================  =====================================
 
 >>> float(attempt_rng(7, 0).random()) == float(attempt_rng(7, 0).random())
@@ -35,7 +36,7 @@ import numpy as np
 from worldgen.errors import ParameterError
 
 __all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "CURRICULUM_STREAM",
-           "EDIT_STREAM", "level_seed", "curriculum_rng", "edit_rng",
+           "EDIT_STREAM", "level_seed", "curriculum_rng", "edit_rng", "policy_rng",
            "check_seed", "attempt_rng", "mover_rng", "people_rng", "env_rngs", "draw_seed", "recipe_rng"]
 
 #: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
@@ -91,6 +92,12 @@ def env_rngs(entropy: int) -> tuple[np.random.Generator, np.random.Generator]:
 def curriculum_rng(entropy: int) -> np.random.Generator:
     """An environment's curriculum stream for a reset's seed (independent of its worlds and noise)."""
     return _stream(entropy, CURRICULUM_STREAM)
+
+
+def policy_rng(seed: int) -> np.random.Generator:
+    """A baseline policy's own stream (worldgen.envs.policies), from the seed it was made with. No key: the same
+    numbers as ``numpy.random.default_rng(seed)``, which the policies used before this module held them."""
+    return _stream(seed)
 
 
 def edit_rng(seed: int) -> np.random.Generator:

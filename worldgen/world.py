@@ -8,7 +8,7 @@ from functools import cached_property
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Optional, Sequence, Union
 
-from worldgen.errors import OutputError
+from worldgen.errors import OutputError, ParameterError
 from worldgen.export import formats as formats_table
 from worldgen.export.formats import FILE_NAMES, FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.files import METADATA_NAME, PREVIEW_NAME, refuse_other_world, write_folder_atomically
@@ -16,6 +16,9 @@ from worldgen.scene import Robot, Scene, Task
 
 __all__ = ["World", "FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats"]
 
+
+#: set_provenance's "leave it as it is".
+_UNCHANGED: Any = object()
 
 class World:
     """One world. Nothing here touches the disk until :meth:`write`.
@@ -40,10 +43,35 @@ class World:
         self.attempts = attempts
         self.allow_infeasible = bool(allow_infeasible)
         self.path: Optional[Path] = None  # the folder once written
-        self.preset: Optional[str] = None
-        #: How a world asked for at a difficulty level was reached (worldgen.leveling); None otherwise.
-        self.difficulty_request: Optional[dict] = None
-        self._texts: dict[tuple, str] = {}  # export()'s renderings, by (format, SDF version)
+        self._preset: Optional[str] = None
+        self._difficulty_request: Optional[dict] = None
+        self._blobs: dict[tuple, bytes] = {}  # export_bytes()'s renderings, by (format, SDF version)
+
+    @property
+    def preset(self) -> Optional[str]:
+        """The preset this world came from (world.json ``preset``, the folder name), or None."""
+        return self._preset
+
+    @property
+    def difficulty_request(self) -> Optional[dict]:
+        """How a world asked for at a difficulty level was reached (worldgen.leveling), or None."""
+        return self._difficulty_request
+
+    def set_provenance(self, *, preset: Any = _UNCHANGED, difficulty_request: Any = _UNCHANGED) -> "World":
+        """Record where this world came from: the one place its preset and its level request are set.
+
+        Neither is part of the world's identity (``content_hash``); both are written to world.json. Returns
+        the world, so a caller can chain it after ``generate``.
+        """
+        if preset is not _UNCHANGED:
+            if preset is not None and not isinstance(preset, str):
+                raise ParameterError(f"a world's preset must be a preset's name or None, got {preset!r}")
+            self._preset = preset
+        if difficulty_request is not _UNCHANGED:
+            if difficulty_request is not None and not isinstance(difficulty_request, dict):
+                raise ParameterError(f"a world's difficulty_request must be a dict or None, got {difficulty_request!r}")
+            self._difficulty_request = difficulty_request
+        return self
 
     def __repr__(self) -> str:
         try:
@@ -81,9 +109,14 @@ class World:
 
     @property
     def folder_name(self) -> str:
-        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, else ``world_id``,
-        so worlds of several presets over one generator can be told apart in one folder."""
-        return f"{self.preset}--{self.world_id}" if self.preset else self.world_id
+        """The folder :meth:`write` makes: ``<preset>--<world_id>`` for a preset's world, ``L<k>-r<request seed>--``
+        before the id for a world asked for at level k (its own seed is the draw that landed, 19 digits long), else
+        ``world_id``: worlds of several presets, or levels, over one generator can be told apart in one folder."""
+        name = self.world_id
+        if self.difficulty_request:
+            level = str(self.difficulty_request["level"]).split("/")[0]
+            name = f"L{level}-r{self.difficulty_request['seed']}--{name}"
+        return f"{self.preset}--{name}" if self.preset else name
 
     # -- in-memory exports -------------------------------------------------
     def to_sdf(self, version: str = "1.9") -> str:
@@ -99,16 +132,22 @@ class World:
         return self.export("urdf")
 
     def export(self, fmt: str, sdf_version: str = "1.9") -> str:
-        """The world's text in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and ``write``
-        share it (a World is a value: its scene and params do not change)."""
-        key = (fmt, sdf_version if fmt == "sdf" else None)
-        text = self._texts.get(key)
-        if text is None:
-            text = self._texts[key] = self._render(fmt, sdf_version)
-        return text
+        """The world's text in ``fmt`` (a text format: not ``usdc``, whose bytes :meth:`export_bytes` gives)."""
+        if fmt in formats_table.TABLE and formats_table.TABLE[fmt].binary:
+            raise OutputError(f"format {fmt!r} is binary, not text: use World.export_bytes({fmt!r})")
+        return self.export_bytes(fmt, sdf_version).decode()
 
-    def _render(self, fmt: str, sdf_version: str) -> str:
-        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version).decode()
+    def export_bytes(self, fmt: str, sdf_version: str = "1.9") -> bytes:
+        """The bytes of the world's file in ``fmt``, rendered once per world: ``to_*``, ``metadata`` and
+        ``write`` share them (a World is a value: its scene and params do not change)."""
+        key = (fmt, sdf_version if fmt == "sdf" else None)
+        data = self._blobs.get(key)
+        if data is None:
+            data = self._blobs[key] = self._render(fmt, sdf_version)
+        return data
+
+    def _render(self, fmt: str, sdf_version: str) -> bytes:
+        return formats_table.render(fmt, self.scene, self.world_id, self.params, sdf_version, world=self)
 
     def mesh_files(self) -> dict[str, bytes]:
         """Mesh files the exported formats refer to: relative path -> bytes."""
@@ -123,7 +162,8 @@ class World:
     def rendered_files(self, formats: Iterable[str] = FORMATS, sdf_version: str = "1.9") -> dict[str, tuple[str, bytes]]:
         """Every file of the world but world.json: ``{key: (relative path, bytes)}``."""
         formats = normalise_formats(formats)
-        files = {fmt: (FILE_NAMES[fmt], self.export(fmt, sdf_version).encode()) for fmt in formats}
+        formats_table.require_formats(formats)  # a missing extra: one line, before anything is rendered
+        files = {fmt: (FILE_NAMES[fmt], self.export_bytes(fmt, sdf_version)) for fmt in formats}
         if formats_table.uses_meshes(formats):
             for rel, data in self.mesh_files().items():
                 files[f"mesh:{rel}"] = (rel, data)

@@ -184,9 +184,9 @@ MISTAKES = {
     "seed in --set": (["generate", "cluttered", "--set", "seed=3", "--out", "{out}"],
                       r"error: unknown parameter 'seed' for generator 'cluttered' \(the seed is set with --seed\); known .*"),
     "bad formats": (["generate", "cluttered", "--formats", "sdf,obj", "--out", "{out}"],
-                    r"error: parameter 'formats' must name formats among sdf, mjcf, urdf, got 'obj'"),
+                    r"error: parameter 'formats' must name formats among sdf, mjcf, urdf, usd, usdc, got 'obj'"),
     "empty formats": (["generate", "cluttered", "--formats", ",", "--out", "{out}"],
-                      r"error: parameter 'formats' must name at least one of sdf, mjcf, urdf, got nothing"),
+                      r"error: parameter 'formats' must name at least one of sdf, mjcf, urdf, usd, usdc, got nothing"),
     "bad sdf version": (["generate", "cluttered", "--sdf-version", "1.7", "--out", "{out}"],
                         r"error: Invalid value for '--sdf-version': '1\.7' is not one of '1\.9', '1\.6'\..*"),
     "negative seed": (["generate", "cluttered", "--seed", "-1", "--out", "{out}"],
@@ -358,3 +358,15 @@ def test_make_demo_ends_with_what_to_try_next_and_each_suggestion_works(tmp_path
     assert shown.returncode == 0 and shown.stdout.startswith("cluttered: "), shown.stderr
     assert (root / example[1]).is_file()
     assert pack[1:4] == ["pack", "build", "examples/recipes/ci_smoke.yaml"] and (root / pack[3]).is_file()
+
+
+def test_check_given_a_folder_of_worlds_is_a_usage_mistake(tmp_path):
+    """It exited 1 (a folder that fails) where the mistake is the argument: exit 2 and how to give them."""
+    for seed in (0, 1):
+        worldgen.generate("minimal", seed=seed).write(tmp_path / "worlds", preview=False)
+    done = run("check", tmp_path / "worlds")
+    assert done.returncode == 2 and done.stdout == "", done.stdout
+    assert done.stderr == (f"error: '{tmp_path / 'worlds'}' is a folder of 2 world folders, not a world folder "
+                           f"(no world.json); give them: worldgen check {tmp_path / 'worlds'}/*\n")
+    each = run("check", *world_dirs(tmp_path / "worlds"))
+    assert each.returncode == 0 and each.stdout.count("OK ") == 2, each.stdout + each.stderr

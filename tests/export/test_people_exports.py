@@ -25,6 +25,7 @@ from support.reftools_sdf import dump_sdf
 import worldgen
 from worldgen.errors import WorldgenError
 from worldgen.export.actor_path import TENSION, WAYPOINT_TOLERANCE, actor_waypoints
+from worldgen.export.sdf import HOLD_SECONDS
 from worldgen.scene.motion import drive_mocap, positions_at
 
 #: Agreement promised between the formats (m).
@@ -146,10 +147,13 @@ def test_sdf_actors_as_libsdformat_reads_them_follow_world_json_within_a_millime
     for person in meta["people"]:
         rows = np.array(person["trajectory"])
         actor = actors[person["name"]]
-        assert not actor["loop"] and list(actor["trajectories"]) == [0]
+        # Written looping, with a last leg standing at the last row for HOLD_SECONDS: a script that does not
+        # loop hangs Gazebo Sim once a rendering sensor plays it (docs/gazebo.md).
+        assert actor["loop"] and list(actor["trajectories"]) == [0]
         script = actor["trajectories"][0]
         assert script["tension"] == TENSION == 0.0
         waypoints = np.array(script["waypoints"])[:, :4]
+        assert waypoints[-1, :3].tolist() == [rows[-1, 0] + HOLD_SECONDS, rows[-1, 1], rows[-1, 2]]
         assert waypoints[0, 0] == 0.0 and np.all(waypoints[:, 3] == 0.0)
         times = sample_times(waypoints, rows, rng)
         assert len(times) >= 1000

@@ -218,7 +218,7 @@ def test_the_legend_lists_what_the_world_has():
     moving = names(worldgen.generate("cluttered", 0, size=[8, 8], n_obstacles=3, n_movers=1))
     assert "mover" in moving and "door" not in moving
     people = names(worldgen.generate("cluttered", 1, size=[8, 8], n_obstacles=3, n_people=2))
-    assert "person (dot every 5 s)" in people and "mover" not in people
+    assert "people (a colour each, dot every 5 s)" in people and "mover" not in people
     door = worldgen.generate("door", 2)
     assert door.metadata["tasks"][0]["requires_door_open"]
     assert {"door", "path (opens a door)"} <= set(names(door)) and "path" not in names(door)
@@ -237,3 +237,21 @@ def test_floor_no_footprint_reaches_is_muted_and_the_corridor_is_not(tmp_path):
     a, b = wp[0], wp[1]
     off = a + 0.25 * (b - a) + np.array([0.0, 0.25])
     assert _close(image.getpixel(_pixel_of(meta, *off)), COLOURS["floor"], tol=12)
+
+
+def test_many_people_each_in_a_colour_and_the_title_names_preset_and_level():
+    """preview.png of 10 people was a tangle of one-colour tracks; its title named neither preset nor level."""
+    from worldgen.export.preview_frame import title_lines
+    from worldgen.export.topdown import PERSON_COLOURS
+    from worldgen.presets import generate_preset
+
+    crowd = worldgen.generate("cluttered", 3, size=[12, 12], n_obstacles=6, n_people=10, people_duration=20.0)
+    colours = {c for _, c in draw(crowd.metadata).getcolors(1 << 20)}
+    assert set(PERSON_COLOURS) <= colours  # a colour per person, each drawn solid somewhere (its start ring)
+    head, parts = title_lines(crowd.metadata)
+    assert head == crowd.world_id and parts[:2] == [f"level {crowd.metadata['metrics']['difficulty_level']}/10",
+                                                     "10 people"]
+    preset = generate_preset("person_head_on")
+    assert title_lines(preset.metadata)[0] == f"person_head_on--{preset.world_id}"
+    asked = worldgen.generate("cluttered", 3, size=[8, 8], difficulty="4/10")
+    assert title_lines(asked.metadata)[1][0] == "level 4/10 (request seed 3)"

@@ -149,3 +149,37 @@ def test_barn_inputs_of_a_world_are_what_metrics_barn_uses():
         truth.barn_inputs(world, task=1)
     with pytest.raises(worldgen.errors.InfeasibleError, match="no reference path"):
         truth.barn_inputs(worldgen.generate("cluttered", seed=0, infeasible=True))
+
+
+def _walked(occ, r, c, dr, dc) -> int:
+    """Free cells from (r, c) along (dr, dc) before a wall or the grid's edge, one step at a time."""
+    n = 0
+    while 0 <= r + (n + 1) * dr < occ.shape[0] and 0 <= c + (n + 1) * dc < occ.shape[1] \
+            and not occ[r + (n + 1) * dr, c + (n + 1) * dc]:
+        n += 1
+    return n
+
+
+def test_free_runs_and_closest_wall_against_walking_and_every_wall():
+    """The binary searches and the column window (barn._free_runs, barn._closest_wall) against the plain
+    definitions: a walk step by step, and the nearest of every wall cell, on random grids."""
+    rng = np.random.default_rng(30)
+    for _ in range(300):
+        rows, cols = (int(v) for v in rng.integers(1, 40, 2))
+        # Sparse grids too: there the nearest wall is often off every line through the cell.
+        occ = rng.random((rows, cols)) < rng.choice([0.0, 0.005, 0.01, 0.02, 0.05, 0.1, 0.3, 0.6])
+        r, c = rng.integers(0, rows, 40), rng.integers(0, cols, 40)
+        wall = occ[r, c]
+        runs = barn._free_runs(occ, r, c)
+        assert len(runs) == 8
+        for (dr, dc), got in runs.items():
+            want = [-1 if w else _walked(occ, int(i), int(j), dr, dc) for i, j, w in zip(r, c, wall)]
+            assert got.tolist() == want, (dr, dc)
+        got = barn._closest_wall(occ, r, c, wall, runs)
+        wr, wc = np.nonzero(occ)
+        for k in range(len(r)):
+            if not occ.any():
+                want = float((rows - 1) // 2)
+            else:
+                want = 0.0 if wall[k] else math.sqrt(int(((wr - r[k]) ** 2 + (wc - c[k]) ** 2).min()))
+            assert got[k] == want

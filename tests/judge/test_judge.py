@@ -46,11 +46,14 @@ def test_clean_runs_pass_the_gate(setup, tmp_path):
     out = tmp_path / "report"
     r = run("judge", setup["clean"], setup["idle"], "--world", setup["world"], "--criteria", setup["criteria"], "--out", out)
     assert r.returncode == 0, r.stderr
-    assert r.stdout.splitlines()[0] == "2 bags, 2 judged, 2 succeeded, 0 unreadable: PASS"
+    assert r.stdout.splitlines()[0] == "2 bags, 2 judged, 2 succeeded, 0 unjudged: PASS" and r.stderr == ""
     report = _report(out)
-    assert report["passed"] is True and report["summary"]["unreadable"] == 0
+    assert report["passed"] is True and report["summary"]["unjudged"] == 0
     clean, idle = report["runs"]
-    assert clean["run"] == "clean" and idle["run"] == "idle"  # from the bag's metadata, else its name
+    world_id = oracles.load(setup["world"]).meta["world_id"]
+    # <world>__<task>__ and the run's own name from the bag's metadata, else the first free index
+    assert clean["run"] == f"{world_id}__task_0__clean" and idle["run"] == f"{world_id}__task_0__run0"
+    assert clean["outcome"] == idle["outcome"] == "success"
     assert clean["source"] == idle["source"] == "tf" and clean["start"] == "command"
     assert idle["start_time"] == pytest.approx(4.0)
     # the idle seconds before the first command do not count: the same drive, the same time to goal
@@ -61,7 +64,7 @@ def test_clean_runs_pass_the_gate(setup, tmp_path):
     assert clean["min_clearance"] == pytest.approx(truth.min_clearance, abs=1e-9)
     with (out / "report.csv").open() as f:
         rows = list(csv.DictReader(f))
-    assert [r["run"] for r in rows] == ["clean", "idle"] and rows[0]["success"] == "True"
+    assert [r["run"] for r in rows] == [clean["run"], idle["run"]] and rows[0]["success"] == "True"
     md = (out / "report.md").read_text()
     assert md.startswith("# Run report: PASS\n") and "| navigation.success_rate | >= 1 | 1 | PASS |" in md
     for row in report["runs"]:
@@ -86,7 +89,7 @@ def test_a_collision_fails_the_gate_and_is_drawn(setup, tmp_path):
     assert COLOURS["contact"] in colours and COLOURS["path"] in colours and COLOURS["spawn"] in colours
 
 
-def test_an_unreadable_bag_is_a_row_and_fails_the_gate(setup, tmp_path):
+def test_an_unreadable_bag_is_an_unjudged_row_named_on_stderr_and_fails_the_gate(setup, tmp_path):
     broken = tmp_path / "broken.mcap"
     data = next(setup["clean"].glob("*.mcap")).read_bytes()
     broken.write_bytes(data[: len(data) // 3])
@@ -94,12 +97,45 @@ def test_an_unreadable_bag_is_a_row_and_fails_the_gate(setup, tmp_path):
     r = run("judge", setup["clean"], broken, "--world", setup["world"], "--out", out)
     assert r.returncode == 1, r.stderr
     report = _report(out)
-    assert report["summary"]["unreadable"] == 1 and report["summary"]["bags"] == 2 and report["summary"]["runs"] == 1
+    assert report["summary"]["unjudged"] == 1 and report["summary"]["bags"] == 2 and report["summary"]["runs"] == 1
     row = report["runs"][1]
-    assert row["readable"] is False and row["run"] == "broken" and "cannot be read as a ROS bag" in row["reason"]
-    assert "bags: 1 of 2 could not be read; a gate does not pass on missing data" in report["failures"]
+    assert row["outcome"] == "unjudged" and row["success"] is None and row["readable"] is False
+    world_id = oracles.load(setup["world"]).meta["world_id"]
+    assert row["run"] == f"{world_id}__task_0__run0" and "cannot be read as a ROS bag" in row["reason"]
+    assert "bags: 1 of 2 could not be judged; a gate does not pass on missing data" in report["failures"]
+    lines = r.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"unjudged {broken}: cannot be read as a ROS bag (")
     only_broken = run("judge", broken, "--world", setup["world"], "--out", tmp_path / "r2")
     assert only_broken.returncode == 1 and _report(tmp_path / "r2")["summary"]["runs"] == 0
+
+
+def test_every_refused_bag_gets_a_line_then_a_count(setup, tmp_path):
+    missing = [tmp_path / f"gone{k:02d}" for k in range(23)]
+    r = run("judge", *missing, "--world", setup["world"], "--out", tmp_path / "r")
+    assert r.returncode == 1
+    lines = r.stderr.splitlines()
+    assert lines[:20] == [f"unjudged {m}: does not exist" for m in missing[:20]]
+    assert lines[20:] == ["... and 3 more not judged or failed (every one in report.md)"]
+
+
+def test_an_empty_pack_folder_or_a_missing_one_is_a_usage_mistake(setup, tmp_path):
+    (tmp_path / "empty").mkdir()
+    for pack, message in ((tmp_path / "nowhere", "does not exist"), (tmp_path / "empty", "neither a pack")):
+        r = run("judge", setup["clean"], "--pack", pack, "--out", tmp_path / "r")
+        assert r.returncode == 2 and message in r.stderr and len(r.stderr.splitlines()) == 1, r.stdout + r.stderr
+        assert not (tmp_path / "r").exists()
+
+
+def test_run_names_are_unique_and_readable_across_worlds(tmp_path):
+    """The bundle's launch files number runs per world (worldgen.run 0 in every world): names carry the world."""
+    worlds = [small_world(tmp_path / "worlds", seed=s) for s in (0, 1, 2)]
+    bags = [write_bag(tmp_path / "bags" / f"w{k}", w, along(w), storage="mcap", run="0") for k, w in enumerate(worlds)]
+    r = run("judge", *bags, "--pack", tmp_path / "worlds", "--out", tmp_path / "r")
+    assert r.returncode == 0, r.stdout + r.stderr
+    report = _report(tmp_path / "r")
+    ids = [oracles.load(w).meta["world_id"] for w in worlds]
+    assert [row["run"] for row in report["runs"]] == [f"{i}__task_0__run0" for i in ids]
+    assert sorted(p.name for p in (tmp_path / "r" / "runs").iterdir()) == sorted(f"{i}__task_0__run0.png" for i in ids)
 
 
 def test_worlds_named_in_the_bags_metadata_and_a_runs_table(setup, tmp_path):
@@ -113,17 +149,36 @@ def test_worlds_named_in_the_bags_metadata_and_a_runs_table(setup, tmp_path):
     # No criteria: the gate is that every run meets its scenario, and the crash does not.
     assert r.returncode == 1, r.stderr
     report = _report(tmp_path / "b")
-    assert [row["run"] for row in report["runs"]] == ["first", "second"]
+    world_id = oracles.load(setup["world"]).meta["world_id"]
+    assert [row["run"] for row in report["runs"]] == [f"{world_id}__task_0__first", f"{world_id}__task_0__second"]
     assert [row["success"] for row in report["runs"]] == [True, False]
     assert report["failures"][0].startswith("navigation.success_rate: required >= 1, measured 0.5")
 
 
-def test_a_bag_from_another_world_is_an_unreadable_row(setup, tmp_path):
+def test_a_bag_from_another_world_is_a_failed_run_not_an_unreadable_one(setup, tmp_path):
     other = small_world(tmp_path / "other", seed=1)
     r = run("judge", setup["clean"], "--world", other, "--out", tmp_path / "r")
     assert r.returncode == 1
-    reason = _report(tmp_path / "r")["runs"][0]["reason"]
-    assert "was recorded in world" in reason or "from the task's spawn" in reason
+    report = _report(tmp_path / "r")
+    row = report["runs"][0]
+    assert row["outcome"] == "failure" and row["success"] is False and row["readable"] is True
+    assert "was recorded in world" in row["reason"]
+    assert report["summary"]["runs"] == 1 and report["summary"]["unjudged"] == 0
+    assert r.stderr.splitlines() == [f"failed {row['run']} ({setup['clean']}): {row['reason']}"]
+    assert "could not be" not in r.stdout
+
+
+def test_a_run_that_starts_far_from_the_spawn_is_a_failed_run_with_its_distance(setup, tmp_path):
+    shifted = along(setup["world"])
+    shifted[:, 1] += 6.4 if shifted[0, 1] < 0 else -6.4
+    bag = write_bag(tmp_path / "far", setup["world"], shifted, storage="mcap")
+    r = run("judge", bag, "--world", setup["world"], "--out", tmp_path / "r")
+    assert r.returncode == 1
+    report = _report(tmp_path / "r")
+    row = report["runs"][0]
+    assert row["outcome"] == "failure" and "the run starts 6.40 m from the task's spawn" in row["reason"]
+    assert report["summary"]["runs"] == 1 and report["summary"]["successes"] == 0
+    assert report["summary"]["unjudged"] == 0 and r.stderr.startswith(f"failed {row['run']} ({bag}): the run starts 6.40 m")
 
 
 @pytest.mark.parametrize("args,message", [
@@ -204,3 +259,27 @@ def test_the_progress_bar_goes_to_stderr_when_asked(setup, tmp_path):
     assert r.returncode == 0 and r.stderr.splitlines() == ["judging: 1 of 2 bags (50%)", "judging: 2 of 2 bags (100%)"]
     quiet = run("judge", setup["clean"], "--world", setup["world"], "--out", tmp_path / "q")
     assert quiet.returncode == 0 and quiet.stderr == ""  # not a terminal: no bar
+
+
+def test_a_run_among_people_is_drawn_with_the_people_where_they_were_at_the_contact(tmp_path):
+    """The caption said 'collision with person_0 at t=4.55 s' over an empty line: now the person is drawn."""
+    from worldgen.export.preview import layout
+    from worldgen.export.topdown import PERSON_COLOURS, discs_at
+    from worldgen.judge.report import _HEADER, _WIDTH
+    from worldgen.presets import generate_preset
+
+    world = generate_preset("person_head_on").write(tmp_path / "worlds", preview=False)
+    bag = write_bag(tmp_path / "bags" / "straight", world, along(world), storage="mcap")  # no yielding: it meets the person
+    r = run("judge", bag, "--world", world, "--out", tmp_path / "r")
+    assert r.returncode == 1
+    row = _report(tmp_path / "r")["runs"][0]
+    person = next(c for c in row["collisions"] if c["entity"] == "person_0")
+    meta = oracles.load(world).meta
+    (_, x, y, radius, colour), = [d for d in discs_at(meta, person["time"]) if d[0] == "person_0"]
+    assert colour == PERSON_COLOURS[0]
+    lay = layout(meta, _WIDTH)
+    with Image.open(tmp_path / "r" / row["picture"]) as img:
+        rgb = img.convert("RGB")
+        u, v = lay.px(x + 0.6 * radius, y)  # inside the person's disc, off the crossed-out robot at its centre
+        assert rgb.getpixel((round(u), round(v) + _HEADER)) == PERSON_COLOURS[0]
+        assert {c for _, c in rgb.getcolors(1 << 20)} >= {PERSON_COLOURS[0], (200, 30, 30)}

@@ -75,7 +75,7 @@ def test_build_writes_manifest_index_and_every_world(built, capsys):
         assert meta["params"] == w["params"] and meta["seed"] == w["seed"] and meta.get("preset") == w.get("preset")
         assert w["metrics"]["narrowest_passage"] == meta["metrics"]["narrowest_passage"]
     rows = (pack / "index.csv").read_text().splitlines()
-    assert len(rows) == 15 and rows[0].startswith("index,world_id,generator,seed,folder,obstacle_count")
+    assert len(rows) == 15 and rows[0].startswith("index,world_id,generator,seed,level,request_seed,folder,obstacle_count")
     assert {w["generator"] for w in manifest["worlds"]} == {"cluttered", "corridor"}
 
 

@@ -75,8 +75,32 @@ def test_the_manifest_records_each_worlds_level_and_the_pack_verifies(tmp_path):
     manifest = json.loads((out / "manifest.json").read_text())
     assert [w["level"] for w in manifest["worlds"]] == [1, 1, 4, 4, 6, 7]
     for w in manifest["worlds"]:
-        meta = json.loads((out / "worlds" / w["world_id"] / "world.json").read_text())
+        folder = f"L{w['level']}-r{w['request_seed']}--{w['world_id']}"  # the level and request seed, then the id
+        meta = json.loads((out / "worlds" / folder / "world.json").read_text())
         assert meta["metrics"]["difficulty_level"] == w["level"]
         # The world's own seed is the draw that landed; the request's seed is kept beside it.
         assert meta["seed"] == w["seed"] and meta["difficulty_request"]["seed"] == w["request_seed"]
     assert all(ok for ok, _ in verify_pack(out, regenerate=True))
+
+
+def test_a_pack_by_levels_filters_and_counts_by_level(tmp_path):
+    """index.csv, `pack ls --where` and `pack info` know the level (was: 'difficulty_level' an unknown metric)."""
+    import csv
+
+    from support.cli import run
+
+    out = tmp_path / "ladder"
+    build_pack(parse(LADDER), out, jobs=1)
+    with (out / "index.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert [(r["level"], r["difficulty_level"]) for r in rows] == [(str(k), str(k)) for k in (1, 1, 4, 4, 6, 7)]
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert [r["request_seed"] for r in rows] == [str(w["request_seed"]) for w in manifest["worlds"]]
+    listed = run("pack", "ls", out, "--where", "difficulty_level >= 5")
+    assert listed.returncode == 0, listed.stderr
+    assert [line.split("\t")[1] for line in listed.stdout.splitlines()] == [w["world_id"] for w in manifest["worlds"][4:]]
+    assert all(line.endswith(("difficulty_level=6", "difficulty_level=7")) for line in listed.stdout.splitlines())
+    info = run("pack", "info", out)
+    assert info.returncode == 0 and "difficulty levels: 1: 2, 4: 2, 6: 1, 7: 1" in info.stdout.splitlines()
+    assert "asked for by level: 6 worlds at levels 1, 4, 6, 7" in info.stdout.splitlines()
+    assert "  difficulty_level: min 1, max 7" in info.stdout.splitlines()

@@ -15,6 +15,7 @@ import worldgen
 from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.export import metadata
 from worldgen.export.actor_path import TENSION, actor_waypoints, spline_positions
+from worldgen.export.sdf import HOLD_SECONDS, script_rows
 from worldgen.export.xml import parse_bytes
 from worldgen.people.places import KEEP_OUT, LEG_MAX, LEG_MIN, SLACK, draw_people, people_footprints
 from worldgen.scene.footprint import FootprintIndex
@@ -66,7 +67,7 @@ def test_world_json_lists_people_apart_from_movers(world):
     assert meta["robot"]["max_speed"] == 0.5 and meta["params"]["n_people"] == 4
 
 
-def test_sdf_actors_do_not_loop_and_carry_the_rows(world, tmp_path):
+def test_sdf_actors_play_the_rows_once_and_then_stand(world, tmp_path):
     folder = world.write(tmp_path)
     sdf = folder / "world.sdf"
     ok, messages = check_sdf(sdf)
@@ -75,11 +76,14 @@ def test_sdf_actors_do_not_loop_and_carry_the_rows(world, tmp_path):
     actors = {a.get("name"): a for a in parse_bytes(sdf.read_bytes()).getroot().findall("world/actor")}
     for p in meta["people"]:
         actor = actors[p["name"]]
-        assert actor.findtext("script/loop") == "false"
+        # Written looping, the rows then a stay of HOLD_SECONDS at the last one: a script that does not loop
+        # hangs Gazebo Sim with a rendering sensor (docs/gazebo.md).
+        assert actor.findtext("script/loop") == "true"
         points = [(float(w.findtext("time")), *map(float, w.findtext("pose").split()[:2]))
                   for w in actor.findall("script/trajectory/waypoint")]
         # The rows, with points added on the legs for Gazebo's spline (tests/export/test_people_exports.py).
-        np.testing.assert_array_equal(np.array(points), actor_waypoints(p["trajectory"]))
+        np.testing.assert_array_equal(np.array(points), actor_waypoints(script_rows(p["trajectory"], False)))
+        assert points[-1] == (p["trajectory"][-1][0] + HOLD_SECONDS, *p["trajectory"][-1][1:])
     links = {link.get("name") for link in parse_bytes((folder / "world.urdf").read_bytes()).getroot().findall("link")}
     assert not links & {p["name"] for p in meta["people"]}
 
@@ -143,7 +147,7 @@ def test_a_standing_person_stands_still_in_every_format(tmp_path):
     assert float(actor.find("script/trajectory").get("tension")) == TENSION
     points = np.array([(float(w.findtext("time")), *map(float, w.findtext("pose").split()[:2]))
                        for w in actor.findall("script/trajectory/waypoint")])
-    np.testing.assert_array_equal(points, actor_waypoints(rows))
+    np.testing.assert_array_equal(points, actor_waypoints(script_rows(rows, False)))
     np.testing.assert_array_equal(points[:2], rows[:2])  # the stay: its two rows, nothing between
     stay = np.linspace(0.0, 8.0, 8001)
     assert np.hypot(*(spline_positions(points, stay) - centre).T).max() <= 1e-3

@@ -11,7 +11,7 @@ import pytest
 from support.runs import along, idle_then, small_world, spawn_of, toward, write_bag
 
 from worldgen import oracles
-from worldgen.errors import ParameterError
+from worldgen.errors import BagError
 from worldgen.ros import read_run
 
 pytest.importorskip("rosbags")
@@ -129,17 +129,17 @@ def test_a_collision_run_reads_back_with_its_contact(world, tmp_path):
 
 def test_a_missing_topic_is_one_line_naming_the_topics_found(world, tmp_path):
     no_cmd = write_bag(tmp_path / "nocmd", world, along(world), topics=("clock", "odom", "tf"))
-    with pytest.raises(ParameterError) as err:
+    with pytest.raises(BagError) as err:
         read_run(no_cmd, world)
     msg = str(err.value)
     assert "\n" not in msg and "needs /cmd_vel" in msg and "/odom (nav_msgs/msg/Odometry)" in msg and "/tf " in msg
     assert read_run(no_cmd, world, start="bag").source == "tf"  # the bag's start needs no command
     no_pose = write_bag(tmp_path / "nopose", world, along(world), topics=("clock", "cmd_vel"))
-    with pytest.raises(ParameterError, match=r"no pose source: need /ground_truth, /tf with map->odom->base_footprint"
+    with pytest.raises(BagError, match=r"no pose source: need /ground_truth, /tf with map->odom->base_footprint"
                                              r"\|base_link, or /odom; topics found: /clock \(rosgraph_msgs/msg/Clock\), "
                                              r"/cmd_vel \(geometry_msgs/msg/Twist\)$"):
         read_run(no_pose, world)
-    with pytest.raises(ParameterError, match="start='goal' needs a goal topic"):
+    with pytest.raises(BagError, match="start='goal' needs a goal topic"):
         read_run(write_bag(tmp_path / "nogoal", world, along(world)), world, start="goal")
 
 
@@ -149,7 +149,7 @@ def test_a_truncated_file_is_one_line(world, tmp_path, storage):
     data = _single_file(bag)
     data.write_bytes(data.read_bytes()[: data.stat().st_size // 2])
     for path in (bag, data):
-        with pytest.raises(ParameterError) as err:
+        with pytest.raises(BagError) as err:
             read_run(path, world)
         assert "\n" not in str(err.value) and "cannot be read as a ROS bag" in str(err.value)
         assert str(err.value).startswith(f"bag '{path}'")
@@ -163,7 +163,8 @@ def test_a_run_that_does_not_start_at_the_spawn_names_the_distance(world, tmp_pa
     bag = tmp_path / "run"
     from worldgen.ros import write_run
     write_run(bag, moved, spawn=tuple(moved[0, 1:4]), world_id="elsewhere")  # odometry zeroed where it really started
-    with pytest.raises(ParameterError) as err:
+    from worldgen.ros import RunMismatchError
+    with pytest.raises(RunMismatchError) as err:  # a BagError: read, but not this task's run
         read_run(bag, world)
     msg = str(err.value)
     assert "\n" not in msg and "the run starts 1.00 m from the task's spawn" in msg and "spawn_tolerance 0.25 m" in msg
@@ -198,9 +199,9 @@ def test_mcap_bags_decode_with_the_official_mcap_reader(world, tmp_path):
 def test_reading_needs_rosbags_and_says_what_to_install(monkeypatch, tmp_path):
     import sys
 
-    from worldgen.ros.deps import MissingRosbagsError
+    from worldgen.errors import MissingDependencyError
     monkeypatch.setitem(sys.modules, "rosbags", None)
-    with pytest.raises(MissingRosbagsError, match=r"pip install 'worldgen\[ros\]'$"):
+    with pytest.raises(MissingDependencyError, match=r"pip install 'worldgen\[ros\]'$"):
         read_run(tmp_path / "x")
 
 
@@ -218,3 +219,80 @@ def test_a_bag_without_message_definitions_reads_with_the_release_typestore(worl
         run = read_run(bag, world, distro=distro)
         assert run.source == "tf"
         np.testing.assert_allclose(run.trajectory[:, :3], truth[:, :3], atol=1e-9)
+
+
+# -- bags holding no pose topic, like ROS 2's own test bags: refused by their topic list alone -------------
+
+_EVENT = """\
+service_msgs/msg/ServiceEventInfo info
+test_msgs/msg/BasicTypes_Request[<=1] request
+test_msgs/msg/BasicTypes_Response[<=1] response
+"""
+
+
+def _foreign_bag(path, kind: str, storage: str):
+    """A bag as rosbag2's own tests record them: /rosout only, a std_msgs/String chatter, or service events."""
+    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
+    store = get_typestore(Stores.ROS2_JAZZY)
+    if kind == "events":
+        fields = "bool bool_value\nint32 int32_value\nstring string_value\n"
+        types = get_types_from_msg(fields, "test_msgs/msg/BasicTypes_Request")
+        types |= get_types_from_msg(fields, "test_msgs/msg/BasicTypes_Response")
+        (event,) = get_types_from_msg(_EVENT, "test_msgs/msg/BasicTypes_Event").values()
+        store.register(types | {"test_msgs/srv/BasicTypes_Event": event})  # the name rosbag2 records
+    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
+    with Writer(path, version=9, storage_plugin=plugin) as writer:
+        for k in range(5):
+            if kind == "rosout":
+                Log, Time = store.types["rcl_interfaces/msg/Log"], store.types["builtin_interfaces/msg/Time"]
+                msg, topic = Log(stamp=Time(sec=k, nanosec=0), level=20, name="talker", msg=f"hello {k}", file="t.cpp",
+                                 function="main", line=k), "/rosout"
+            elif kind == "string":
+                msg, topic = store.types["std_msgs/msg/String"](data=f"hello {k}"), "/chatter"
+            else:
+                T = store.types
+                info = T["service_msgs/msg/ServiceEventInfo"](
+                    event_type=0, stamp=T["builtin_interfaces/msg/Time"](sec=k, nanosec=0), client_gid=np.zeros(16, np.uint8),
+                    sequence_number=k)
+                req = T["test_msgs/msg/BasicTypes_Request"](bool_value=True, int32_value=k, string_value="x")
+                msg, topic = T["test_msgs/srv/BasicTypes_Event"](info=info, request=[req], response=[]), \
+                    "/test_service/_service_event"
+            if k == 0:
+                conn = writer.add_connection(topic, msg.__msgtype__, typestore=store)
+            writer.write(conn, k * 10**9, store.serialize_cdr(msg, msg.__msgtype__))
+    return path
+
+
+@pytest.mark.parametrize("kind,topic", [("rosout", "/rosout (rcl_interfaces/msg/Log)"),
+                                        ("string", "/chatter (std_msgs/msg/String)"),
+                                        ("events", "/test_service/_service_event (test_msgs/srv/BasicTypes_Event)")])
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_a_bag_without_a_pose_topic_is_refused_by_its_topic_list_without_decoding(world, tmp_path, monkeypatch,
+                                                                                  kind, topic, storage):
+    from rosbags.highlevel import AnyReader
+
+    from worldgen.ros import bagio
+
+    bag = _foreign_bag(tmp_path / kind, kind, storage)
+    calls = {"messages": 0, "decoder": 0}
+    messages, decoder = AnyReader.messages, bagio.decoder
+
+    def counted_messages(self, *a, **kw):
+        calls["messages"] += 1
+        return messages(self, *a, **kw)
+
+    def counted_decoder(*a, **kw):
+        calls["decoder"] += 1
+        return decoder(*a, **kw)
+
+    monkeypatch.setattr(AnyReader, "messages", counted_messages)
+    monkeypatch.setattr("worldgen.ros.reader.decoder", counted_decoder)
+    for start in ("command", "bag"):
+        with pytest.raises(BagError) as err:
+            read_run(bag, world, start=start)
+        message = str(err.value)
+        assert "\n" not in message and message.startswith(f"bag '{bag}': no pose source: need /ground_truth")
+        assert message.endswith(f"topics found: {topic}")
+    assert calls == {"messages": 0, "decoder": 0}

@@ -46,7 +46,8 @@ def test_compare_table(reports):
     assert done.returncode == 0, done.stderr
     assert done.stderr == ""
     lines = done.stdout.splitlines()
-    assert lines[0] == f"A: {reports['sim']} (6 runs)    B: {reports['real']} (7 runs)"
+    assert lines[0] == (f"A: {reports['sim']} (6 judged runs, 0 unjudged)    "
+                        f"B: {reports['real']} (7 judged runs, 0 unjudged)")
     assert any(line.startswith("success  A 6/6 = 1.000 (95% CI 0.541-1.000)   B 6/7 = 0.857") for line in lines)
     assert any("Fisher's exact p = 1.0000" in line and "odds ratio inf" in line for line in lines)
     head = next(line for line in lines if line.startswith("figure"))
@@ -114,3 +115,27 @@ def test_bad_input_is_one_line_exit_2(reports, tmp_path):
         assert done.stderr.startswith("error: ") and words in done.stderr and "Traceback" not in done.stderr
     done = run("compare", reports["sim"], reports["real"], "--confidence", "1.5")
     assert done.returncode == 2 and len(done.stderr.splitlines()) == 1
+
+
+def test_unjudged_bags_are_left_out_counted_and_a_side_of_only_them_is_bad_input(reports, tmp_path):
+    """The issue's case: a report whose one bag could not be read is no evidence of failure (was Fisher p = 0.0476)."""
+    pytest.importorskip("rosbags")
+    world = worldgen.generate("cluttered", seed=2, size=[6, 6], n_obstacles=8).write(tmp_path / "worlds", preview=False)
+    judged = run("judge", tmp_path / "missing_bag", "--world", world, "--out", tmp_path / "r1")
+    assert judged.returncode == 1 and json.loads((tmp_path / "r1" / "report.json").read_text())["summary"]["unjudged"] == 1
+    for a, b in ((reports["sim"], tmp_path / "r1"), (tmp_path / "r1", reports["sim"])):
+        done = run("compare", a, b)
+        assert done.returncode == 2 and done.stdout == "", done.stdout
+        assert done.stderr.startswith("error: report ") and "holds no judged run" in done.stderr
+    # A report of an older version: unreadable rows carried success false beside readable false.
+    rows = json.loads((reports["real"] / "report.json").read_text())["runs"]
+    old = rows + [{"bag": "b", "run": "b", "readable": False, "success": False, "reason": "truncated"}] * 3
+    (tmp_path / "old").mkdir()
+    (tmp_path / "old" / "report.json").write_text(json.dumps({"runs": old}))
+    done = run("compare", reports["sim"], tmp_path / "old", "--json")
+    assert done.returncode == 0, done.stderr
+    out = json.loads(done.stdout)
+    assert out["runs"] == {"a": 6, "b": 7} and out["unjudged"] == {"a": 0, "b": 3}
+    assert out["success"]["b"]["runs"] == 7 and out["success"]["b"]["successes"] == 6
+    table = run("compare", reports["sim"], tmp_path / "old").stdout.splitlines()
+    assert table[0].endswith("(7 judged runs, 3 unjudged)") and "left out of every test" in table[1]

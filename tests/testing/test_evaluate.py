@@ -191,3 +191,21 @@ def test_new_criteria_forms_and_their_mistakes():
         with pytest.raises(ParameterError) as exc:
             load_criteria(text)
         assert words in str(exc.value) and "\n" not in str(exc.value)
+
+
+def test_a_refused_run_is_a_failure_counted_in_the_rates_and_out_of_the_figures(clutter):
+    """The judge's bag that started far from its spawn: judged, failed, with its reason and no figures."""
+    good = along(clutter.metadata["tasks"][0]["path"]["waypoints"], 1.0, 0.0, 0.5)
+    alone = evaluate([(good, clutter)], {"navigation": {"success_rate": 0.5}}).to_dict()
+    both = evaluate([(good, clutter), {"world": clutter, "task": None, "refused": "the run starts 6.40 m from the "
+                                       "task's spawn"}], {"navigation": {"success_rate": 0.5}}).to_dict()
+    s = both["summary"]
+    assert (s["runs"], s["successes"], s["success_rate"]) == (2, 1, 0.5) and both["passed"]
+    for figure in ("min_clearance", "max_velocity", "mean_time_to_goal", "mean_path_efficiency", "collision_count"):
+        assert s[figure] == alone["summary"][figure]  # the refused run has no figure to add
+    refused = both["runs"][1]
+    assert refused["success"] is False and refused["reason"].startswith("the run starts 6.40 m")
+    assert refused["world_id"] == clutter.world_id and refused["barn_score"] == 0.0 and "min_clearance" not in refused
+    assert s["per_world"][clutter.world_id]["runs"] == 2 and s["mean_barn_score"] == alone["summary"]["mean_barn_score"] / 2
+    only = evaluate([{"world": clutter, "refused": "another world"}], {"navigation": {"success_rate": 1.0}}).to_dict()
+    assert only["summary"]["min_clearance"] is None and not only["passed"]

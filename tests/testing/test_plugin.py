@@ -66,6 +66,30 @@ def test_seed_option_replays_one_world(pytester):
     result.assert_outcomes(passed=1)
 
 
+def test_the_marker_asks_for_a_level_as_generate_and_the_cli_do(pytester):
+    pytester.makepyfile("""
+        import pytest
+
+        @pytest.mark.worldgen("cluttered", seeds=[0], difficulty="2/10", size=[5, 5])
+        def test_level(world):
+            assert world.metadata["metrics"]["difficulty_level"] == 2
+            assert world.metadata["difficulty_request"]["level"] == "2/10"
+
+        @pytest.mark.worldgen("cluttered", seeds=[0], difficulty="12/10")
+        def test_no_such_level(world):
+            pass
+
+        @pytest.mark.worldgen("cluttered", seeds=[0], difficulty=3, n_obstacles=4)
+        def test_level_and_its_knob(world):
+            pass
+    """)
+    result = pytester.runpytest_subprocess()
+    result.assert_outcomes(passed=1, errors=2)
+    one = {name.split("[")[0]: lines[0] for name, lines in error_sections(result).items()}
+    assert "parameter 'difficulty' must be a level 'k/10'" in one["test_no_such_level"]
+    assert "leave out 'n_obstacles'" in one["test_level_and_its_knob"]
+
+
 def test_factory_fixture_writes_into_tmp(pytester):
     pytester.makepyfile("""
         def test_corridor(worldgen_world, tmp_path):
@@ -127,7 +151,8 @@ def test_a_mistake_in_a_marker_fails_that_test_with_one_line_and_the_run_goes_on
         "test_no_generator"))
     assert all(len(lines) == 1 for lines in sections.values()), sections  # no traceback
     one = {name.split("[")[0]: lines[0] for name, lines in sections.items()}
-    assert "unknown argument 'n_obstacle' (did you mean 'n_obstacles'?); allowed: seeds, allow_infeasible, pack, " \
+    assert "unknown argument 'n_obstacle' (did you mean 'n_obstacles'?); allowed: seeds, allow_infeasible, difficulty, " \
+           "pack, " \
            "or a parameter of 'cluttered': box_size" in one["test_typo_in_a_parameter"]
     assert "unknown generator 'clutterd' (did you mean 'cluttered'?); available: barn, cluttered, corridor" \
            in one["test_typo_in_the_generator"]

@@ -187,7 +187,7 @@ def test_compare_runs_takes_each_figure_over_its_runs():
     a = [row(True, 10.0, 1.1, 0.2), row(True, 11.0, 1.2, 0.3), row(False, None, 0.6, -0.1), {"success": None}]
     b = [row(True, 12.0, 1.3, 0.1), row(True, 14.0, 1.5, 0.2), row(True, 13.0, 1.4, 0.2)]
     out = stats.compare_runs(a, b)
-    assert out["runs"] == {"a": 4, "b": 3} and out["unjudged"] == {"a": 1, "b": 0}
+    assert out["runs"] == {"a": 3, "b": 3} and out["unjudged"] == {"a": 1, "b": 0}  # runs: judged ones
     assert out["success"]["a"]["successes"] == 2 and out["success"]["a"]["runs"] == 3
     eff = out["figures"]["path_efficiency"]
     assert eff["over"] == "successful runs" and eff["n_a"] == 2 and eff["mean_a"] == pytest.approx(1.15)

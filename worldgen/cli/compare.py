@@ -36,8 +36,12 @@ def read_runs(path) -> list[dict]:
     runs = data.get("runs") if isinstance(data, dict) else None
     if not isinstance(runs, list) or not all(isinstance(r, dict) for r in runs):
         raise ParameterError(f"report '{file}' has no list of runs ('runs'); is it a report of 'worldgen judge'?")
-    if not any(isinstance(r.get("success"), bool) for r in runs):
-        raise ParameterError(f"report '{file}' holds no judged run (none has a success true or false); nothing to compare")
+    from worldgen.testing.stats import judged_runs
+
+    if not judged_runs(runs):
+        rows = f"{len(runs)} row{'' if len(runs) == 1 else 's'}"
+        raise ParameterError(f"report '{file}' holds no judged run ({rows}, none with a verdict: every bag was "
+                             "unjudged); nothing to compare")
     return runs
 
 
@@ -55,10 +59,11 @@ def format_comparison(result: dict, name_a: str, name_b: str) -> str:
     """The readable table of a :func:`~worldgen.testing.stats.compare_runs` result."""
     s = result["success"]
     conf = f"{result['confidence']:.0%}"
-    out = [f"A: {name_a} ({result['runs']['a']} runs)    B: {name_b} ({result['runs']['b']} runs)"]
     unjudged = result["unjudged"]
+    out = [f"A: {name_a} ({result['runs']['a']} judged runs, {unjudged['a']} unjudged)    "
+           f"B: {name_b} ({result['runs']['b']} judged runs, {unjudged['b']} unjudged)"]
     if unjudged["a"] or unjudged["b"]:
-        out.append(f"left out, no verdict (unreadable runs): A {unjudged['a']}, B {unjudged['b']}")
+        out.append("unjudged bags (no verdict: unreadable, or their world not found) are left out of every test below")
     out.append("")
 
     def side(x: dict) -> str:

@@ -1,7 +1,8 @@
 """``worldgen judge``: a thin click layer over :mod:`worldgen.judge.runs` and :mod:`worldgen.judge.report`.
 
 Mistakes raise :class:`~worldgen.errors.WorldgenError`, which ``worldgen.cli.main`` prints as one
-line with exit status 2; criteria that do not hold (or an unreadable bag) exit 1.
+line with exit status 2; criteria that do not hold (or a bag that could not be judged) exit 1.
+Every bag not judged, and every failed run, is named on stderr with its reason.
 """
 
 from __future__ import annotations
@@ -14,7 +15,27 @@ import click
 
 from worldgen.cli.context import CONTEXT as _CONTEXT
 
-__all__ = ["judge_command"]
+__all__ = ["judge_command", "bag_lines", "BAG_LINES"]
+
+#: Refused or failed bags named one per line on stderr; the rest are counted (report.md lists them all).
+BAG_LINES = 20
+
+
+def bag_lines(rows: Sequence[dict], limit: int = BAG_LINES) -> list[str]:
+    """One line per bag that was not judged or whose run failed: its name, its outcome and the reason."""
+    bad = [r for r in rows if r.get("outcome") != "success"]
+    out = []
+    for r in bad[:limit]:
+        reason = " ".join(str(r.get("reason") or "").split())
+        prefix = f"bag '{r['bag']}': "
+        reason = reason[len(prefix):] if reason.startswith(prefix) else reason
+        if r.get("outcome") == "unjudged":
+            out.append(f"unjudged {r['bag']}: {reason}")
+        else:
+            out.append(f"failed {r['run']} ({r['bag']}): {reason}")
+    if len(bad) > limit:
+        out.append(f"... and {len(bad) - limit} more not judged or failed (every one in report.md)")
+    return out
 
 
 
@@ -92,9 +113,11 @@ def judge_command(bags: Sequence[Path], world: Optional[Path], pack: Optional[Pa
     else:
         result = judge(bags, criteria, world=world, pack=pack, runs=runs_table, start=start, read_options=options)
     folder = write_report(result, out)
+    for line in bag_lines(result.report["runs"]):
+        click.echo(line, err=True)
     s = result.report["summary"]
     click.echo(f"{s['bags']} bags, {s.get('runs', 0)} judged, {s.get('successes', 0)} succeeded, "
-               f"{s['unreadable']} unreadable: {'PASS' if result.passed else 'FAIL'}")
+               f"{s['unjudged']} unjudged: {'PASS' if result.passed else 'FAIL'}")
     for line in result.report["failures"]:
         click.echo(f"FAILED {line}")
     click.echo(f"report: {folder}")

@@ -19,6 +19,7 @@ import click
 import worldgen
 from worldgen.cli.compare import compare_command
 from worldgen.cli.context import CONTEXT
+from worldgen.cli.drive import drive_command
 from worldgen.cli.judge import judge_command
 from worldgen.cli.pack import pack_group
 from worldgen.cli.world import check_command, generate_command, list_command, presets_command, preview_command
@@ -39,7 +40,7 @@ def cli() -> None:
 
 
 for _command in (list_command, generate_command, preview_command, check_command, presets_command, pack_group,
-                 compare_command, judge_command):
+                 compare_command, judge_command, drive_command):
     cli.add_command(_command)
 
 

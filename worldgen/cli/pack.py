@@ -88,6 +88,16 @@ def info_command(pack: Path) -> None:
     for w in p:
         gens[w.generator] = gens.get(w.generator, 0) + 1
     click.echo("generators: " + ", ".join(f"{g} {n}" for g, n in sorted(gens.items())))
+    levels: dict[str, int] = {}
+    for w in p:  # the level each world landed in (metrics.difficulty_level); "none" without a path
+        level = w.metrics.get("difficulty_level")
+        levels[str(level) if level is not None else "none"] = levels.get(str(level) if level is not None else "none", 0) + 1
+    if levels:
+        order = sorted(levels, key=lambda k: (k == "none", int(k) if k != "none" else 0))
+        click.echo("difficulty levels: " + ", ".join(f"{k}: {levels[k]}" for k in order))
+    asked = [w.get("level") for w in m["worlds"] if w.get("level") is not None]
+    if asked:
+        click.echo(f"asked for by level: {len(asked)} worlds at levels {', '.join(str(k) for k in sorted(set(asked)))}")
     for k in METRICS:
         vals = [w.metrics[k] for w in p if w.metrics.get(k) is not None]
         if vals:
@@ -108,7 +118,8 @@ def ls_command(pack: Path, where: Optional[str]) -> None:
     for w in chosen:
         m = w.metrics
         click.echo(f"{w.index}\t{w.world_id}\tnarrowest_passage={m.get('narrowest_passage')}"
-                   f"\tobstacle_count={m.get('obstacle_count')}\tpath_length={m.get('path_length')}")
+                   f"\tobstacle_count={m.get('obstacle_count')}\tpath_length={m.get('path_length')}"
+                   f"\tdifficulty_level={m.get('difficulty_level')}")
     p.close()
 
 

@@ -18,7 +18,7 @@ import click
 import worldgen
 from worldgen.cli.context import CONTEXT as _CONTEXT
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError, did_you_mean
-from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
+from worldgen.export.formats import ALL_FORMATS, FORMATS, SDF_VERSIONS, normalise_formats, require_formats
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
 from worldgen.ros.bundle import DEFAULT_GZ_RELEASE, GZ_RELEASES
@@ -148,7 +148,7 @@ def parameter_tables(specs) -> str:
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Folder to write DIR/<world_id>/ (DIR/<preset>--<world_id>/ with --preset) into (created if missing).")
 @click.option("--formats", default=",".join(FORMATS), show_default=True,
-              help=f"Comma-separated subset of {', '.join(FORMATS)}; world.json is always written.")
+              help=f"Comma-separated formats among {', '.join(ALL_FORMATS)} (usd needs its extra); world.json always.")
 @click.option("--sdf-version", type=click.Choice(SDF_VERSIONS), default=SDF_VERSIONS[0], show_default=True,
               help="SDFormat version: 1.9 (Gazebo Fortress to Harmonic) or 1.6 (Gazebo classic).")
 @click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
@@ -193,7 +193,7 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     except InfeasibleError:  # a request known to be undrivable: written anyway only when asked
         if not allow_infeasible:
             raise
-    chosen = normalise_formats(formats)
+    require_formats(chosen := normalise_formats(formats))  # a missing extra (usd): before any world is drawn
     if gz_release is not None and not ros:
         raise ParameterError(f"--gz-release {gz_release} names the Gazebo release of the ROS 2 bundle: add --ros")
     if seed + count - 1 > MAX_SEED:
@@ -201,13 +201,16 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     _check_out(out)
     for s in range(seed, seed + count):
         world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, difficulty=level, **params)
-        world.preset = preset.name if preset is not None else None  # names the folder <preset>--<world_id>
+        world.set_provenance(preset=preset.name if preset is not None else None)  # names the folder <preset>--<world_id>
         folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
                              ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)
         lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
         failed = ",".join(c.name for c in world.feasibility.failed())
         verdict = f"\tinfeasible: {failed}" if failed else ""
-        click.echo(f"{folder}\tpath {lengths} m\tattempts {world.attempts}{verdict}")
+        request = world.difficulty_request  # a level request: the level, its seed and every draw it took
+        tried = (f"level {request['level']}, request seed {request['seed']}\tdraws {len(request['draws'])}" if request
+                 else f"attempts {world.attempts}")
+        click.echo(f"{folder}\tpath {lengths} m\t{tried}{verdict}")
 
 
 @click.command("preview", context_settings=_CONTEXT)
@@ -233,8 +236,14 @@ def check_command(world_dirs: Sequence[Path]) -> None:
 
     Prints "OK DIR" or "FAIL DIR: CHECK: DETAIL" per folder; exit status 1 if any failed.
     """
+    from worldgen.files import METADATA_NAME
     from worldgen.verify import check_folder
 
+    for folder in world_dirs:  # a usage mistake, before any check: a folder of worlds is not a world folder
+        inner = sorted(p.parent.name for p in folder.glob(f"*/{METADATA_NAME}"))
+        if inner and not (folder / METADATA_NAME).exists():
+            raise ParameterError(f"'{folder}' is a folder of {len(inner)} world folders, not a world folder "
+                                 f"(no {METADATA_NAME}); give them: worldgen check {folder}/*")
     failed = 0
     for folder in world_dirs:
         outcome = check_folder(folder)

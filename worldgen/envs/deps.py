@@ -6,10 +6,9 @@ is where worldgen.envs asks for it, and where a missing install becomes one line
 
 from __future__ import annotations
 
-import importlib
 import importlib.util
 
-from worldgen.errors import MissingDependencyError
+from worldgen.errors import MissingDependencyError, require_optional
 
 __all__ = ["MissingDependencyError", "INSTALL_HINT", "gymnasium_available", "require_gymnasium"]
 
@@ -26,9 +25,5 @@ def gymnasium_available() -> bool:
 
 
 def require_gymnasium():
-    """The ``gymnasium`` module, or :class:`MissingDependencyError` with one line saying what to install."""
-    try:
-        return importlib.import_module("gymnasium")
-    except ImportError:
-        raise MissingDependencyError(
-            f"worldgen.envs needs Gymnasium, which is not installed: {INSTALL_HINT}") from None
+    """The ``gymnasium`` module, or :class:`MissingDependencyError` naming the ``rl`` extra."""
+    return require_optional("gymnasium", "rl", "worldgen.envs needs Gymnasium")

@@ -82,7 +82,7 @@ from worldgen.envs.reacting import walkers_of
 from worldgen.envs.reward import StepOutcome, reward
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.envs.source import PackSource, make_source
-from worldgen.errors import ParameterError
+from worldgen.errors import CallOrderError, ParameterError
 from worldgen.seeding import check_seed, draw_seed, env_rngs
 from worldgen.testing.figures import Contact
 
@@ -245,20 +245,20 @@ class NavigationEnv(gym.Env):
     def task(self) -> dict:
         """The current episode's task, as world.json ``tasks[]`` has it (spawn, goal, path, time_limit, ...)."""
         if self.world is None:
-            raise RuntimeError("call reset() first: there is no episode yet")
+            raise CallOrderError("call reset() first: there is no episode yet")
         return self.world.task
 
     @property
     def robot_pose(self) -> tuple[float, float, float]:
         """(x, y, yaw) of the robot now: m, m, rad (a scripted baseline's privileged view)."""
         if self._sim is None:
-            raise RuntimeError("call reset() first: there is no episode yet")
+            raise CallOrderError("call reset() first: there is no episode yet")
         return self._sim.pose()
 
     # -- stepping -------------------------------------------------------------------------------------------
     def step(self, action):
         if self.episode is None or self.episode.done:
-            raise RuntimeError("call reset() first: the episode has not started or has ended")
+            raise CallOrderError("call reset() first: the episode has not started or has ended")
         a = np.asarray(action, dtype=np.float64).reshape(-1)
         if a.shape != (2,) or not np.all(np.isfinite(a)):
             raise ParameterError(f"parameter 'action' must be two finite numbers (v m/s, w rad/s), got {action!r}")
@@ -354,7 +354,7 @@ class NavigationEnv(gym.Env):
             gym.logger.warn("render() was called without a render_mode; pass render_mode='rgb_array' to the env")
             return None
         if self.episode is None:
-            raise RuntimeError("call reset() before render()")
+            raise CallOrderError("call reset() before render()")
         from worldgen.envs.render import TopDown, mover_discs
 
         if self._painter is None:

@@ -21,6 +21,8 @@ from typing import Sequence
 
 import numpy as np
 
+from worldgen.seeding import policy_rng
+
 __all__ = ["GapHeuristic", "PathFollower", "RandomPolicy", "TimedFollower", "drive_timed"]
 
 
@@ -121,7 +123,7 @@ class RandomPolicy:
     def __init__(self, action_space, seed: int = 0):
         self.low = np.asarray(action_space.low, dtype=np.float64)
         self.high = np.asarray(action_space.high, dtype=np.float64)
-        self.rng = np.random.default_rng(seed)
+        self.rng = policy_rng(seed)
 
     def action(self, *_ignored) -> np.ndarray:
         return self.rng.uniform(self.low, self.high).astype(np.float32)

@@ -3,9 +3,10 @@
 The world is drawn once per episode by :func:`worldgen.export.preview.draw` (the same
 picture as preview.png: walls, obstacles, no-go zone, reference path, spawn and
 goal, title, scale bar); each frame copies it and adds, in the preview's own
-world-to-pixel layout: the lidar beams as thin lines to where they read, the
-path travelled so far, the movers where they are now, and the robot (its
-footprint and heading).
+world-to-pixel layout and with the one drawing of a world from above
+(:mod:`worldgen.export.topdown`: its pen and colour table): the lidar beams as thin
+lines to where they read, the path travelled so far, the movers where they are
+now, and the robot (its footprint and heading).
 """
 
 from __future__ import annotations
@@ -16,15 +17,16 @@ from typing import Optional, Sequence
 import numpy as np
 from PIL import Image, ImageDraw
 
-from worldgen.export.preview import COLOURS, draw, layout
+from worldgen.export.preview import draw, layout
+from worldgen.export.topdown import COLOURS, Pen, draw_robot
 
 __all__ = ["FRAME_WIDTH", "MAX_BEAMS_DRAWN", "TopDown", "mover_discs", "ROBOT_COLOUR", "BEAM_COLOUR", "TRACK_COLOUR"]
 
 #: Width of a frame in pixels (the preview's default).
 FRAME_WIDTH = 640
-ROBOT_COLOUR = (235, 110, 20)
-BEAM_COLOUR = (236, 64, 122)
-TRACK_COLOUR = (20, 20, 25)
+ROBOT_COLOUR = COLOURS["robot"]
+BEAM_COLOUR = COLOURS["beam"]
+TRACK_COLOUR = COLOURS["track"]
 #: At most this many beams are drawn (evenly spaced), so a 4096-beam scan stays readable.
 MAX_BEAMS_DRAWN = 360
 
@@ -59,19 +61,12 @@ class TopDown:
             end = self._px(x + r * math.cos(yaw + a), y + r * math.sin(yaw + a))
             pen.line([origin, end], fill=BEAM_COLOUR + (70,), width=1)
         image.paste(overlay, (0, 0), overlay)
-        pen = ImageDraw.Draw(image)
+        pen = Pen(image, self.layout)
         if len(track) > 1:
-            pen.line([self._px(px, py) for px, py in track], fill=TRACK_COLOUR, width=2, joint="curve")
-        scale = self.layout.scale
+            pen.line(track, TRACK_COLOUR, width=2)
         for mx, my, mr in movers:
-            u, v = self._px(mx, my)
-            pen.ellipse([u - mr * scale, v - mr * scale, u + mr * scale, v + mr * scale], fill=COLOURS["mover"])
-        u, v = origin
-        r = self.radius * scale
-        pen.ellipse([u - r, v - r, u + r, v + r], fill=ROBOT_COLOUR if not collided else COLOURS["alert"],
-                    outline=TRACK_COLOUR, width=2)
-        pen.line([origin, self._px(x + 1.6 * self.radius * math.cos(yaw), y + 1.6 * self.radius * math.sin(yaw))],
-                 fill=TRACK_COLOUR, width=3)
+            pen.shape("circle", (mx, my, mr), fill=COLOURS["mover"])
+        draw_robot(pen, x, y, yaw, self.radius, collided)
         return np.asarray(image, dtype=np.uint8)
 
 

@@ -181,8 +181,7 @@ class GeneratorSource:
 
         world = generate(self.generator, seed, difficulty=self.difficulty if difficulty is None else difficulty,
                          **self.params)
-        world.preset = self.preset
-        return world
+        return world.set_provenance(preset=self.preset)
 
 
 class OneWorldSource:

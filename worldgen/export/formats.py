@@ -16,8 +16,8 @@ from typing import Any, Iterable, Mapping, Optional
 
 from worldgen.errors import ParameterError
 
-__all__ = ["Format", "TABLE", "FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats", "render",
-           "movers_note", "uses_meshes"]
+__all__ = ["Format", "TABLE", "FORMATS", "ALL_FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats", "render",
+           "movers_note", "uses_meshes", "require_formats"]
 
 #: Versions the SDF exporter writes: 1.9 for Gazebo Fortress-Harmonic, 1.6 for Gazebo classic.
 SDF_VERSIONS = ("1.9", "1.6")
@@ -31,6 +31,12 @@ class Format:
     ``versions`` lists some) and returning the file's bytes. ``movers_as`` says how the format
     carries a mover (None: it cannot); ``movers_switch`` names a boolean parameter that, set false,
     leaves the movers out of this format. ``meshes``: the file refers to mesh files beside it.
+    ``optional``: written only when asked for (not among :data:`FORMATS`, the default), and named in
+    world.json's ``formats`` notes only when written, so a world written without it keeps its bytes.
+    ``requires``: ``module:function`` that imports what the writer needs, raising a one-line
+    MissingDependencyError when it is not installed. ``world_args``: ``module:function`` giving, for a
+    World, the writer's further keyword arguments (USD: the tasks, and how long movers play).
+    ``binary``: the file is not text (``World.export_bytes`` gives it, ``World.export`` refuses).
     """
 
     name: str
@@ -40,19 +46,33 @@ class Format:
     movers_switch: Optional[str] = None
     versions: tuple[str, ...] = ()
     meshes: bool = False
+    optional: bool = False
+    requires: Optional[str] = None
+    world_args: Optional[str] = None
+    binary: bool = False
 
     def carries_movers(self, params: Mapping[str, Any]) -> bool:
         return self.movers_as is not None and (self.movers_switch is None or bool(params.get(self.movers_switch, True)))
 
 
-#: Every format, in the order they are written. SDF movers are <actor>s, which Drake rejects: the
+#: Every format, in the order they are written. USD (Isaac Sim / Isaac Lab) is optional: it needs
+#: usd-core (the ``usd`` extra) and is written only when asked for. SDF movers are <actor>s, which Drake rejects: the
 #: ``sdf_actors`` parameter leaves them out for Drake users (docs/formats.md).
 TABLE: dict[str, Format] = {f.name: f for f in (
     Format("sdf", "world.sdf", "worldgen.export.sdf:to_sdf", "actor", "sdf_actors", SDF_VERSIONS, meshes=True),
     Format("mjcf", "world.mjcf.xml", "worldgen.export.mjcf:to_mjcf", "mocap_body"),
     Format("urdf", "world.urdf", "worldgen.export.urdf:to_urdf", None, meshes=True),
+    Format("usd", "world.usda", "worldgen.export.usd:to_usd", "kinematic_body", optional=True,
+           requires="worldgen.export.usd_prims:require_pxr",
+           world_args="worldgen.export.usd_motion:writer_args"),
+    # The same stage in USD's binary crate form: smaller (5.0 against 12.7 kB for door seed 0 with a mover), not diffable.
+    Format("usdc", "world.usdc", "worldgen.export.usd:to_usdc", "kinematic_body", optional=True,
+           requires="worldgen.export.usd_prims:require_pxr",
+           world_args="worldgen.export.usd_motion:writer_args", binary=True),
 )}
-FORMATS = tuple(TABLE)
+#: The formats written when none are named; :data:`ALL_FORMATS` adds the optional ones.
+FORMATS = tuple(f.name for f in TABLE.values() if not f.optional)
+ALL_FORMATS = tuple(TABLE)
 FILE_NAMES = {f.name: f.file_name for f in TABLE.values()}
 
 
@@ -63,26 +83,49 @@ def normalise_formats(formats: Iterable[str]) -> tuple[str, ...]:
     chosen = [f.strip().lower() for f in formats]
     for f in chosen:
         if f not in TABLE:
-            raise ParameterError(f"parameter 'formats' must name formats among {', '.join(FORMATS)}, got {f!r}")
+            raise ParameterError(f"parameter 'formats' must name formats among {', '.join(ALL_FORMATS)}, got {f!r}")
     if not chosen:
-        raise ParameterError(f"parameter 'formats' must name at least one of {', '.join(FORMATS)}, got nothing")
-    return tuple(f for f in FORMATS if f in chosen)
+        raise ParameterError(f"parameter 'formats' must name at least one of {', '.join(ALL_FORMATS)}, got nothing")
+    return tuple(f for f in ALL_FORMATS if f in chosen)
 
 
-def render(fmt: str, scene, name: str, params: Mapping[str, Any], sdf_version: str = "1.9") -> bytes:
-    """The bytes of ``scene`` written as ``fmt`` under the world name ``name``."""
+def _function(ref: str):
+    module, function = ref.split(":")
+    return getattr(importlib.import_module(module), function)
+
+
+def require_formats(formats: Iterable[str]) -> None:
+    """MissingDependencyError (one line naming the extra) if a chosen format's dependency is not installed.
+
+    Called before any world is drawn or any file written, so that a missing extra stops a command at
+    once and leaves nothing behind.
+    """
+    for f in normalise_formats(formats):
+        if TABLE[f].requires:
+            _function(TABLE[f].requires)()
+
+
+def render(fmt: str, scene, name: str, params: Mapping[str, Any], sdf_version: str = "1.9", world=None) -> bytes:
+    """The bytes of ``scene`` written as ``fmt`` under the world name ``name``.
+
+    ``world`` gives a format with ``world_args`` what it reads off the world (the tasks, ...)."""
     (chosen,) = normalise_formats([fmt])
     spec = TABLE[chosen]
     if scene.movers and not spec.carries_movers(params):
         scene = scene.with_movers(())
-    module, function = spec.writer.split(":")
-    writer = getattr(importlib.import_module(module), function)
+    writer = _function(spec.writer)
+    if spec.world_args:
+        return writer(scene, name=name, **(_function(spec.world_args)(world) if world is not None else {}))
     return writer(scene, name=name, **({"version": sdf_version} if spec.versions else {}))
 
 
-def movers_note(params: Mapping[str, Any]) -> dict[str, Optional[str]]:
-    """How each format carries a mover of a world with ``params``: world.json's ``dynamic_obstacles[].formats``."""
-    return {f.name: (f.movers_as if f.carries_movers(params) else None) for f in TABLE.values()}
+def movers_note(params: Mapping[str, Any], written: Iterable[str] = ()) -> dict[str, Optional[str]]:
+    """How each format carries a mover of a world with ``params``: world.json's ``dynamic_obstacles[].formats``.
+
+    Every default format, and an optional one only where it is among the ``written`` file keys."""
+    written = set(written)
+    return {f.name: (f.movers_as if f.carries_movers(params) else None) for f in TABLE.values()
+            if not f.optional or f.name in written}
 
 
 def uses_meshes(formats: Iterable[str]) -> bool:

@@ -13,7 +13,7 @@ from __future__ import annotations
 import json
 from functools import lru_cache
 from importlib import resources
-from typing import Any, Mapping
+from typing import Any, Iterable, Mapping
 
 import numpy as np
 import shapely
@@ -58,7 +58,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
         "entities": [_entity(scene, node) for node in scene.nodes],
         "doors": door_records(scene),
-        "dynamic_obstacles": [mover_entry(m, world.params) for m in scene.movers if not m.person],
+        "dynamic_obstacles": [mover_entry(m, world.params, files) for m in scene.movers if not m.person],
         "tasks": [task_entry(world, task, path) for task, path in zip(world.tasks, paths)],
         "feasibility": {
             "feasible": bool(report.feasible),
@@ -102,7 +102,7 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
 
 def _add_people(meta: dict, world, people) -> None:
     """world.json's ``people``, ``robot.max_speed`` and each task's ``timed_path`` (docs/people.md)."""
-    meta["people"] = [person_entry(m, world.params) for m in people]
+    meta["people"] = [person_entry(m, world.params, meta["files"]) for m in people]
     meta["robot"]["max_speed"] = world.params["robot_speed"]
     timed = list(getattr(world.feasibility, "timed_paths", ()))
     timed += [None] * max(0, len(meta["tasks"]) - len(timed))
@@ -121,25 +121,25 @@ def dumps(meta: Mapping[str, Any]) -> str:
     return _emit(meta, "") + "\n"
 
 
-def mover_entry(mover, params: Mapping[str, Any]) -> dict:
+def mover_entry(mover, params: Mapping[str, Any], files: Iterable[str] = ()) -> dict:
     """The mover's ``dynamic_obstacles[]`` entry of world.json, for a world of ``params`` (which say
-    whether the SDF carries movers)."""
+    whether the SDF carries movers) written with the ``files`` keys (which say whether the USD does)."""
     return {
         "name": mover.name,
         "radius": mover.radius,
         "height": mover.height,
         "trajectory": [list(row) for row in mover.trajectory],
         "loop": mover.loop,
-        "formats": movers_note(params),
+        "formats": movers_note(params, files),
     }
 
 
-def person_entry(person, params: Mapping[str, Any]) -> dict:
+def person_entry(person, params: Mapping[str, Any], files: Iterable[str] = ()) -> dict:
     """A person's ``people[]`` entry of world.json: a mover's, without ``loop`` (a person walks once
     and then stands where it stopped)."""
     from worldgen.people.behaviours import behaviours_of, reaction_entry
 
-    entry = mover_entry(person, params)
+    entry = mover_entry(person, params, files)
     del entry["loop"]
     index = int(person.name.rsplit("_", 1)[1])
     behaviours = behaviours_of(params)
@@ -200,12 +200,10 @@ def schema() -> dict:
 def validate(meta: Mapping[str, Any]) -> None:
     """Raise ``jsonschema.ValidationError`` unless ``meta`` follows the schema.
 
-    Needs the optional ``jsonschema`` package (``pip install worldgen[test]``).
+    jsonschema is one of worldgen's own dependencies (``worldgen check`` validates with it).
     """
-    try:
-        import jsonschema
-    except ImportError:  # pragma: no cover - depends on the environment
-        raise ImportError("worldgen.export.metadata.validate needs jsonschema: pip install 'worldgen[test]'") from None
+    import jsonschema
+
     jsonschema.Draft202012Validator(schema()).validate(meta)
 
 

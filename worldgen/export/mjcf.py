@@ -149,7 +149,7 @@ def _write_geom(out: XmlText, node: Node, mesh_assets, pose_attrs: str) -> None:
     elif isinstance(shape, Mesh):
         kind = f' type="mesh" mesh="{mesh_assets[(shape.uri, shape.scale)]}"'
     else:
-        raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
+        raise SceneError(f"node {node.name!r}: unknown shape {shape!r}")
     friction = fmt_seq((node.material.friction, TORSIONAL_FRICTION, ROLLING_FRICTION))
     # Visual only: no contact with anything, drawn in group 2 with the other visuals.
     visual = "" if node.collision else ' contype="0" conaffinity="0" group="2"'

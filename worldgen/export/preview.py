@@ -28,11 +28,11 @@ import io
 import json
 import math
 from pathlib import Path
-from typing import Any, Mapping, Optional
+from typing import Any, Mapping
 
 import numpy as np
 import shapely
-from PIL import Image, ImageDraw
+from PIL import Image
 
 from worldgen.errors import OutputError, ParameterError
 from worldgen.export.preview_frame import (
@@ -47,16 +47,14 @@ from worldgen.export.preview_frame import (
     footer,
     layout,
     legend,
-    text_font,
     title,
 )
+from worldgen.export.topdown import Pen, draw_movers, draw_people, text_font
 from worldgen.files import METADATA_NAME, PREVIEW_NAME, write_atomically
 from worldgen.scene.pose import rpy_matrix
 
 __all__ = ["DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
            "Layout", "layout", "draw", "render", "blocking"]
-#: Seconds between two dots on a person's track.
-TIME_MARK = 5.0
 
 # -- geometry from the metadata ------------------------------------------------
 
@@ -102,54 +100,9 @@ def _inflated(kind: str, geo, grow: float):
 
 # -- drawing -------------------------------------------------------------------
 
-class _Pen:
-    """Draws world-frame shapes on a supersampled image."""
-
-    def __init__(self, image: Image.Image, lay: Layout):
-        self.draw = ImageDraw.Draw(image)
-        self.lay = lay
-
-    def xy(self, pts) -> list[tuple[float, float]]:
-        out = []
-        for x, y in np.asarray(pts, dtype=float).reshape(-1, 2):
-            u, v = self.lay.px(x, y)
-            out.append((u * SUPERSAMPLE, v * SUPERSAMPLE))
-        return out
-
-    def m(self, metres: float) -> float:
-        return metres * self.lay.scale * SUPERSAMPLE
-
-    def shape(self, kind, geo, fill=None, outline=None, width=1):
-        if kind == "circle":
-            (u, v), = self.xy([geo[:2]])
-            r = self.m(geo[2])
-            self.draw.ellipse([u - r, v - r, u + r, v + r], fill=fill, outline=outline, width=width * SUPERSAMPLE)
-        else:
-            self.draw.polygon(self.xy(geo), fill=fill, outline=outline, width=width * SUPERSAMPLE)
-
-    def line(self, pts, fill, width=1, dash: Optional[float] = None):
-        p = self.xy(pts)
-        if dash is None:
-            self.draw.line(p, fill=fill, width=width * SUPERSAMPLE, joint="curve")
-            return
-        step, on = dash * SUPERSAMPLE, True
-        for a, b in zip(p[:-1], p[1:]):  # the dash pattern restarts at each vertex: simple, and fine here
-            length = math.dist(a, b)
-            n = max(1, int(length // step))
-            for k in range(n):
-                if on:
-                    t0, t1 = k / n, (k + 1) / n
-                    self.draw.line([(a[0] + (b[0] - a[0]) * t0, a[1] + (b[1] - a[1]) * t0),
-                                    (a[0] + (b[0] - a[0]) * t1, a[1] + (b[1] - a[1]) * t1)],
-                                   fill=fill, width=width * SUPERSAMPLE)
-                on = not on
-
-    def arrow(self, x, y, yaw, length, fill, width=2):
-        tip = np.array([x + length * math.cos(yaw), y + length * math.sin(yaw)])
-        self.line([(x, y), tip], fill, width)
-        head = min(length * 0.45, 0.35)
-        wings = [tip - head * np.array([math.cos(yaw + s), math.sin(yaw + s)]) for s in (0.45, -0.45)]
-        self.draw.polygon(self.xy([tip, wings[0], wings[1]]), fill=fill)
+def _Pen(image: Image.Image, lay: Layout) -> Pen:
+    """The shared top-down pen (:mod:`worldgen.export.topdown`) on the supersampled image."""
+    return Pen(image, lay, SUPERSAMPLE)
 
 
 # long: the layers of the picture in drawing order, each a few lines
@@ -198,20 +151,8 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
         if e["role"] == "door" and not any(d["name"] == e["name"] for d in meta.get("doors", []) or []):
             pen.shape(*_outline(e), fill=COLOURS["door"])
 
-    for mover in meta.get("dynamic_obstacles", []) or []:
-        traj = [(x, y) for _, x, y in mover["trajectory"]]
-        if mover.get("loop") and len(traj) > 2:
-            traj.append(traj[0])
-        pen.line(traj, COLOURS["mover"], width=2, dash=7)
-        x, y = traj[0]
-        pen.shape("circle", (x, y, mover["radius"]), outline=COLOURS["mover"], width=2)
-    for person in meta.get("people", []) or []:  # a person's track, with a dot every TIME_MARK seconds
-        rows = np.asarray(person["trajectory"], dtype=float)
-        pen.line(rows[:, 1:].tolist(), COLOURS["mover"], width=1)
-        marks = np.arange(0.0, rows[-1, 0] + 1e-9, TIME_MARK)
-        for x, y in zip(np.interp(marks, rows[:, 0], rows[:, 1]), np.interp(marks, rows[:, 0], rows[:, 2])):
-            pen.shape("circle", (x, y, 0.05), fill=COLOURS["mover"])
-        pen.shape("circle", (rows[0, 1], rows[0, 2], person["radius"]), outline=COLOURS["mover"], width=2)
+    draw_movers(pen, meta.get("dynamic_obstacles", []) or [])
+    draw_people(pen, meta.get("people", []) or [])  # a colour each, a dot every topdown.TIME_MARK s
 
     tasks = list(meta.get("tasks", []))
     for t in tasks:
@@ -272,7 +213,7 @@ def _grid_step(scale: float) -> float:
     return 500.0
 
 
-def _grid(pen: _Pen, box, step: float) -> None:
+def _grid(pen: Pen, box, step: float) -> None:
     x0, y0, x1, y1 = box
     for x in np.arange(math.ceil(x0 / step) * step, x1 + 1e-9, step):
         pen.line([(x, y0), (x, y1)], COLOURS["grid"])
@@ -280,7 +221,7 @@ def _grid(pen: _Pen, box, step: float) -> None:
         pen.line([(x0, y), (x1, y)], COLOURS["grid"])
 
 
-def _door(pen: _Pen, door, leaf) -> None:
+def _door(pen: Pen, door, leaf) -> None:
     """The leaf (its entity, where named), its swing arc from limit to limit, and the leaf at each limit."""
     hx, hy = door["hinge"][0], door["hinge"][1]
     width, angle = door["width"], door["angle"]
@@ -305,7 +246,7 @@ def _door(pen: _Pen, door, leaf) -> None:
     pen.shape("circle", (hx, hy, 0.04), fill=COLOURS["frame"])
 
 
-def _pose_marker(pen: _Pen, pose, radius: float, kind: str, label: str, tolerance=None) -> None:
+def _pose_marker(pen: Pen, pose, radius: float, kind: str, label: str, tolerance=None) -> None:
     x, y, yaw = pose[0], pose[1], pose[5]
     if tolerance:
         pen.shape("circle", (x, y, tolerance), outline=COLOURS[kind], width=1)

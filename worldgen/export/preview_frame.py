@@ -5,43 +5,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import lru_cache
 from typing import Any, Mapping
 
 import numpy as np
-from PIL import Image, ImageDraw, ImageFont
+from PIL import Image, ImageDraw
 
 from worldgen.errors import ParameterError
+from worldgen.export.topdown import COLOURS, text_font
 
 __all__ = ["DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA", "SUPERSAMPLE",
-           "HIDDEN_ROLES", "Layout", "layout", "text_font", "title", "footer"]
+           "HIDDEN_ROLES", "Layout", "layout", "text_font", "title", "title_lines", "footer"]
 
 DEFAULT_WIDTH = 800
 MIN_WIDTH, MAX_WIDTH = 400, 4000
 
-#: RGB of each layer; tests sample pixels against these.
-COLOURS = {
-    "background": (255, 255, 255),
-    "slab": (214, 214, 210),        # floor slab outside the usable bounds
-    "floor": (248, 247, 242),       # the usable bounds
-    "unreachable": (232, 231, 226), # floor inside the bounds that no footprint from a spawn can reach
-    "grid": (228, 227, 220),
-    "nogo": (232, 72, 64),          # blended at NOGO_ALPHA over what lies beneath
-    "wall": (45, 45, 55),
-    "obstacle": (84, 104, 140),
-    "overhead": (150, 160, 180),    # outline of colliders the robot passes under
-    "frame": (105, 80, 60),
-    "door": (176, 112, 48),
-    "marker": (120, 170, 120),
-    "mover": (150, 70, 200),
-    "path": (250, 140, 0),
-    "spawn": (28, 150, 70),
-    "spawn_fill": (206, 238, 214),
-    "goal": (30, 90, 220),
-    "goal_fill": (210, 224, 250),
-    "text": (20, 20, 25),
-    "alert": (200, 30, 30),
-}
 #: Opacity of the no-go zone: light enough that the floor grid still shows through.
 NOGO_ALPHA = 0.3
 
@@ -119,35 +96,45 @@ def _extent_points(meta) -> tuple[list[float], list[float]]:
     return xs, ys
 
 
-@lru_cache(maxsize=None)
-def text_font(size: int):
-    return ImageFont.load_default(size=size)
-
-
 def _fmt_m(x) -> str:
     return "-" if x is None else f"{x:.2f} m"
 
 
-def title(image: Image.Image, meta, lay: Layout) -> None:
-    d = ImageDraw.Draw(image)
-    room = lay.width - 2 * _MARGIN
-    big, small = text_font(16), text_font(13)
-    world_id = str(meta.get("world_id", "?"))
-    d.text((_MARGIN, 6), world_id, fill=COLOURS["text"], font=big)
-    feas = meta.get("feasibility", {}) or {}
-    if feas and not feas.get("feasible", True):
-        failed = ", ".join(c["name"] for c in feas.get("checks", []) if not c.get("ok"))
-        x = _MARGIN + big.getlength(world_id) + 12
-        d.text((x, 6), _fit(f"INFEASIBLE: {failed}", big, _MARGIN + room - x), fill=COLOURS["alert"], font=big)
+def title_lines(meta) -> tuple[str, list[str]]:
+    """The title's first line (the folder's name: ``<preset>--<world_id>`` for a preset's world) and the parts
+    of its second, most important first: the level (asked for, with the request's seed, or the one measured),
+    how many people, the path, the narrowest passage, obstacles, doors, the robot."""
+    head = str(meta.get("world_id", "?"))
+    if meta.get("preset"):
+        head = f"{meta['preset']}--{head}"
     metrics = meta.get("metrics", {}) or {}
     lengths = [t["path"]["length"] for t in meta.get("tasks", []) if t.get("path")]
+    level = metrics.get("difficulty_level")
+    request = meta.get("difficulty_request") or {}
     parts = [
+        *([f"level {request['level']} (request seed {request['seed']})"] if request else []),
+        *([f"level {level}/10"] if level is not None and not request else []),
+        *([f"{len(meta['people'])} people"] if meta.get("people") else []),
         f"path {', '.join(f'{x:.2f}' for x in lengths)} m" if lengths else "no path",
         f"narrowest passage {_fmt_m(metrics.get('narrowest_passage'))}",
         f"{metrics.get('obstacle_count', '?')} obstacles",
         *([f"doors: {', '.join(d['state'] for d in meta['doors'])}"] if meta.get("doors") else []),
         f"robot r {meta['robot']['radius']:.2f} + {meta['robot']['clearance']:.2f} m",
     ]
+    return head, parts
+
+
+def title(image: Image.Image, meta, lay: Layout) -> None:
+    d = ImageDraw.Draw(image)
+    room = lay.width - 2 * _MARGIN
+    big, small = text_font(16), text_font(13)
+    head, parts = title_lines(meta)
+    d.text((_MARGIN, 6), head, fill=COLOURS["text"], font=big)
+    feas = meta.get("feasibility", {}) or {}
+    if feas and not feas.get("feasible", True):
+        failed = ", ".join(c["name"] for c in feas.get("checks", []) if not c.get("ok"))
+        x = _MARGIN + big.getlength(head) + 12
+        d.text((x, 6), _fit(f"INFEASIBLE: {failed}", big, _MARGIN + room - x), fill=COLOURS["alert"], font=big)
     while len(parts) > 1 and small.getlength("   |   ".join(parts)) > room:  # narrow image: least important last
         parts.pop()
     d.text((_MARGIN, 26), _fit("   |   ".join(parts), small, room), fill=COLOURS["text"], font=small)
@@ -166,7 +153,8 @@ def _fit(text: str, font, room: float) -> str:
 _LEGEND = (("obstacle", "obstacle", "box"), ("wall", "wall", "box"), ("no-go zone", "nogo", "zone"),
            ("unreachable", "unreachable", "box"), ("path", "path", "line"),
            ("path (opens a door)", "path", "line"), ("spawn", "spawn", "disc"), ("goal", "goal", "disc"),
-           ("door", "door", "box"), ("mover", "mover", "dash"), ("person (dot every 5 s)", "mover", "track"))
+           ("door", "door", "box"), ("mover", "mover", "dash"),
+           ("people (a colour each, dot every 5 s)", "person", "track"))
 _LEGEND_START = _MARGIN + _SCALE_BAR_MAX + 28 + 40  # right of the longest scale bar and the axes
 _LEGEND_GAP = 12  # px between one entry's text and the next glyph
 
@@ -182,7 +170,7 @@ def legend(meta: Mapping[str, Any], unreachable: bool) -> tuple[tuple[str, str, 
         "path": any(t.get("path") and not t.get("requires_door_open") for t in tasks),
         "path (opens a door)": through_door, "spawn": bool(tasks), "goal": bool(tasks),
         "door": bool(meta.get("doors")) or "door" in roles, "mover": bool(meta.get("dynamic_obstacles")),
-        "person (dot every 5 s)": bool(meta.get("people")),
+        "people (a colour each, dot every 5 s)": bool(meta.get("people")),
     }
     return tuple(entry for entry in _LEGEND if shown[entry[0]])
 

@@ -80,7 +80,7 @@ from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matri
 from worldgen.scene.graph import Joint
 from worldgen.scene.mover import MOVER_RGBA, Mover
 
-__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "to_sdf"]
+__all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "HOLD_SECONDS", "script_rows", "to_sdf"]
 
 TEMPLATE = "world.sdf"
 #: Smallest principal moment written (kg m^2): floats keep 6 decimals, and a
@@ -88,6 +88,9 @@ TEMPLATE = "world.sdf"
 MIN_MOMENT = 1e-6
 #: A mover's trajectory ``type``: it would name a skin animation played along it, if there were one.
 TRAJECTORY_TYPE = "walk"
+#: How long (s of simulation time) a person that does not loop stands at its last row: the script is
+#: written looping, with this hold as its last leg (see _sdf_actor).
+HOLD_SECONDS = 86400.0
 
 def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> bytes:
     """The SDFormat world of ``scene``: UTF-8 bytes, pretty-printed (see the module docstring).
@@ -320,6 +323,15 @@ def _write_geometry(out: XmlText, geometry) -> None:
 
 # -- movers: one <actor> each ------------------------------------------------
 
+def script_rows(trajectory, loop: bool) -> np.ndarray:
+    """The (k, 3) ``t, x, y`` rows an actor's script plays: a looping mover's own, or a non-looping one's
+    followed by a stay of :data:`HOLD_SECONDS` at its last row (see :func:`_sdf_actor`)."""
+    rows = np.asarray(trajectory, dtype=float)
+    if loop:
+        return rows
+    return np.vstack([rows, [rows[-1, 0] + HOLD_SECONDS, rows[-1, 1], rows[-1, 2]]])
+
+
 def _write_actors(out: XmlText, scene: Scene) -> None:
     """Write one ``<actor>`` per mover at the end of the SDF ``<world>`` (``out`` is at its children's depth)."""
     for mover in scene.movers:
@@ -339,15 +351,21 @@ def _sdf_actor(out: XmlText, mover: Mover) -> None:
     _write_material(out, MOVER_RGBA)
     out.close("visual")
     out.close("link")
+    # A script that does not loop hangs Gazebo Sim (Fortress to Harmonic) once a rendering sensor plays it:
+    # the placeholder that marks "no loop" gets the delay as its start and end, not the trajectory's end,
+    # so SceneManager's ActorTrajectoryAt sees a script of total time 0, treats it as looping and wraps
+    # time by 0 for ever (docs/gazebo.md). So every script loops, and one that should not ends with the
+    # mover standing at its last row for HOLD_SECONDS, a stay the waypoints keep to like any other.
+    rows = script_rows(mover.trajectory, mover.loop)
     out.open("script")
-    out.leaf("loop", "true" if mover.loop else "false")
+    out.leaf("loop", "true")
     out.leaf("delay_start", "0")
     out.leaf("auto_start", "true")
     out.open("trajectory", f' id="0" type="{TRAJECTORY_TYPE}" tension="{fmt(TENSION)}"')
     # One line per waypoint (a person has thousands: a third of the bytes of one element per line).
     pad = "  " * out.depth
     out.parts.extend(f"{pad}<waypoint><time>{fmt(t)}</time><pose>{fmt(x)} {fmt(y)} 0 0 0 0</pose></waypoint>\n"
-                     for t, x, y in actor_waypoints(mover.trajectory, loop=mover.loop).tolist())
+                     for t, x, y in actor_waypoints(rows, loop=mover.loop).tolist())
     out.close("trajectory")
     out.close("script")
     out.close("actor")

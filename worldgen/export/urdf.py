@@ -194,7 +194,7 @@ def _geometry(node: Node) -> tuple[str, str]:
         return "sphere", f' radius="{fmt(shape.radius)}"'
     if isinstance(shape, Mesh):
         return "mesh", f' filename="{escape_attr(shape.uri)}" scale="{fmt_seq(shape.scale)}"'
-    raise TypeError(f"node {node.name!r}: unknown shape {shape!r}")
+    raise SceneError(f"node {node.name!r}: unknown shape {shape!r}")
 
 
 def _write_joint(out: XmlText, node: Node, joint: Joint | None, parent_joint: Joint | None) -> None:

@@ -8,6 +8,9 @@ in the order the data flows through them:
   circles with their cones), the bounds shrunk by it, exact segment and arc clearances;
 - ``tangents``: common tangents between corner circles, the edges of the tangent graph;
 - ``planner``: the exact shortest path (lazy A* over the tangent graph) and its polyline;
+- ``roadmap``: the same paths over the whole tangent graph built once (many queries in one space);
+- ``exact``: the one interface of the two (``ExactPlanner``) and ``exact_planner``, which picks one
+  by the number of queries coming;
 - ``passage``: the exact narrowest passage (the widest disc that gets through);
 - ``collision``: FCL objects and broad-phased distance queries;
 - ``verify``: the FCL proof of a path, on the volume the footprint sweeps along it;

@@ -24,9 +24,9 @@ import numpy as np
 
 from worldgen.feasibility.collision import Colliders
 from worldgen.feasibility.cspace import ConfigSpace
+from worldgen.feasibility.exact import exact_planner
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.passage import narrowest_passage
-from worldgen.feasibility.planner import Planner
 from worldgen.feasibility.report import CHECKER, Check, FeasibilityReport, TaskPath
 from worldgen.feasibility.route import waypoints
 from worldgen.feasibility.verify import verify_path
@@ -113,7 +113,7 @@ class _Plans:
         bounds = scene.bounds
         obstacles = Obstacles2D.from_footprints(robot_footprints(scene, robot))
         cspace = ConfigSpace.build(obstacles, robot.inflation + SAFETY, bounds)
-        planner = Planner(cspace)
+        planner = exact_planner(cspace, len(tasks))
         slack = cspace.points_clearance(np.vstack([spawns, goals]))
         start_slack, goal_slack = slack[: len(tasks)], slack[len(tasks):]
         out = cls(clearances=np.full(len(tasks), np.nan))

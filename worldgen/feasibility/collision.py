@@ -18,6 +18,7 @@ from typing import Optional
 import fcl
 import numpy as np
 
+from worldgen.errors import SceneError
 from worldgen.scene import Robot, Scene
 
 __all__ = ["Colliders", "Nearest"]
@@ -54,7 +55,7 @@ def _geometry(node):
         model.addSubModel(np.ascontiguousarray(shape.scaled_vertices(), dtype=float), faces)
         model.endModel()
         return model
-    raise TypeError(f"node {node.name!r}: no FCL geometry for shape kind {shape.kind!r}")
+    raise SceneError(f"node {node.name!r}: no FCL geometry for shape kind {shape.kind!r}")
 
 
 class Colliders:

@@ -83,7 +83,7 @@ class Planner:
     def __init__(self, cs: ConfigSpace):
         self.cs = cs
         n = len(cs.obstacles)
-        self._have: dict[int, np.ndarray] = {}  # per obstacle: the obstacles its tangents were computed to
+        self._have: dict[int, np.ndarray] = {}  # per (circle, side): the obstacles its tangents were computed to
         self._store = TangentStore()
         self._angle0 = np.arctan2(cs.cone_a[:, 1], cs.cone_a[:, 0])
         self._full = cs.full
@@ -309,26 +309,29 @@ class Planner:
         return np.flatnonzero(near)
 
     def _fill_tables(self, requests) -> None:
-        """Compute, in one call, every tangent the requests need that no earlier request did."""
+        """Compute, in one call, every tangent the requests need that no earlier request did: from each
+        node's own circle and side (the only rows it reads) to every circle of its band's new obstacles."""
         cs = self.cs
-        src_parts, dst_parts, nodes = [], [], []
+        src_parts, dst_parts, s1_parts, nodes = [], [], [], []
         for i, band, _ in requests:
             node = self._nodes[i]
             if node.circle < 0:
                 continue
-            a = int(cs.owner[node.circle])
-            have = self._have.setdefault(a, np.zeros(len(cs.obstacles), dtype=bool))
+            have = self._have.setdefault(node.circle * 2 + (node.side < 0), np.zeros(len(cs.obstacles), dtype=bool))
             todo = band[~have[band]]
             if len(todo):
                 have[todo] = True
-                src_c = np.arange(cs.first[a], cs.first[a + 1])
                 dst_c = cs.circles_of(todo)
-                src_parts.append(np.repeat(src_c, len(dst_c)))
-                dst_parts.append(np.tile(dst_c, len(src_c)))
+                src_parts.append(np.full(len(dst_c), node.circle))
+                dst_parts.append(dst_c)
+                s1_parts.append(np.full(len(dst_c), node.side))
                 nodes.append(node)
         if src_parts:
-            src, dst, s1, s2 = every_side(np.concatenate(src_parts), np.concatenate(dst_parts))
-            self._store.add(tangents(cs, src, dst, s1, s2, among=self._blockers(nodes, None)), cs)
+            src, dst, s1 = np.concatenate(src_parts), np.concatenate(dst_parts), np.concatenate(s1_parts)
+            n = len(src)
+            s2 = np.repeat(np.array([1, -1], dtype=np.int64), n)
+            self._store.add(tangents(cs, np.tile(src, 2), np.tile(dst, 2), np.tile(s1, 2), s2,
+                                     among=self._blockers(nodes, None)), cs)
 
     # -- arcs --------------------------------------------------------------
     def _rel(self, circle: int, normal: np.ndarray) -> float:

@@ -8,6 +8,7 @@ from typing import Any, Callable, Mapping, Optional
 
 import numpy as np
 
+from worldgen.errors import ParameterError
 from worldgen.params import COMMON_PARAMS, Param, validate_params
 from worldgen.scene import Robot, Scene, Task
 
@@ -47,7 +48,7 @@ class GeneratorSpec:
     def __post_init__(self):
         # The name becomes part of every world_id, and so of folder names: keep it plain.
         if not re.fullmatch(r"[a-z][a-z0-9_]{0,31}", self.name):
-            raise ValueError(f"generator name {self.name!r} must be 1-32 of a-z, 0-9, _ (starting with a letter)")
+            raise ParameterError(f"generator name {self.name!r} must be 1-32 of a-z, 0-9, _ (starting with a letter)")
 
     @property
     def all_params(self) -> tuple[Param, ...]:

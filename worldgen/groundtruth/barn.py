@@ -46,7 +46,7 @@ of path BARN's A* returns.
 from __future__ import annotations
 
 import math
-from typing import Callable, Optional
+from typing import Optional
 
 import numpy as np
 
@@ -100,7 +100,7 @@ def barn_metrics(grid, path_cells, disp_radius) -> dict[str, Optional[float]]:
     longest = max(rows, cols) + 1
     table = {1: np.arange(longest + 1, dtype=float), 2: _steps(math.sqrt(2), longest)}
     return {
-        "closest_wall": _mean(_closest_wall(occ, r, c, wall)),
+        "closest_wall": _mean(_closest_wall(occ, r, c, wall, runs)),
         "average_visibility": _mean(_visibility(runs, wall, table)),
         "dispersion": _mean(_dispersion(occ, r, c, wall, disp_radius)),
         "characteristic_dimension": _mean(_char_dim(runs, wall, table, rows + cols)),
@@ -150,18 +150,27 @@ def world_inputs(occupied, origin, resolution: float, robot_radius: float, waypo
     cell of its own: BARN's C-space is smaller than its map by the kernel). ``kernel`` replaces
     :func:`kernel_cells`; 1 gives the uninflated map and the chain in map cells.
     """
+    grid, half = _grid(occupied, resolution, robot_radius, kernel)
+    return grid, _cells(grid, half, len(occupied), origin, resolution, waypoints)
+
+
+def _grid(occupied, resolution: float, robot_radius: float, kernel: Optional[int]) -> tuple[np.ndarray, int]:
+    """(BARN's C-space of the map, the kernel's half-width): the part of :func:`world_inputs` every path shares."""
     occ = np.asarray(occupied, dtype=bool)[::-1]
     rows, cols = occ.shape
     k = min(kernel_cells(robot_radius, resolution) if kernel is None else kernel, rows, cols)
-    half = k // 2
-    grid = cspace(occ, k)
+    return cspace(occ, k), k // 2
+
+
+def _cells(grid: np.ndarray, half: int, rows: int, origin, resolution: float, waypoints) -> np.ndarray:
+    """The chain of C-space cells of one path's waypoints (see :func:`world_inputs`)."""
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     col = np.floor((w[:, 0] - origin[0]) / resolution).astype(np.int64)
     row = rows - 1 - np.floor((w[:, 1] - origin[1]) / resolution).astype(np.int64)
     cells = chain(np.c_[row, col]) - half
     cells = np.c_[np.clip(cells[:, 0], 0, grid.shape[0] - 1), np.clip(cells[:, 1], 0, grid.shape[1] - 1)]
     keep = np.r_[True, (cells[1:] != cells[:-1]).any(axis=1)]
-    return grid, cells[keep]
+    return cells[keep]
 
 
 def world_metrics(occupied, origin, resolution: float, robot_radius: float, paths,
@@ -169,8 +178,9 @@ def world_metrics(occupied, origin, resolution: float, robot_radius: float, path
     """BARN's five metrics of a world: :func:`barn_metrics` on :func:`world_inputs` of each path
     (polylines; None for a task without one), averaged over the paths; each None without a path
     (tortuosity also where every path starts and ends in one cell)."""
-    per = [barn_metrics(*world_inputs(occupied, origin, resolution, robot_radius, p), disp_radius)
-           for p in paths if p is not None]
+    found = [p for p in paths if p is not None]
+    grid, half = _grid(occupied, resolution, robot_radius, None) if found else (None, 0)  # one C-space for all
+    per = [barn_metrics(grid, _cells(grid, half, len(occupied), origin, resolution, p), disp_radius) for p in found]
     out: dict[str, Optional[float]] = {}
     for name in NAMES:
         values = [v for m in per if (v := m[name]) is not None]
@@ -209,56 +219,87 @@ def _steps(step: float, n: int) -> np.ndarray:
     return np.r_[0.0, np.add.accumulate(np.full(n, step))]
 
 
-def _closest_wall(occ, r, c, wall) -> np.ndarray:
+def _closest_wall(occ, r, c, wall, runs) -> np.ndarray:
     rows, cols = occ.shape
     if not occ.any():
         return np.full(len(r), float((rows - 1) // 2))  # BARN's fallback, Python 2's division
     # BARN's best-first search pops cells by Euclidean distance from the start and stops at the
-    # first wall: the nearest wall cell of the grid. Exactly, in two passes: the vertical distance
-    # to the nearest wall of every column, then per path cell the least dx^2 + dy^2 over the
-    # columns (integers throughout, so the square root is BARN's math.sqrt of the same integer).
-    at = np.arange(rows, dtype=np.int32)[:, None]
-    far = rows + cols  # a column without a wall: farther than any wall of the grid
-    below = np.minimum.accumulate(np.where(occ, at, np.int32(rows + far))[::-1], axis=0)[::-1][r] - r[:, None]
-    above = r[:, None] - np.maximum.accumulate(np.where(occ, at, np.int32(-far)), axis=0)[r]
-    dy = np.minimum(below, above).astype(np.int64)  # (path cells, cols)
-    dx = np.arange(cols)[None, :] - c[:, None]
-    d2 = (dx * dx + dy * dy).min(axis=1)
+    # first wall: the nearest wall cell of the grid. Exactly: the wall a free run along one of the 8
+    # moves stops at (when it stops inside the grid) bounds that distance, so only the columns within
+    # the bound can hold the nearest wall; in each, the nearest wall above and below the cell is found by
+    # binary search, and the least dx^2 + dy^2 taken (integers throughout, so the square root is BARN's
+    # math.sqrt of the same integer). A cell with no such run looks at every column.
+    bound = np.full(len(r), cols, dtype=np.int64)  # columns either side to look at
+    for (dr, dc), run in runs.items():
+        k = run.astype(np.int64) + 1
+        stop_r, stop_c = r + k * dr, c + k * dc
+        inside = (stop_r >= 0) & (stop_r < rows) & (stop_c >= 0) & (stop_c < cols)
+        # The wall at k steps is k (or k sqrt(2) on a diagonal) away: columns beyond that cannot be nearer.
+        reach = k if dr == 0 or dc == 0 else np.ceil(k * math.sqrt(2)).astype(np.int64)
+        bound = np.where(inside, np.minimum(bound, reach), bound)
+    bound = np.where(wall, 0, bound)
+    lo, hi = np.maximum(c - bound, 0), np.minimum(c + bound, cols - 1)
+    counts = hi - lo + 1
+    cell = np.repeat(np.arange(len(r)), counts)
+    col = np.repeat(lo, counts) + (np.arange(counts.sum()) - np.repeat(np.cumsum(counts) - counts, counts))
+    row = r[cell]
+    keys = np.flatnonzero(occ.T)  # column-major: sorted by column, then row
+    here = col * rows + row
+    far = rows + cols  # farther than any wall of the grid
+    below = _to_wall(keys, here, rows - row, side="left")  # the wall at or below (row + k) the cell
+    above = _to_wall(keys, here, row + 1, side="right")
+    below = np.where(below < rows - row, below, far)
+    above = np.where(above < row + 1, above, far)
+    dy = np.minimum(below, above)
+    dx = col - c[cell]
+    d2 = np.full(len(r), np.iinfo(np.int64).max)
+    np.minimum.at(d2, cell, dx * dx + dy * dy)
     return np.where(wall, 0.0, np.sqrt(d2.astype(float)))
 
 
 def _free_runs(occ, r, c) -> dict[tuple[int, int], np.ndarray]:
     """For each of the 8 grid moves, the free cells after each path cell before a wall or the edge.
 
-    Only the lines (rows, columns, diagonals) through path cells are scanned: each is laid out
-    as a row of a (lines, length) array, cells off the grid counting as walls (a run stops at
-    the edge as at a wall), and the next and previous stop of every cell found by running
-    minima and maxima along it."""
+    The walls of each family of lines (rows, columns, both diagonals) as one sorted array of keys
+    (line id, position along the line); each path cell's next and previous wall on its line by binary
+    search, the edge of the grid counting as a wall (a run stops there as at a wall). A wall cell's
+    runs are -1 (its own cell stops them)."""
     rows, cols = occ.shape
+    flat = np.flatnonzero(occ)  # row-major: sorted by row, then column
+    wr, wc = flat // cols, flat % cols
     out = {}
-    # The grid with `rows` wall columns either side: a diagonal leaving the grid runs into them.
-    padded = np.pad(occ, ((0, 0), (rows, rows)), constant_values=True).ravel()
-    start = np.arange(rows) * (cols + 2 * rows) + rows  # flat index of each row's first grid cell
-    # (line ids of the path cells, the lines' cells, the path cells' positions along their line)
-    layouts: dict[tuple[int, int], tuple[np.ndarray, Callable[..., np.ndarray], np.ndarray]] = {
-        (0, 1): (r, lambda ids: occ[ids], c),
-        (1, 0): (c, lambda ids: occ[:, ids].T, r),
-    }
-    for dc in (1, -1):
-        # Down-right diagonals keep c - r, down-left ones c + r; position along them is the row.
-        def lay(ids, dc=dc):
-            return padded[ids[:, None] + (start + dc * np.arange(rows))[None, :]]
-        layouts[(1, dc)] = (c - dc * r, lay, r)
-    for (dr, dc), (key, lay, pos) in layouts.items():
-        ids, line = np.unique(key, return_inverse=True)
-        cells = lay(ids)
-        n = cells.shape[1]
-        at = np.arange(n, dtype=np.int32)[None, :]
-        nxt = np.flip(np.minimum.accumulate(np.flip(np.where(cells, at, np.int32(n)), 1), axis=1), 1)
-        prv = np.maximum.accumulate(np.where(cells, at, np.int32(-1)), axis=1)
-        out[(dr, dc)] = nxt[line, pos] - pos - 1
-        out[(-dr, -dc)] = pos - prv[line, pos] - 1
+    # (move, line id and position of the walls, of the path cells; cells to the edge forwards, backwards)
+    families = (
+        ((0, 1), wr, wc, r, c, cols - c, c + 1),
+        ((1, 0), wc, wr, c, r, rows - r, r + 1),
+        ((1, 1), wc - wr + rows, wr, c - r + rows, r, np.minimum(rows - r, cols - c), np.minimum(r + 1, c + 1)),
+        ((1, -1), wc + wr, wr, c + r, r, np.minimum(rows - r, c + 1), np.minimum(r + 1, cols - c)),
+    )
+    span = rows + cols + 1  # more than any line id or position
+    for move, wall_line, wall_pos, line, pos, to_edge, back_edge in families:
+        on = np.zeros(span, dtype=bool)
+        on[line] = True
+        keep = on[wall_line]  # only the lines through path cells
+        keys = wall_line[keep].astype(np.int64) * span + wall_pos[keep]
+        if move != (0, 1):  # the rows' keys come sorted
+            keys.sort()
+        here = line.astype(np.int64) * span + pos
+        out[move] = np.minimum(_to_wall(keys, here, span - pos, side="left"), to_edge) - 1
+        out[(-move[0], -move[1])] = np.minimum(_to_wall(keys, here, pos + 1, side="right"), back_edge) - 1
     return out
+
+
+def _to_wall(keys: np.ndarray, here: np.ndarray, limit: np.ndarray, side: str) -> np.ndarray:
+    """Steps from each key ``here`` to the nearest of the sorted ``keys`` ahead (``side="left"``: at or
+    after it) or behind (``"right"``: at or before it); ``limit`` (or more) where that is on another line."""
+    if len(keys) == 0:
+        return limit
+    i = np.searchsorted(keys, here, side=side)
+    if side == "left":
+        steps = keys[np.minimum(i, len(keys) - 1)] - here
+        return np.where((i < len(keys)) & (steps < limit), steps, limit)
+    steps = here - keys[np.maximum(i - 1, 0)]
+    return np.where((i > 0) & (steps < limit), steps, limit)
 
 
 def _visibility(runs, wall, table) -> np.ndarray:

@@ -2,7 +2,8 @@
 
 The one place that reads a World's parameters for lidar, map and metrics, so
 that world.json and the written map files always agree. A world's occupancy map
-is made once and remembered (worlds are written after their metadata is built).
+and difficulty figures are made once and remembered (worlds are written after their metadata is built,
+and a world asked for at a level is scored before it).
 """
 
 from __future__ import annotations
@@ -17,15 +18,17 @@ from worldgen.params import COMMON_PARAMS
 from worldgen.scene import Pose
 from worldgen.scene.doors import open_scene
 
-__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "occupancy_block", "map_files", "difficulty", "barn",
-           "barn_inputs",
-           "MAP_KEYS"]
+__all__ = ["lidar_spec", "sensors", "planning_scene", "occupancy_map", "start_occupancy_map", "doors_start_shut",
+           "occupancy_block", "map_files", "difficulty", "barn", "barn_inputs", "MAP_KEYS"]
 
 #: world.json ``files`` keys of the map's two files.
 MAP_KEYS = ("map_pgm", "map_yaml")
 
 _DEFAULTS = {p.name: p.default for p in COMMON_PARAMS}
 _MAPS: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+#: The difficulty figures of each world, computed once: a world asked for at a level was scored with them
+#: (worldgen.leveling) before its world.json is built.
+_DIFFICULTY: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 
 def _param(world, name: str):
@@ -67,6 +70,21 @@ def occupancy_map(world) -> occupancy.OccupancyMap:
     return _MAPS[world]
 
 
+def doors_start_shut(world) -> bool:
+    """Whether a door leaf starts anywhere but at its open limit (closed or ajar): then the scene as it
+    starts differs from :func:`planning_scene`, and so does its map."""
+    from worldgen.scene.doors import door_joints, state_of
+
+    return any(state_of(joint) != "open" for joint in door_joints(world.scene))
+
+
+def start_occupancy_map(world) -> occupancy.OccupancyMap:
+    """The occupancy map of the scene as it starts (every door leaf where it starts), with map.pgm's
+    height, resolution and extent: what a localiser meets at the spawn. world.json's map stays
+    :func:`occupancy_map` (the planning scene); the ROS 2 bundle gives nav2 this one."""
+    return occupancy.build(world.scene, float(_param(world, "map_height")), float(_param(world, "map_resolution")))
+
+
 def occupancy_block(world) -> dict:
     """world.json's ``occupancy`` block."""
     return occupancy_map(world).describe(MAP_IMAGE_NAME, MAP_YAML_NAME)
@@ -81,7 +99,10 @@ def map_files(world) -> dict[str, tuple[str, bytes]]:
 
 def difficulty(world) -> dict:
     """worldgen's five exact figures of world.json's ``metrics`` (after BARN's; not BARN's numbers)."""
-    return metrics.difficulty(planning_scene(world), world.robot, world.tasks, world.feasibility.paths)
+    if world not in _DIFFICULTY:
+        _DIFFICULTY[world] = metrics.difficulty(planning_scene(world), world.robot, world.tasks,
+                                                world.feasibility.paths)
+    return dict(_DIFFICULTY[world])
 
 
 def barn(world) -> dict:

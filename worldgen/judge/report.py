@@ -4,7 +4,7 @@
       report.json     evaluate's report (verdict, failures, summary, criteria) with one row per bag
       report.csv      one row per bag, the columns of RUN_COLUMNS first
       report.md       the verdict, the criteria, the per-world summary where the report has one, every run
-      runs/RUN.png    the run over the world's map.pgm: reference path, trajectory, spawn, goal, contacts
+      runs/RUN.png    the run over the world as preview.png draws it: trajectory, contacts, who was where at each
 
 The folder is written beside its destination under a temporary name and renamed into place,
 so a reader never sees half a report; an earlier report in the same place is replaced, any
@@ -25,16 +25,16 @@ from typing import Any, Optional
 import numpy as np
 
 from worldgen.errors import OutputError
+from worldgen.export.topdown import COLOURS as TOPDOWN_COLOURS
 
 __all__ = ["write_report", "RUN_COLUMNS", "draw_run", "COLOURS"]
 
 #: Columns of report.csv, in order; any other key of a row follows, sorted.
-RUN_COLUMNS = ["run", "bag", "readable", "world_id", "task", "source", "start", "start_time", "success", "reason",
+RUN_COLUMNS = ["run", "bag", "outcome", "readable", "world_id", "task", "source", "start", "start_time", "success", "reason",
                "reached_goal", "time_to_goal", "duration", "path_length", "path_efficiency", "min_clearance",
                "collisions", "min_separation", "max_velocity", "drift_bounded", "source_detail", "picture"]
-#: RGB of the picture's layers (the reference path and markers as preview.png draws them).
-COLOURS = {"path": (250, 140, 0), "run": (200, 30, 30), "run_ok": (28, 120, 200), "spawn": (28, 150, 70),
-           "goal": (30, 90, 220), "contact": (200, 30, 30), "text": (20, 20, 25)}
+#: The one colour table of every top-down picture (worldgen.export.topdown), the run's layers among it.
+COLOURS = TOPDOWN_COLOURS
 _WIDTH = 640
 
 
@@ -74,7 +74,7 @@ def _markdown(report: dict) -> str:
     s = report["summary"]
     out = [f"# Run report: {'PASS' if report['passed'] else 'FAIL'}", ""]
     out.append(f"{s.get('bags', s.get('runs'))} bags, {s.get('runs', 0)} runs judged, {s.get('successes', 0)} succeeded, "
-               f"{s.get('unreadable', 0)} unreadable.")
+               f"{s.get('unjudged', 0)} unjudged (no verdict: left out of every rate).")
     out.append("")
     if report["failures"]:
         out += ["## Failures", ""] + [f"- {f}" for f in report["failures"]] + [""]
@@ -94,83 +94,60 @@ def _markdown(report: dict) -> str:
     elif isinstance(per_world, list) and per_world:
         keys = sorted({k for v in per_world for k in v})
         out += ["## Per world", ""] + _table(keys, [[_cell(v.get(k)) for k in keys] for v in per_world]) + [""]
-    head = ["run", "world", "task", "source", "success", "reason", "time to goal (s)", "path eff.", "min clearance (m)",
+    head = ["run", "world", "task", "source", "outcome", "reason", "time to goal (s)", "path eff.", "min clearance (m)",
             "contacts", "picture"]
     rows = []
     for r in report["runs"]:
         pic = f"[png]({r['picture']})" if r.get("picture") else ""
         rows.append([str(r.get("run")), _cell(r.get("world_id")), _cell(r.get("task")), _cell(r.get("source")),
-                     "yes" if r.get("success") else "no", _cell(r.get("reason")), _cell(r.get("time_to_goal")),
+                     _cell(r.get("outcome")), _cell(r.get("reason")), _cell(r.get("time_to_goal")),
                      _cell(r.get("path_efficiency")), _cell(r.get("min_clearance")), str(len(r.get("collisions") or [])), pic])
     out += ["## Runs", ""] + _table(head, rows) + [""]
     return "\n".join(out)
 
 
-def _map(folder: Path):
-    """(RGB image of map.pgm, resolution, origin x, origin y), or None where the world has no map."""
-    import yaml
-    from PIL import Image
-
-    from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
-
-    try:
-        meta = yaml.safe_load((folder / MAP_YAML_NAME).read_text())
-        img = Image.open(folder / str(meta.get("image", MAP_IMAGE_NAME)))
-        img.load()
-    except (OSError, ValueError, yaml.YAMLError):
-        return None
-    return img.convert("RGB"), float(meta["resolution"]), float(meta["origin"][0]), float(meta["origin"][1])
+#: px above the world's picture for the run's name, verdict and legend.
+_HEADER = 54
 
 
-def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict):
-    """The run's picture (a Pillow image) over the world's map, or None when the folder has no map.pgm."""
+#: Worlds whose picture is kept while a report is drawn (runs usually come grouped by world).
+_WORLDS_KEPT = 4
+
+
+def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict, worlds: Optional[dict] = None):
+    """The run's picture (a Pillow image): the world as preview.png draws it from world.json (walls, obstacles,
+    no-go zone, reference path, spawn and goal, movers' and people's tracks), the run over it, and at each
+    contact who was where, all with :mod:`worldgen.export.topdown`; a header with the run and its verdict.
+    ``worlds`` keeps each world's picture between runs (it costs tens of ms to draw)."""
     from PIL import Image, ImageDraw
 
-    from worldgen.export.preview_frame import text_font
+    from worldgen.export.preview import draw, layout
+    from worldgen.export.topdown import Pen, text_font
+    from worldgen.export.topdown import draw_run as draw_trajectory
     from worldgen.groundtruth.ground import load
 
-    found = _map(Path(world))
-    if found is None:
-        return None
-    img, res, ox, oy = found
-    scale = max(1, _WIDTH // img.width)
-    img = img.resize((img.width * scale, img.height * scale), Image.NEAREST)
-    top = 54
-    canvas = Image.new("RGB", (img.width, img.height + top), (255, 255, 255))
-    canvas.paste(img, (0, top))
+    worlds = {} if worlds is None else worlds
+    key = str(Path(world).resolve())
+    if key not in worlds:
+        ground = load(world)
+        worlds[key] = (ground, layout(ground.meta, _WIDTH), draw(ground.meta, _WIDTH))
+        while len(worlds) > _WORLDS_KEPT:
+            worlds.pop(next(iter(worlds)))
+    ground, lay, background = worlds[key]
+    meta = ground.meta
+    picture = background.copy()
+    draw_trajectory(Pen(picture, lay), meta, trajectory, bool(row.get("success")), row.get("collisions") or [])
+    canvas = Image.new("RGB", (picture.width, picture.height + _HEADER), COLOURS["background"])
+    canvas.paste(picture, (0, _HEADER))
     pen = ImageDraw.Draw(canvas)
-    px_per_m = scale / res
-
-    def px(x: float, y: float) -> tuple[float, float]:
-        return (x - ox) * px_per_m, top + img.height - (y - oy) * px_per_m
-
-    t = load(world).task(task)
-    robot_r = float(load(world).meta["robot"]["radius"]) * px_per_m
-    ref = (t.get("path") or {}).get("waypoints") or []
-    if len(ref) > 1:
-        pen.line([px(*p[:2]) for p in ref], fill=COLOURS["path"], width=7)
-    sx, sy = px(*t["spawn"][:2])
-    pen.ellipse([sx - robot_r, sy - robot_r, sx + robot_r, sy + robot_r], outline=COLOURS["spawn"], width=3)
-    gx, gy = px(*t["goal"][:2])
-    gr = float(t["goal_tolerance"]) * px_per_m
-    pen.ellipse([gx - gr, gy - gr, gx + gr, gy + gr], outline=COLOURS["goal"], width=3)
+    t = ground.task(task)
     colour = COLOURS["run_ok"] if row.get("success") else COLOURS["run"]
-    if len(trajectory) > 1:
-        pen.line([px(x, y) for _, x, y in trajectory], fill=colour, width=3)
-    for c in row.get("collisions") or []:
-        cx = float(np.interp(c["time"], trajectory[:, 0], trajectory[:, 1]))
-        cy = float(np.interp(c["time"], trajectory[:, 0], trajectory[:, 2]))
-        x, y = px(cx, cy)
-        pen.ellipse([x - robot_r, y - robot_r, x + robot_r, y + robot_r], outline=COLOURS["contact"], width=3)
-        pen.line([x - robot_r, y - robot_r, x + robot_r, y + robot_r], fill=COLOURS["contact"], width=2)
-        pen.line([x - robot_r, y + robot_r, x + robot_r, y - robot_r], fill=COLOURS["contact"], width=2)
     verdict = "success" if row.get("success") else f"FAIL: {row.get('reason') or ''}"
-    font = text_font(13)
-    pen.text((6, 3), f"{row.get('run')}  {row.get('world_id')} / {t['id']}  source: {row.get('source')}", fill=COLOURS["text"],
-             font=font)
-    pen.text((6, 19), verdict[:60], fill=colour, font=font)
-    pen.text((6, 35), "orange: reference path   blue/red line: the run   green: spawn   blue circle: goal   x: contact",
-             fill=COLOURS["text"], font=text_font(11))
+    pen.text((6, 3), f"{row.get('run')}   task {t['id']}   source: {row.get('source')}", fill=COLOURS["text"],
+             font=text_font(13))
+    pen.text((6, 19), verdict[:90], fill=colour, font=text_font(13))
+    pen.text((6, 35), "blue/red line: the run (success/failure)   red x: a contact, with every mover and person "
+             "where they were then", fill=COLOURS["text"], font=text_font(11))
     return canvas
 
 
@@ -185,11 +162,12 @@ def write_report(result, out) -> Path:
         shutil.rmtree(tmp, ignore_errors=True)
         (tmp / "runs").mkdir(parents=True)
         report = result.report
+        worlds: dict = {}
         for k, (row, plot) in enumerate(zip(report["runs"], result.plots)):
             row["picture"] = None
             if plot is None:
                 continue
-            image = draw_run(plot["world"], plot["task"], result.trajectory(k), row)
+            image = draw_run(plot["world"], plot["task"], result.trajectory(k), row, worlds)
             if image is not None:
                 name = f"runs/{_safe(str(row['run']))}.png"
                 image.save(tmp / name, format="PNG")

@@ -3,7 +3,7 @@
 Usage (an example that runs is in :mod:`worldgen.ros`)::
 
     result = judge(["runs/r0", "runs/r1"], "criteria.yaml", world="worlds/cluttered-s0-1f3a9c0b")
-    result.passed, result.report["summary"]["unreadable"]
+    result.passed, result.report["summary"]["unjudged"]
     write_report(result, "report/")          # worldgen.judge.report
 
 Which world a bag ran in, in order of precedence:
@@ -17,10 +17,12 @@ Which world a bag ran in, in order of precedence:
 
 A bag that names a world in its metadata is checked against the world it is judged in.
 Each bag is read (streamed) as its turn comes and only its figures are kept, so a batch
-of thousands holds one bag at a time. A bag that cannot be read, or whose world cannot be
-found, is a row with ``readable`` False and its ``reason``; it is counted in
-``summary.unreadable`` and the verdict does not pass while any bag is unreadable: a gate
-must not pass on missing data.
+of thousands holds one bag at a time. Each row's ``outcome`` is ``success``, ``failure`` or
+``unjudged``: a bag that cannot be read, or whose world cannot be found, has no verdict
+(``success`` None, ``readable`` False, its ``reason``); it is counted in ``summary.unjudged``, left
+out of every rate, and the verdict does not pass while any bag is unjudged: a gate must not pass
+on missing data. A bag that reads but whose run is not its task's (it starts far from the spawn,
+or names another world) is a failed run with that reason.
 """
 
 from __future__ import annotations
@@ -188,6 +190,20 @@ def _decimate(traj: np.ndarray, n: int = PLOT_POINTS) -> np.ndarray:
     return traj[np.minimum(keep, len(traj) - 1), :3].copy()
 
 
+def _run_name(world_id: str, task: str, index: Optional[str], taken: set[str]) -> str:
+    """``<world>__<task>__run<k>``: readable, and unique across worlds (the bundle's run index counts per world).
+
+    ``k`` is the run's own index (the table's ``run``, the bag's ``worldgen.run``), else the first free one;
+    a run named by a word rather than a number keeps the word (``<world>__<task>__<name>``)."""
+    if index is not None:
+        index = str(index)
+        return _unique(f"{world_id}__{task}__{'run' if index.isdigit() else ''}{index}", taken)
+    k = 0
+    while f"{world_id}__{task}__run{k}" in taken:
+        k += 1
+    return _unique(f"{world_id}__{task}__run{k}", taken)
+
+
 # long: reading each bag, judging it and assembling the rows share the per-world cache
 def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, runs=None,
           start: str = "command", read_options: Optional[dict] = None,
@@ -197,22 +213,26 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     ``read_options`` go to :func:`worldgen.ros.reader.read_run` (topic and frame names,
     ``spawn_tolerance``, ``distro``...). ``progress(k)`` is called after each bag. Without
     ``criteria`` the gate is :data:`DEFAULT_CRITERIA`: every run meets its scenario, so a batch of
-    crashed runs never passes for want of a criteria file.
+    crashed runs never passes for want of a criteria file. Each row's ``outcome`` is ``success``,
+    ``failure`` (judged, and it failed: a run that started far from its spawn or names another world
+    too) or ``unjudged`` (the bag could not be read, or its world not found: no verdict at all).
     """
-    from worldgen.ros.reader import read_run
+    from worldgen.ros.reader import RunMismatchError, peek_metadata, read_run
     from worldgen.testing.evaluate import evaluate, load_criteria
 
     if criteria is None:
         criteria = DEFAULT_CRITERIA
     load_criteria(criteria)  # a mistake in the criteria stops before any bag is read
     items = plan(bags, world=world, pack=pack, runs=runs)
+    packs: dict[str, dict[str, Path]] = {}
+    if pack is not None:  # a pack that is missing or holds no world is a usage mistake, not 20 unjudged bags
+        packs[str(pack)] = _index(pack)
     options = dict(read_options or {})
     grounds: OrderedDict[Path, _WorldGround] = OrderedDict()
-    extra: list[dict] = []        # per bag: the judge's columns (readable ones also get evaluate's)
+    extra: list[dict] = []        # per bag: the judge's columns (judged ones also get evaluate's)
     plots: list[Optional[dict]] = []
     scratch = tempfile.TemporaryDirectory(prefix="worldgen-judge-")
     names: set[str] = set()
-    packs: dict[str, dict[str, Path]] = {}
 
     def ground(folder: Path) -> _WorldGround:
         key = folder.resolve()
@@ -223,53 +243,51 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
         grounds.move_to_end(key)
         return grounds[key]
 
-    def unique(name: str) -> str:
-        base, k = name, 2
-        while name in names:
-            name, k = f"{base}-{k}", k + 1
-        names.add(name)
-        return name
-
-    def readable() -> Iterator[tuple]:
+    def judged() -> Iterator[Any]:
         for k, item in enumerate(items):
             row: dict[str, Any] = {"bag": str(item.bag), "run": None, "readable": True}
             try:
-                folder, task = item.world, item.task
-                named = {}
-                if folder is None or task is None:
-                    from worldgen.ros.reader import peek_metadata
-                    named = peek_metadata(item.bag)
+                named = peek_metadata(item.bag)
+                folder, task = item.world, item.task or named.get("worldgen.task")
                 if folder is None:
                     if not named.get("worldgen.world_id"):
                         raise ParameterError(f"bag '{item.bag}': names no world in its metadata (worldgen.world_id); "
                                              "give --world DIR or --runs TABLE")
                     folder = _pack_world(pack, named["worldgen.world_id"], packs)
                 g = ground(folder)
-                task = task or named.get("worldgen.task")
-                got = read_run(item.bag, g, task=task, start=start, **options)
-                named = got.metadata.get("worldgen.world_id")
-                if named and named != g.meta.get("world_id"):
-                    raise ParameterError(f"bag '{item.bag}' was recorded in world {named!r}, "
-                                         f"not {g.meta.get('world_id')!r}")
-                row["run"] = unique(item.run or got.metadata.get("worldgen.run") or _stem(item.bag))
+                world_id, task_id = str(g.meta.get("world_id")), g.task(task)["id"]
+                row["run"] = _run_name(world_id, task_id, item.run or named.get("worldgen.run"), names)
+                row["world_folder"] = str(folder)
+                try:
+                    _same_world(item.bag, named, world_id)
+                    got = read_run(item.bag, g, task=task, start=start, **options)
+                    _same_world(item.bag, got.metadata, world_id)  # a bare storage file carries its own
+                    if item.run is None and not named.get("worldgen.run") and got.metadata.get("worldgen.run"):
+                        names.discard(row["run"])
+                        row["run"] = _run_name(world_id, task_id, got.metadata["worldgen.run"], names)
+                except RunMismatchError as exc:  # read, and not this task's run: a failure, not missing data
+                    extra.append(row)
+                    plots.append(None)
+                    yield {"world": g, "task": task, "refused": str(exc)}
+                    continue
                 row.update(source=got.source, source_detail=got.source_detail, drift_bounded=got.drift_bounded,
-                           start=got.start, start_time=got.start_time, world_folder=str(folder))
+                           start=got.start, start_time=got.start_time)
                 extra.append(row)
                 points = Path(scratch.name) / f"{len(plots)}.npy"
                 np.save(points, _decimate(got.trajectory))
                 plots.append({"world": folder, "task": task, "points": points})
                 yield got.trajectory, g, task
             except WorldgenError as exc:
-                row.update(run=row["run"] or unique(item.run or _stem(item.bag)), readable=False, reason=str(exc),
-                           success=False, world_id=None, task=item.task)
+                row.update(run=row["run"] or _unique(_stem(item.bag), names), readable=False, outcome="unjudged",
+                           reason=str(exc), success=None, world_id=None, task=item.task)
                 extra.append(row)
                 plots.append(None)
             finally:
                 if progress is not None:
                     progress(k + 1)
 
-    judged: Optional[dict] = None
-    runs_iter = readable()
+    report: Optional[dict] = None
+    runs_iter = judged()
     try:
         first = next(runs_iter)
     except StopIteration:
@@ -278,8 +296,25 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
         def chained():
             yield first
             yield from runs_iter
-        judged = evaluate(chained(), criteria).to_dict()
-    return JudgeResult(_assemble(judged, extra), plots, scratch)
+        report = evaluate(chained(), criteria).to_dict()
+    return JudgeResult(_assemble(report, extra), plots, scratch)
+
+
+def _same_world(bag: Path, metadata: dict, world_id: str) -> None:
+    """RunMismatchError when the bag's metadata names a world other than the one it is judged in."""
+    from worldgen.ros.reader import RunMismatchError
+
+    claimed = metadata.get("worldgen.world_id")
+    if claimed and claimed != world_id:
+        raise RunMismatchError(f"bag '{bag}' was recorded in world {claimed!r}, not {world_id!r}")
+
+
+def _unique(name: str, taken: set[str]) -> str:
+    base, k = name, 2
+    while name in taken:
+        name, k = f"{base}-{k}", k + 1
+    taken.add(name)
+    return name
 
 
 def _stem(bag: Path) -> str:
@@ -287,18 +322,21 @@ def _stem(bag: Path) -> str:
 
 
 def _assemble(judged: Optional[dict], extra: list[dict]) -> dict:
-    """Evaluate's report with every bag's row in bag order (unreadable ones included) and the gate's verdict."""
+    """Evaluate's report with every bag's row in bag order (unjudged ones included) and the gate's verdict."""
     rows, it = [], iter((judged or {}).get("runs", []))
     for row in extra:
-        rows.append((next(it) | row) if row["readable"] else row)
-    unreadable = sum(not r["readable"] for r in extra)
+        if row["readable"]:
+            row = next(it) | row
+            row["outcome"] = "success" if row.get("success") else "failure"
+        rows.append(row)
+    unjudged = sum(r["outcome"] == "unjudged" for r in rows)
     report = dict(judged) if judged else {"passed": False, "failures": [], "summary": {"runs": 0, "successes": 0},
                                           "criteria": []}
     report["runs"] = rows
-    report["summary"] = dict(report["summary"]) | {"bags": len(extra), "unreadable": unreadable}
-    if unreadable:
+    report["summary"] = dict(report["summary"]) | {"bags": len(extra), "unjudged": unjudged}
+    if unjudged:
         report["failures"] = list(report["failures"]) + [
-            f"bags: {unreadable} of {len(extra)} could not be read; a gate does not pass on missing data"]
+            f"bags: {unjudged} of {len(extra)} could not be judged; a gate does not pass on missing data"]
         report["passed"] = False
     for r in rows:  # JSON has no NaN or inf
         for k, v in r.items():

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Iterator, Optional, TextIO
 
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError
+from worldgen.export.formats import require_formats
 from worldgen.files import BUILD_STATE_DIR, INDEX_NAME, MANIFEST_NAME, WORLDS_DIR, write_atomically
 from worldgen.pack.manifest import build_manifest, index_bytes, manifest_bytes, world_folder
 from worldgen.pack.recipe import Recipe
@@ -83,6 +84,7 @@ def build_pack(recipe: Recipe, out, jobs: int = 1, progress: Optional[TextIO] = 
     import worldgen
 
     _check_options(jobs, executor, scheduler)
+    require_formats(recipe.formats)  # a missing extra (usd) stops the build before any folder is made
     version = version or worldgen.__version__
     out = Path(out)
     created = _first_missing(out)

@@ -21,7 +21,7 @@ SCHEMA_ID = "worldgen.pack/1"
 #: The key metrics copied from each world.json into the manifest and index.csv.
 METRICS = ("obstacle_count", "free_area_ratio", "narrowest_passage", "path_length",
            "closest_obstacle_distance_mean", "average_visibility", "dispersion",
-           "characteristic_dimension", "tortuosity")
+           "characteristic_dimension", "tortuosity", "difficulty", "difficulty_level")
 
 
 def build_manifest(recipe, records: Iterable[Mapping[str, Any]], version: str) -> dict:
@@ -63,13 +63,16 @@ def world_folder(world: Mapping[str, Any]) -> str:
 
 
 def index_bytes(manifest: Mapping[str, Any]) -> bytes:
-    """index.csv: one row per world, its id, generator, seed, folder and key metrics."""
+    """index.csv: one row per world, its id, generator, seed, the level asked for and its request seed, folder
+    and key metrics (``difficulty_level`` among them: the level it landed in, for every world)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    w.writerow(["index", "world_id", "generator", "seed", "folder", *METRICS])
+    w.writerow(["index", "world_id", "generator", "seed", "level", "request_seed", "folder", *METRICS])
     for i, world in enumerate(manifest["worlds"]):
         m = world["metrics"]
-        w.writerow([i, world["world_id"], world["generator"], world["seed"], world_folder(world),
+        # level, request_seed: what a level entry asked for (empty for the rest); seed is the draw that landed
+        w.writerow([i, world["world_id"], world["generator"], world["seed"], world.get("level", ""),
+                    world.get("request_seed", ""), world_folder(world),
                     *("" if m.get(k) is None else repr(m[k]) for k in METRICS)])
     return buf.getvalue().encode()
 

@@ -5,7 +5,7 @@ beyond YAML's safe scalars), so every value keeps the line it came from and
 every mistake is one line ``RECIPE:LINE: key 'K': what is wrong``::
 
     name: small-clutter            # optional; default: the file's stem
-    formats: [sdf, mjcf, urdf]     # optional; default: every format
+    formats: [sdf, mjcf, urdf]     # optional; default: sdf, mjcf, urdf (usd only when listed)
     sdf_version: "1.9"             # optional
     preview: false                 # optional; default false (preview.png costs ~40 ms a world)
     ros: false                     # optional; true (or a Gazebo release: fortress, harmonic, ...) adds ros2/
@@ -46,7 +46,7 @@ from typing import Any, Optional
 import yaml
 
 from worldgen.errors import InfeasibleError, ParameterError, WorldgenError, did_you_mean, quoted, read_user_text
-from worldgen.export.formats import FORMATS, SDF_VERSIONS, normalise_formats
+from worldgen.export.formats import ALL_FORMATS, FORMATS, SDF_VERSIONS, normalise_formats
 from worldgen.floats import round_float
 from worldgen.seeding import MAX_SEED, recipe_rng
 
@@ -141,7 +141,7 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
         try:
             formats = normalise_formats(value if isinstance(value, (list, str)) else [str(value)])
         except (ParameterError, AttributeError):
-            r.fail(top["formats"], "formats", f"must list formats among {', '.join(FORMATS)}, got {quoted(value)}")
+            r.fail(top["formats"], "formats", f"must list formats among {', '.join(ALL_FORMATS)}, got {quoted(value)}")
     sdf_version = SDF_VERSIONS[0]
     if "sdf_version" in top:
         sdf_version = str(r.value(top["sdf_version"]))

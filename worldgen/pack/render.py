@@ -49,7 +49,7 @@ def render_job(job: Job, formats, sdf_version: str, preview: bool, ros=False) ->
     except InfeasibleError as exc:
         rec.update(params=params, reason=str(exc), failures=dict(sorted(exc.failures.items())))
         return rec, {}
-    world.preset = job.preset
+    world.set_provenance(preset=job.preset)
     if job.preset:
         rec["preset"] = job.preset
     if job.level is not None:  # the world's own seed is the draw that landed; the request's is kept beside it

@@ -42,14 +42,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence
 
 import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
+from worldgen.feasibility.exact import GRAPH_MAX_CIRCLES, GRAPH_ROWS_PER_QUERY, ExactPlanner, exact_planner
 from worldgen.feasibility.geometry import Obstacles2D
-from worldgen.feasibility.planner import Planner
-from worldgen.feasibility.roadmap import Roadmap
 from worldgen.floats import round_float
 from worldgen.people.behaviours import widest_tube
 from worldgen.people.groups import GroupForce, group_force
@@ -72,13 +71,14 @@ ARRIVE = 0.2
 CUTOFF = 1.5
 #: Least distance (m) a walking person covers between two looks before it counts as held up.
 STUCK = 0.1
-#: When a walk's routes go over one tangent graph (:class:`Roadmap`) rather than a lazy planner query each
-#: (:class:`Planner`; the same paths): measured in the benchmark's world (137 corner circles), the graph
-#: costs about 0.67 us per candidate tangent (2 C^2 of them for C circles) and saves about 0.08 ms per
-#: person and second walked, so it pays from this many candidates per person-second; and only up to
-#: ROADMAP_MAX_CIRCLES (at 524 circles its build took 1.4 s and 0.5 GB, a query 2.5 ms against 2.7).
-ROADMAP_ROWS_PER_PERSON_S = 117
-ROADMAP_MAX_CIRCLES = 250
+#: Exact route queries a walk asks per person and second walked (measured 0.119 in the benchmark's world:
+#: 143 for 20 people over 60 s); :func:`~worldgen.feasibility.exact.exact_planner` picks the planner by it.
+#: A power of two, so that the choice is the one made with the two figures below before (exactly so wherever
+#: people x seconds is exact in floating point).
+QUERIES_PER_PERSON_S = 0.125
+#: The same break-even per person-second, and the largest space the graph is built for.
+ROADMAP_ROWS_PER_PERSON_S = GRAPH_ROWS_PER_QUERY * QUERIES_PER_PERSON_S
+ROADMAP_MAX_CIRCLES = GRAPH_MAX_CIRCLES
 
 
 @dataclass(frozen=True)
@@ -190,7 +190,7 @@ def _runs(who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 class _Router:
     """Each person's places and the planned path to the current one; ``target`` the waypoint steered to."""
 
-    def __init__(self, planner: Union[Roadmap, Planner], sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
+    def __init__(self, planner: ExactPlanner, sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
         # Sight is tested in a configuration space SLACK thinner than the planner's: a waypoint on a
         # planner's circle is then in sight, not touching.
         self.planner, self.sight, self.places = planner, sight, places
@@ -329,12 +329,9 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
     return out
 
 
-def _route_finder(cs: ConfigSpace, n: int, duration: float):
-    """The router of a walk of ``n`` people for ``duration`` s: the one that costs less (both are exact)."""
-    c = cs.n_circles
-    if c <= ROADMAP_MAX_CIRCLES and 2 * c * c <= ROADMAP_ROWS_PER_PERSON_S * n * duration:
-        return Roadmap(cs)
-    return Planner(cs)
+def _route_finder(cs: ConfigSpace, n: int, duration: float) -> ExactPlanner:
+    """The router of a walk of ``n`` people for ``duration`` s: the exact planner that costs less for it."""
+    return exact_planner(cs, n * duration * QUERIES_PER_PERSON_S)
 
 
 def _people_force(p: np.ndarray, v: np.ndarray, e: np.ndarray, radius: float, m: SocialForce,

@@ -28,7 +28,7 @@ missing. Judging runs against worlds is :mod:`worldgen.judge`'s (docs/judge.md).
 
 from __future__ import annotations
 
-from worldgen.ros.reader import START_RULES, BagRun, read_run
+from worldgen.ros.reader import START_RULES, BagRun, RunMismatchError, read_run
 from worldgen.ros.writer import DISTROS, STORAGES, write_run
 
-__all__ = ["read_run", "write_run", "BagRun", "START_RULES", "STORAGES", "DISTROS"]
+__all__ = ["read_run", "write_run", "BagRun", "RunMismatchError", "START_RULES", "STORAGES", "DISTROS"]

@@ -18,16 +18,28 @@ from pathlib import Path
 from typing import Any, Callable, Optional
 
 import worldgen.ros.cdr as cdr
-from worldgen.errors import ParameterError
+from worldgen.errors import BagError
 
-__all__ = ["fail", "unreadable", "typestore", "storage", "bag_metadata", "decoder"]
-
-
-def fail(bag: Path, why: str) -> ParameterError:
-    return ParameterError(f"bag '{bag}': {why}")
+__all__ = ["RunMismatchError", "fail", "mismatch", "unreadable", "typestore", "storage", "listed_topics", "bag_metadata",
+           "decoder"]
 
 
-def unreadable(bag: Path, exc: Exception) -> ParameterError:
+class RunMismatchError(BagError):
+    """The bag reads, but its run is not the task's: it starts far from the spawn, or names another world.
+
+    Not a bag that cannot be read: the judge counts it as a failed run, with this reason.
+    """
+
+
+def fail(bag: Path, why: str) -> BagError:
+    return BagError(f"bag '{bag}': {why}")
+
+
+def mismatch(bag: Path, why: str) -> RunMismatchError:
+    return RunMismatchError(f"bag '{bag}': {why}")
+
+
+def unreadable(bag: Path, exc: Exception) -> BagError:
     why = (str(exc).splitlines() or [""])[0][:160]
     return fail(bag, f"cannot be read as a ROS bag ({type(exc).__name__}: {why})")
 
@@ -60,6 +72,28 @@ def storage(path: Path) -> tuple[Path, dict[str, Any]]:
     if single is not None and plain and single.suffix in (".mcap", ".db3") and single.is_file():
         return single, meta
     return path, meta
+
+
+def listed_topics(path: Path) -> Optional[dict[str, str]]:
+    """topic -> type as the bag lists them without a reader: a rosbag2 folder's metadata.yaml, else a .db3's
+    ``topics`` table; None where neither can be read. For a bag rosbags cannot open (a definition it cannot
+    build, say), this still tells whether any pose topic was there to read."""
+    import sqlite3
+
+    import yaml
+
+    meta_file = path / "metadata.yaml"
+    try:
+        if path.is_dir() and meta_file.is_file():
+            info = yaml.safe_load(meta_file.read_text())["rosbag2_bagfile_information"]
+            return {str(t["topic_metadata"]["name"]): str(t["topic_metadata"]["type"])
+                    for t in info.get("topics_with_message_count") or []}
+        if path.is_file() and path.suffix == ".db3":
+            with sqlite3.connect(f"file:{path}?mode=ro", uri=True) as db:
+                return {str(name): str(kind) for name, kind in db.execute("SELECT name, type FROM topics")}
+    except (OSError, yaml.YAMLError, sqlite3.Error, KeyError, TypeError, AttributeError):
+        return None
+    return None
 
 
 def bag_metadata(reader) -> dict[str, Any]:

@@ -29,11 +29,13 @@ from typing import Any, Mapping, Optional
 
 from worldgen.errors import ParameterError
 
-__all__ = ["BUNDLE_DIR", "GZ_RELEASES", "DEFAULT_GZ_RELEASE", "DEFAULT_ROBOT_NAME", "TOPICS", "RECORDED_TOPICS",
-           "ros_name", "release_of", "plugins", "with_plugins", "bridge_config", "nav2_overrides", "tasks_spec",
-           "bundle", "dumps"]
+__all__ = ["BUNDLE_DIR", "ROBOT_SDF", "ROBOT_URDF", "GZ_RELEASES", "GZ_SERVERS", "DEFAULT_GZ_RELEASE",
+           "DEFAULT_ROBOT_NAME", "TOPICS", "RECORDED_TOPICS", "ros_name", "release_of", "plugins", "with_plugins",
+           "bridge_config", "nav2_map", "nav2_overrides", "tasks_spec", "bundle", "dumps"]
 
 BUNDLE_DIR = "ros2"
+#: The shipped robot's files in the bundle (worldgen.export.robot).
+ROBOT_SDF, ROBOT_URDF = "robot.sdf", "robot.urdf"
 DEFAULT_ROBOT_NAME = "robot"
 #: Gazebo releases the bundle's world.sdf can be written for: how their system plugins are named.
 #: Fortress (ROS 2 Humble) still uses the ignition names; Garden and later the gz-sim ones
@@ -43,6 +45,16 @@ GZ_RELEASES = {
     "garden": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
     "harmonic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
     "ionic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
+}
+#: Gazebo's server command per release, whether it takes ``--seed`` (gz-sim 8's cmdsim.rb has it; gz-sim 7's
+#: and ign-gazebo 6's do not) and the variable it reads system plugin paths from. The launch file runs it
+#: without a shell: ros_gz_sim's gz_sim.launch.py runs ``ruby $(which gz) sim`` through one, the shell does
+#: not pass launch's SIGINT on, and Gazebo outlives the run (ros2/launch#545).
+GZ_SERVERS = {
+    "fortress": (("ign", "gazebo"), False, "IGN_GAZEBO_SYSTEM_PLUGIN_PATH"),
+    "garden": (("gz", "sim"), False, "GZ_SIM_SYSTEM_PLUGIN_PATH"),
+    "harmonic": (("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH"),
+    "ionic": (("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH"),
 }
 #: Harmonic pairs with ROS 2 Jazzy, the current LTS pair.
 DEFAULT_GZ_RELEASE = "harmonic"
@@ -66,6 +78,8 @@ TOPICS: dict[str, tuple[str, str, str, str]] = {
     "/odom": ("nav_msgs/msg/Odometry", "Odometry", "/odom", "GZ_TO_ROS"),
     "/tf": ("tf2_msgs/msg/TFMessage", "Pose_V", "/tf", "GZ_TO_ROS"),
     "/scan": ("sensor_msgs/msg/LaserScan", "LaserScan", "/scan", "GZ_TO_ROS"),
+    "/imu": ("sensor_msgs/msg/Imu", "IMU", "/imu", "GZ_TO_ROS"),
+    "/joint_states": ("sensor_msgs/msg/JointState", "Model", "/joint_states", "GZ_TO_ROS"),
 }
 #: What ``ros2 bag record`` keeps: what ``worldgen judge`` reads (the goal's time from the navigate_to_pose
 #: action's status, a hidden topic), plus the contacts.
@@ -150,18 +164,29 @@ def _spawn(task) -> dict[str, float]:
             "yaw": round_float(task.spawn.yaw)}
 
 
+def nav2_map(world) -> str:
+    """The map nav2 gets, relative to the world folder: the world's map.yaml, unless a door leaf starts
+    closed or ajar; then the bundle's own map of the scene as it starts (map.pgm draws every leaf open,
+    the scene the reference paths were planned in, and AMCL would meet leaves its map lacks). Door states
+    are the world's (world.json ``doors[].state``), so every task starts from the same map."""
+    from worldgen.files import MAP_YAML_NAME
+    from worldgen.groundtruth.truth import doors_start_shut
+
+    return f"{BUNDLE_DIR}/{MAP_YAML_NAME}" if doors_start_shut(world) else MAP_YAML_NAME
+
+
 def nav2_overrides(world, task) -> dict[str, Any]:
     """nav2 parameters for ``task``: merged over a full nav2 params file by the launch file.
 
-    ``map_server.yaml_filename`` is relative to the world folder (the launch file makes it absolute).
+    ``map_server.yaml_filename`` (:func:`nav2_map`) is relative to the world folder (the launch file
+    makes it absolute).
     """
-    from worldgen.files import MAP_YAML_NAME
     from worldgen.floats import round_float
 
     out: dict[str, Any] = {node: {"ros__parameters": {"use_sim_time": True}} for node in _NAV2_NODES}
     out["amcl"]["ros__parameters"].update({"set_initial_pose": True, "initial_pose": _spawn(task),
                                            "global_frame_id": "map"})
-    out["map_server"]["ros__parameters"]["yaml_filename"] = MAP_YAML_NAME
+    out["map_server"]["ros__parameters"]["yaml_filename"] = nav2_map(world)
     radius = round_float(world.robot.radius)
     for costmap in ("local_costmap", "global_costmap"):
         out[costmap] = {costmap: {"ros__parameters": {"use_sim_time": True, "robot_radius": radius}}}
@@ -205,8 +230,14 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
 
     ``gz_release`` picks the system plugin names of the bundle's world.sdf (None: no second SDF; the
     run loads the world's own world.sdf with Gazebo's default systems, which publish no sensor in
-    Garden and later). ``folder_name`` names the bags (default: the world's folder name).
+    Garden and later). ``folder_name`` names the bags (default: the world's folder name). The robot
+    worldgen.export.robot makes for the world is shipped as ``robot.sdf`` (spawned unless the run names
+    another) and ``robot.urdf`` (robot_state_publisher's), named ``robot_name``.
     """
+    from worldgen.export.robot import robot_sdf, robot_urdf
+    from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
+    from worldgen.groundtruth.truth import doors_start_shut, start_occupancy_map
+
     if gz_release is not None:
         _release(gz_release)
     robot = ros_name(robot_name)
@@ -217,12 +248,21 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
     }
     for task in world.tasks:
         files[f"{BUNDLE_DIR}/nav2/{task.id}.yaml"] = dumps(nav2_overrides(world, task))
+    if doors_start_shut(world):
+        grid = start_occupancy_map(world)
+        files[f"{BUNDLE_DIR}/{MAP_IMAGE_NAME}"] = grid.pgm()
+        files[f"{BUNDLE_DIR}/{MAP_YAML_NAME}"] = grid.yaml(MAP_IMAGE_NAME)
+    files[f"{BUNDLE_DIR}/{ROBOT_SDF}"] = robot_sdf(world, name=robot, gz_release=gz_release or DEFAULT_GZ_RELEASE).encode()
+    files[f"{BUNDLE_DIR}/{ROBOT_URDF}"] = robot_urdf(world, name=robot).encode()
     sdf_file = "world.sdf"
     if gz_release is not None:
         files[f"{BUNDLE_DIR}/world.sdf"] = with_plugins(world.export("sdf", sdf_version), gz_release, "../")
         sdf_file = f"{BUNDLE_DIR}/world.sdf"
+    command, seed, plugin_path = GZ_SERVERS[gz_release or DEFAULT_GZ_RELEASE]
     values = {"WORLD_ID": world.world_id, "WORLD_NAME": world.world_id, "ROS_NAME": name,
-              "FOLDER": folder_name or world.folder_name, "SDF": sdf_file, "ROBOT": robot,
+              "FOLDER": folder_name or world.folder_name, "SDF": sdf_file, "ROBOT": robot, "MAP": nav2_map(world),
+              "ROBOT_SDF": ROBOT_SDF, "ROBOT_URDF": ROBOT_URDF,
+              "GZ_COMMAND": repr(command), "GZ_SEED": repr(seed), "GZ_PLUGIN_PATH": plugin_path,
               "FIRST_TASK": world.tasks[0].id, "TOPICS": repr(tuple(t.format(robot=robot) for t in RECORDED_TOPICS))}
     launch = _fill(_template("launch.py"), values)
     files[f"{BUNDLE_DIR}/launch/{name}.launch.py"] = launch.encode()

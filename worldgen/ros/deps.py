@@ -1,30 +1,18 @@
 """The optional dependency of reading and writing bags: rosbags, imported only when a bag is touched.
 
-``import worldgen`` and ``worldgen judge --help`` never import rosbags; this module is where the bag
-reader and writer ask for it, and where a missing install becomes one line.
+``import worldgen`` and ``worldgen judge --help`` never import rosbags; the bag reader and writer ask
+for it here, through the package's one mechanism for optional extras (:func:`worldgen.errors.require_optional`).
 """
 
 from __future__ import annotations
 
-import importlib
+from worldgen.errors import require_optional
 
-from worldgen.errors import WorldgenError
-
-__all__ = ["MissingRosbagsError", "INSTALL_HINT", "require_rosbags"]
-
-#: What to install for bags (the ``ros`` extra of worldgen's pyproject.toml).
-INSTALL_HINT = "pip install 'worldgen[ros]'"
-
-
-class MissingRosbagsError(WorldgenError, ImportError):
-    """rosbags is not installed; the message says what to install."""
+__all__ = ["require_rosbags"]
 
 
 def require_rosbags():
-    """The ``rosbags`` package, or :class:`MissingRosbagsError` with one line saying what to install."""
-    try:
-        module = importlib.import_module("rosbags")
-        importlib.import_module("rosbags.highlevel")
-        return module
-    except ImportError:
-        raise MissingRosbagsError(f"reading or writing ROS bags needs rosbags, which is not installed: {INSTALL_HINT}") from None
+    """The ``rosbags`` package (with its high-level reader), or MissingDependencyError naming the ``ros`` extra."""
+    needs = "reading or writing ROS bags needs rosbags"
+    require_optional("rosbags.highlevel", "ros", needs)
+    return require_optional("rosbags", "ros", needs)

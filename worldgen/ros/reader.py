@@ -45,10 +45,21 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError
-from worldgen.ros.bagio import bag_metadata, decoder, fail, storage, typestore, unreadable
+from worldgen.ros.bagio import (
+    RunMismatchError,
+    bag_metadata,
+    decoder,
+    fail,
+    listed_topics,
+    mismatch,
+    storage,
+    typestore,
+    unreadable,
+)
 from worldgen.ros.deps import require_rosbags
 
-__all__ = ["BagRun", "read_run", "bag_metadata", "peek_metadata", "START_RULES", "GOAL_TOPICS", "MOTION_START"]
+__all__ = ["BagRun", "RunMismatchError", "read_run", "bag_metadata", "peek_metadata", "START_RULES", "GOAL_TOPICS",
+           "MOTION_START"]
 
 START_RULES = ("command", "goal", "motion", "bag")
 #: Where a goal shows: RViz's and nav2's goal topic, and the navigate_to_pose action's topics as recorded.
@@ -157,17 +168,25 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
         with AnyReader([source], default_typestore=typestore(distro)) as reader:
             meta = meta or bag_metadata(reader)
             topics = {c.topic: c.msgtype for c in reader.connections}
-            st = _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topics, map_frame, odom_frame,
-                         tuple(base_frames), start, min_dt, distro)
+            st = None  # a bag without any pose topic is refused by its topic list: no message is read
+            if _pose_topics(topics, pose_topic, odom_topic):
+                st = _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topics, map_frame,
+                             odom_frame, tuple(base_frames), start, min_dt, distro)
     except WorldgenError as exc:
         raise fail(path, str(exc)) from None
     except Exception as exc:  # rosbags' and the storage libraries' errors: a truncated or foreign file
-        raise unreadable(path, exc) from None
+        listed = listed_topics(path)
+        if listed is not None and not _pose_topics(listed, pose_topic, odom_topic):  # foreign, and no pose anyway
+            topics, st = listed, None
+        else:
+            raise unreadable(path, exc) from None
     found = ", ".join(f"{t} ({ty})" for t, ty in sorted(topics.items())) or "none"
-    source, detail, traj = _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames)
+    source, detail, traj = _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames) if st else \
+        (None, "", None)
     if traj is None:
         need = f"{pose_topic}, /tf with {map_frame}->{odom_frame}->{'|'.join(base_frames)}, or {odom_topic}"
-        has_odometry = (st["odom"] is not None and len(st["odom"].data)) or any(len(b.data) for b in st["base"].values())
+        has_odometry = st is not None and ((st["odom"] is not None and len(st["odom"].data))
+                                           or any(len(b.data) for b in st["base"].values()))
         if has_odometry and spawn is None:
             need += " (odometry needs a world for its spawn pose)"
         raise fail(path, f"no pose source: need {need}; topics found: {found}")
@@ -176,12 +195,18 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
     if spawn is not None:
         d = float(math.hypot(traj[0, 1] - spawn[0], traj[0, 2] - spawn[1]))
         if d > spawn_tolerance:
-            raise fail(path, f"the run starts {d:.2f} m from the task's spawn ({spawn[0]:.2f}, {spawn[1]:.2f}) at "
+            raise mismatch(path, f"the run starts {d:.2f} m from the task's spawn ({spawn[0]:.2f}, {spawn[1]:.2f}) at "
                               f"({traj[0, 1]:.2f}, {traj[0, 2]:.2f}), more than spawn_tolerance {spawn_tolerance:g} m: "
                               f"is this the right world and task?")
     return BagRun(bag=str(path), trajectory=traj, source=source, source_detail=detail, drift_bounded=source != "odom",
                   start=rule, start_time=float(traj[0, 0]), end_time=float(traj[-1, 0]), topics=topics,
                   metadata={k: str(v) for k, v in meta["custom"].items() if str(k).startswith("worldgen.")})
+
+
+def _pose_topics(topics: dict[str, str], pose_topic: str, odom_topic: str) -> bool:
+    """Whether the bag has a topic any pose source could come from (its connections, before any message)."""
+    return (topics.get(pose_topic) in _POSE_TYPES or "/tf" in topics or "/tf_static" in topics
+            or odom_topic in topics)
 
 
 def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topics, map_frame, odom_frame, base_frames,

@@ -14,6 +14,7 @@ from typing import Mapping
 
 import numpy as np
 
+from worldgen.errors import SceneError
 from worldgen.scene.graph import Scene
 from worldgen.scene.mover import Mover
 
@@ -77,5 +78,5 @@ def drive_mocap(model, data, source, t: float) -> None:
     for (name, height, _, _), (x, y) in zip(_mover_rows(source), xy):
         mocap = model.body(name).mocapid[0]
         if mocap < 0:
-            raise ValueError(f"body {name!r} is not a mocap body")
+            raise SceneError(f"body {name!r} is not a mocap body")
         data.mocap_pos[mocap] = (x, y, height / 2.0)

@@ -179,4 +179,4 @@ def unit_inertia(shape: Shape) -> tuple[float, float, float]:
     if isinstance(shape, Sphere):
         i = 0.4 * shape.radius**2
         return (i, i, i)
-    raise TypeError(f"unknown shape {shape!r}")
+    raise SceneError(f"unknown shape {shape!r}")

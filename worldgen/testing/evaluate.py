@@ -210,12 +210,15 @@ class Report:
         return path
 
 
-def _runs(runs: Iterable) -> Iterable[tuple[Any, Any, Optional[str]]]:
+def _runs(runs: Iterable) -> Iterable[tuple[Any, Any, Optional[str], Optional[str]]]:
+    """(trajectory, world, task, refused) of each run; ``refused`` is the reason a run failed unmeasured."""
     for i, item in enumerate(runs):
-        if isinstance(item, Mapping):
-            yield item["trajectory"], item["world"], item.get("task")
+        if isinstance(item, Mapping) and item.get("refused") is not None:
+            yield None, item["world"], item.get("task"), str(item["refused"])
+        elif isinstance(item, Mapping):
+            yield item["trajectory"], item["world"], item.get("task"), None
         elif isinstance(item, (tuple, list)) and len(item) in (2, 3):
-            yield item[0], item[1], (item[2] if len(item) == 3 else None)
+            yield item[0], item[1], (item[2] if len(item) == 3 else None), None
         else:
             raise ParameterError(f"parameter 'runs' item {i} must be (trajectory, world[, task]) or a dict with those keys")
 
@@ -224,24 +227,43 @@ def _mean(xs: list[float]) -> Optional[float]:
     return sum(xs) / len(xs) if xs else None
 
 
-def _figures(judged: list[tuple[Run, bool, Optional[float]]]) -> dict[str, Any]:
-    """The summary figures of some judged runs (run, success, BARN score), each over the runs AVERAGED_OVER says."""
-    good = [r for r, ok, _ in judged if ok]
+#: One judged run: its figures (None for a run refused unmeasured, a failure), success, BARN score, world id.
+_Judged = tuple[Optional[Run], bool, Optional[float], str]
+
+
+def _figures(judged: list[_Judged]) -> dict[str, Any]:
+    """The summary figures of some judged runs, each over the runs AVERAGED_OVER says."""
+    good = [r for r, ok, _, _ in judged if ok and r is not None]
     times = [r.time_to_goal for r in good if r.time_to_goal is not None]
-    scores = [s for _, _, s in judged if s is not None]
+    scores = [s for _, _, s, _ in judged if s is not None]
     return {
         "runs": len(judged), "successes": len(good), "success_rate": len(good) / len(judged),
         "mean_time_to_goal": _mean(times), "max_time_to_goal": max(times) if times else None,
         "mean_path_efficiency": _mean([r.path_efficiency for r in good if r.path_efficiency is not None]),
         "mean_barn_score": _mean(scores),
-        "min_clearance": min(r.min_clearance for r, _, _ in judged),
+        "min_clearance": min((r.min_clearance for r, *_ in judged if r is not None), default=None),
     }
+
+
+def _refused_row(ground, task: Optional[str], reason: str, k: float, speed: float) -> tuple[dict, _Judged]:
+    """The row of a run that failed before it could be measured (it started far from the spawn, or names
+    another world): a failure with its reason and no figures, counted in every rate."""
+    t = ground.task(task)
+    ref = (t.get("path") or {}).get("length")
+    score = barn_score(False, None, float(ref) if ref else None, k, speed)
+    world_id = str(ground.meta.get("world_id", ""))
+    row = {"world_id": world_id, "task": t["id"], "reference_length": float(ref) if ref else None,
+           "success": False, "reason": reason, "barn_score": score}
+    return row, (None, False, score, world_id)
 
 
 # long: each run's figures, then the criteria over all of them, in one place so the rows stay aligned
 def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
              reference_speed: Optional[float] = None) -> Report:
     """Figures of every run (each a ``(trajectory, world[, task])`` or a dict), judged against ``criteria``.
+
+    A dict ``{"world", "task", "refused": reason}`` (no trajectory) is a run that failed before it
+    could be measured: a failure with that reason, counted in the rates, with no figures.
 
     ``barn_k`` and ``reference_speed`` set the BARN score (the criteria file's ``scoring`` section
     otherwise, else BARN's current 2 optimal times and 2 m/s).
@@ -251,28 +273,34 @@ def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
     k = scoring["barn_k"] if barn_k is None else barn_k
     speed = scoring["reference_speed"] if reference_speed is None else reference_speed
     rows, judged = [], []
-    for trajectory, world, task in _runs(runs):
+    for trajectory, world, task, refused in _runs(runs):
         ground = load(world)
+        if refused is not None:
+            row, item = _refused_row(ground, task, refused, k, speed)
+            rows.append(row)
+            judged.append(item)
+            continue
         r = run_figures(trajectory, ground, task)
         ok, why = _succeeded(r, _task_spec(scenario_of(world), r.task))
         score = barn_score(ok, r.time_to_goal, r.reference_length, k, speed)
-        judged.append((r, ok, score))
+        judged.append((r, ok, score, r.world_id))
         rows.append(r.as_dict() | {"success": ok, "reason": why, "barn_score": score})
     if not judged:
         raise ParameterError("parameter 'runs' must hold at least one run, got none")
-    seps = [r.min_separation for r, _, _ in judged if r.min_separation is not None]
+    measured_runs = [r for r, *_ in judged if r is not None]
+    seps = [r.min_separation for r in measured_runs if r.min_separation is not None]
 
     def extreme(pick, key):  # over the runs that have the figure (worlds with people); None without any
-        values = [getattr(r, key) for r, _, _ in judged if getattr(r, key) is not None]
+        values = [getattr(r, key) for r in measured_runs if getattr(r, key) is not None]
         return pick(values) if values else None
 
     by_world: dict[str, list] = {}
     for item in judged:
-        by_world.setdefault(item[0].world_id, []).append(item)
+        by_world.setdefault(item[3], []).append(item)
     summary = _figures(judged) | {
-        "collision_count": sum(len(r.collisions) for r, _, _ in judged),
+        "collision_count": sum(len(r.collisions) for r in measured_runs),
         "min_separation": min(seps) if seps else None,
-        "max_velocity": max(r.max_velocity for r, _, _ in judged),
+        "max_velocity": max((r.max_velocity for r in measured_runs), default=None),
         "min_person_distance": extreme(min, "min_person_distance"),
         "personal_space_time": extreme(max, "personal_space_time"),
         "min_time_to_collision": extreme(min, "min_time_to_collision"),

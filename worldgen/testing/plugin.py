@@ -53,7 +53,7 @@ def pytest_configure(config):
 
 
 #: The marker's own keyword arguments; every other keyword is a parameter of the generator.
-MARKER_ARGS = ("seeds", "allow_infeasible")
+MARKER_ARGS = ("seeds", "allow_infeasible", "difficulty")
 
 
 class _MarkerError(Exception):
@@ -100,8 +100,16 @@ def _generated_cases(mark, replay):
     allow_infeasible = mark.kwargs.get("allow_infeasible", False)
     if not isinstance(allow_infeasible, bool):
         raise _MarkerError(f"allow_infeasible must be True or False, got {allow_infeasible!r}")
+    difficulty = mark.kwargs.get("difficulty")
     try:
-        spec.resolve(params)  # every value checked once here, not once per seed
+        if difficulty is not None:  # a level request (as generate's difficulty=): checked here, drawn per seed
+            from worldgen.leveling import check_request
+
+            if allow_infeasible:
+                raise _MarkerError("difficulty asks for a drivable world; it excludes allow_infeasible")
+            check_request(spec.name, difficulty, params)
+        else:
+            spec.resolve(params)  # every value checked once here, not once per seed
     except InfeasibleError as exc:
         if not allow_infeasible:
             raise _MarkerError(f"{exc} (allow_infeasible=True writes such worlds for negative tests)") from None
@@ -118,6 +126,8 @@ def _generated_cases(mark, replay):
     if replay is not None:
         # Replaying one world must not silently run nothing: a seed outside the list still runs.
         seeds = [replay]
+    if difficulty is not None:
+        params = {**params, "difficulty": difficulty}
     cases = [("generate", spec.name, seed, params, allow_infeasible) for seed in seeds]
     return cases, [f"{spec.name}-s{seed}" for seed in seeds]
 

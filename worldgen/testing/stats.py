@@ -23,12 +23,12 @@ import warnings
 from numbers import Integral
 from typing import Any, Optional, Sequence, Union
 
-from worldgen.errors import MissingDependencyError, ParameterError
+from worldgen.errors import ParameterError, require_optional
 from worldgen.floats import finite_or_none  # None where scipy gives NaN or an infinity: JSON has neither
 
 __all__ = [
     "INSTALL_HINT", "FIGURES", "NOTE", "require_scipy",
-    "clopper_pearson_lower", "clopper_pearson_interval", "wilson_interval", "runs_needed", "success_bound",
+    "judged_runs", "clopper_pearson_lower", "clopper_pearson_interval", "wilson_interval", "runs_needed", "success_bound",
     "welch", "mann_whitney", "fisher", "compare_samples", "compare_runs",
 ]
 
@@ -51,12 +51,8 @@ MIN_SAMPLE = 2
 
 
 def require_scipy():
-    """The ``scipy.stats`` module, or :class:`MissingDependencyError` with one line saying what to install."""
-    try:
-        import scipy.stats
-    except ImportError:
-        raise MissingDependencyError(f"worldgen's statistics need scipy, which is not installed: {INSTALL_HINT}") from None
-    return scipy.stats
+    """The ``scipy.stats`` module, or :class:`MissingDependencyError` naming the ``stats`` extra."""
+    return require_optional("scipy.stats", "stats", "worldgen's statistics need scipy")
 
 
 def _check_counts(k: int, n: int) -> None:
@@ -228,9 +224,11 @@ def compare_samples(a: Sequence[float], b: Sequence[float], confidence: float = 
     return out
 
 
-def _judged(runs: Sequence[dict]) -> list[dict]:
-    """Runs with a verdict (success True or False); a row without one (an unreadable bag) is left out."""
-    return [r for r in runs if isinstance(r.get("success"), bool)]
+def judged_runs(runs: Sequence[dict]) -> list[dict]:
+    """Runs with a verdict (success True or False); an unjudged row (a bag that could not be read, or whose
+    world was not found: ``outcome`` "unjudged", or ``readable`` False in reports of older versions) is left out."""
+    return [r for r in runs if isinstance(r.get("success"), bool) and r.get("outcome") != "unjudged"
+            and r.get("readable") is not False]
 
 
 #: Significant digits a figure is compared at. Figures computed two ways (a path length summed in
@@ -256,7 +254,7 @@ def compare_runs(runs_a: Sequence[dict], runs_b: Sequence[dict], confidence: flo
     missing a figure (None: not measured) is left out of that figure only.
     """
     _check_confidence(confidence)
-    a, b = _judged(runs_a), _judged(runs_b)
+    a, b = judged_runs(runs_a), judged_runs(runs_b)
     if not a or not b:
         raise ParameterError(f"each side needs at least one judged run, got A {len(a)}, B {len(b)}")
     ka, kb = sum(r["success"] for r in a), sum(r["success"] for r in b)
@@ -266,7 +264,7 @@ def compare_runs(runs_a: Sequence[dict], runs_b: Sequence[dict], confidence: flo
         pick_b = [r for r in b if r["success"]] if over == "successful" else b
         figures[name] = {"over": f"{over} runs", **compare_samples(_values(pick_a, name), _values(pick_b, name), confidence)}
     return {"confidence": confidence,
-            "runs": {"a": len(runs_a), "b": len(runs_b)},
+            "runs": {"a": len(a), "b": len(b)},
             "unjudged": {"a": len(runs_a) - len(a), "b": len(runs_b) - len(b)},
             "success": fisher(ka, len(a), kb, len(b), confidence),
             "figures": figures, "note": NOTE}

@@ -10,6 +10,9 @@ An edit changes one thing of a world's scene or tasks:
 ``move_goal``  a task's goal slides by up to :data:`STEP` m (its tolerance and yaw kept; never nearer the
                spawn than the generator's ``min_spawn_goal_distance``).
 
+Two more operators are never drawn, only recorded by :func:`worldgen.shrink` (:data:`REMOVALS`):
+``remove`` of any root obstacle without children (a mesh too), and ``remove_mover`` of a scripted mover.
+
 Only the root nodes whose role is ``obstacle`` and whose shape is a box or a cylinder are edited (walls,
 doors, frames and floors never); an edited obstacle stays inside the scene's bounds. Worlds with movers
 or people are not edited (their timed proofs follow the obstacles): :func:`edit_world` returns None.
@@ -38,10 +41,13 @@ from worldgen.scene import Box, Cylinder, Material, Node, Pose, Scene, Task
 from worldgen.seeding import edit_rng
 from worldgen.world import World
 
-__all__ = ["EDITS", "STEP", "SCALE", "TRIES", "EditedWorld", "edit_world", "apply_edit", "replay_edits", "editable"]
+__all__ = ["EDITS", "REMOVALS", "STEP", "SCALE", "TRIES", "EditedWorld", "edit_world", "apply_edit", "replay_edits",
+           "with_edits", "editable"]
 
 #: The edit operators, in the order their names are drawn from.
 EDITS = ("move", "resize", "add", "remove", "move_goal")
+#: What shrinking records: removing an obstacle (any root obstacle without children) or a scripted mover.
+REMOVALS = ("remove", "remove_mover")
 #: Largest slide of an obstacle or a goal (m): an edit is small next to a room of several metres.
 STEP = 0.5
 #: Range of the factor a resize scales a footprint by.
@@ -63,7 +69,7 @@ class EditedWorld(World):
     def __init__(self, parent: World, scene: Scene, tasks: Sequence[Task], report, edits: Sequence[dict]):
         super().__init__(parent.generator, parent.seed, parent.params, scene, tasks, parent.robot, report,
                          parent.attempts, parent.allow_infeasible)
-        self.preset = parent.preset
+        self.set_provenance(preset=parent.preset)
         self.edits: tuple[dict, ...] = tuple(edits)
 
     @cached_property
@@ -96,7 +102,7 @@ def edit_world(world: World, seed: int, ops: Sequence[str] = EDITS, tries: int =
         edit = _propose(world, str(ops[int(rng.integers(len(ops)))]), rng)
         if edit is None:
             continue
-        edited = _proven(world, edit)
+        edited = _proven(world, [edit])
         if edited is not None:
             return edited
     return None
@@ -107,7 +113,7 @@ def replay_edits(world: World, edits: Sequence[dict]) -> EditedWorld:
     longer applies or no longer passes (a record from another worldgen version)."""
     out: World = world
     for edit in edits:
-        edited = _proven(out, dict(edit))
+        edited = _proven(out, [dict(edit)])
         if edited is None:
             raise ParameterError(f"edit {edit!r} of world {world.world_id} does not give a feasible world")
         out = edited
@@ -116,16 +122,24 @@ def replay_edits(world: World, edits: Sequence[dict]) -> EditedWorld:
     return out
 
 
-def _proven(world: World, edit: dict) -> Optional[EditedWorld]:
+def with_edits(world: World, edits: Sequence[dict]) -> Optional[EditedWorld]:
+    """``world`` with all of ``edits`` applied, proven once at the end; None when one names nothing there or
+    the result does not pass the checker. The same world :func:`replay_edits` rebuilds edit by edit."""
+    return _proven(world, [dict(e) for e in edits])
+
+
+def _proven(world: World, edits: list[dict]) -> Optional[EditedWorld]:
+    scene, tasks = world.scene, world.tasks
     try:
-        scene, tasks = apply_edit(world.scene, world.tasks, edit)
+        for edit in edits:
+            scene, tasks = apply_edit(scene, tasks, edit)
     except (KeyError, ValueError, IndexError, TypeError):  # a record that names nothing here, or a bad value
         return None
     report = feasibility.check(scene, tasks, world.robot)
     if not report.feasible or any(p is None for p in report.paths):
         return None
     before = world.edits if isinstance(world, EditedWorld) else ()
-    return EditedWorld(world, scene, tasks, report, before + (edit,))
+    return EditedWorld(world, scene, tasks, report, before + tuple(edits))
 
 
 def apply_edit(scene: Scene, tasks: Sequence[Task], edit: dict) -> tuple[Scene, tuple[Task, ...]]:
@@ -138,15 +152,23 @@ def apply_edit(scene: Scene, tasks: Sequence[Task], edit: dict) -> tuple[Scene, 
         t = tasks[k]
         goal = Pose(float(edit["x"]), float(edit["y"]), t.goal.z, t.goal.roll, t.goal.pitch, t.goal.yaw)
         return scene, tasks[:k] + (Task(t.id, t.spawn, goal, t.goal_tolerance),) + tasks[k + 1:]
+    if op == "remove_mover":
+        if not any(m.name == edit["mover"] for m in scene.movers):
+            raise ParameterError(f"no mover named {edit['mover']!r}")
+        return scene.with_movers(m for m in scene.movers if m.name != edit["mover"]), tasks
     nodes = list(scene.nodes)
     if op == "add":
         node = _node(edit["name"], edit["shape"], float(edit["x"]), float(edit["y"]), float(edit["yaw"]),
                      Material(*edit["material"]))
         _inside(node, scene.bounds)
         return scene.with_nodes(nodes + [node]), tasks
-    index = next((i for i, n in enumerate(nodes) if n.name == edit["node"] and _obstacle(n)), None)
+    def removable(n: Node) -> bool:  # shrinking removes any root obstacle that holds nothing
+        return n.role == "obstacle" and n.parent is None and not scene.children(n.name)
+
+    target = removable if op == "remove" else _obstacle
+    index = next((i for i, n in enumerate(nodes) if n.name == edit["node"] and target(n)), None)
     if index is None:
-        raise ValueError(f"no obstacle named {edit['node']!r}")
+        raise ParameterError(f"no obstacle named {edit['node']!r}")
     old = nodes[index]
     if op == "remove":
         return scene.with_nodes(nodes[:index] + nodes[index + 1:]), tasks
@@ -162,7 +184,7 @@ def apply_edit(scene: Scene, tasks: Sequence[Task], edit: dict) -> tuple[Scene, 
             shape["radius"] = round_float(shape["radius"] * factor)
         node = _node(old.name, shape, old.pose.x, old.pose.y, old.pose.yaw, old.material)
     else:
-        raise ValueError(f"unknown edit {op!r}")
+        raise ParameterError(f"unknown edit {op!r}")
     _inside(node, scene.bounds)
     nodes[index] = node
     return scene.with_nodes(nodes), tasks
@@ -246,7 +268,7 @@ def _inside(node: Node, bounds) -> None:
         hx, hy = shape.size[0] / 2, shape.size[1] / 2
         ex, ey = c * hx + s * hy, s * hx + c * hy
     if not (x0 + ex <= pose.x <= x1 - ex and y0 + ey <= pose.y <= y1 - ey):
-        raise ValueError(f"obstacle {node.name} would leave the floor")
+        raise ParameterError(f"obstacle {node.name} would leave the floor")
 
 
 def _task_dict(task: Task) -> dict:

@@ -170,14 +170,14 @@ def _regenerate(meta: dict):
             world = replay_edits(world, meta["edits"])
         except WorldgenError as exc:
             raise _Fail("regenerate", f"edits: {exc}") from None
-    world.preset = meta.get("preset")  # not a parameter: where the world came from (world.json and folder name)
+    world.set_provenance(preset=meta.get("preset"))  # not a parameter: where the world came from (world.json and folder name)
     request = meta.get("difficulty_request")  # not a parameter either: how a world at a level was drawn
     if request:
         last = request["draws"][-1] if request.get("draws") else {}
         if (last.get("seed"), last.get(request.get("knob"))) != (meta["seed"], meta["params"].get(request.get("knob"))):
             raise _Fail("regenerate", "difficulty_request's last draw is not this world's seed and "
                                       f"{request.get('knob')}")
-        world.difficulty_request = request
+        world.set_provenance(difficulty_request=request)
     if world.content_hash != meta["content_hash"]:
         raise _Fail("regenerate", f"content_hash {_h(world.content_hash)} regenerated, "
                                   f"{_h(meta['content_hash'])} recorded{_versions(meta)}")
@@ -236,14 +236,14 @@ def _timed(meta: dict, world) -> None:
 
 def _reproduce(folder: Path, meta: dict, world, entries) -> str:
     import worldgen
-    from worldgen.export.formats import FILE_NAMES, FORMATS
+    from worldgen.export.formats import ALL_FORMATS, FILE_NAMES
 
     if meta.get("worldgen_version") != worldgen.__version__:
         return f"written by worldgen {meta.get('worldgen_version')}, not compared byte for byte"
     listed = {key for key, _, _ in entries}
-    formats = [f for f in FORMATS if f in listed]
+    formats = [f for f in ALL_FORMATS if f in listed]
     if not formats:
-        raise _Fail("reproduce", "world.json lists none of the formats " + ", ".join(FORMATS))
+        raise _Fail("reproduce", "world.json lists none of the formats " + ", ".join(ALL_FORMATS))
     sdf_version = _sdf_version(folder / FILE_NAMES["sdf"]) if "sdf" in listed else "1.9"
     blobs = world.folder_blobs(formats, sdf_version, preview=False)
     fresh = json.loads(blobs.pop(METADATA_NAME))

@@ -1,0 +1,68 @@
+"""People and movers in a real Gazebo with a rendering sensor: the worlds step (a non-looping actor script
+used to hang Gazebo Sim there, docs/gazebo.md), and a gpu_lidar sees each actor where world.json's
+trajectory has it at the scan's time.
+
+Gazebo publishes no actor pose (docs/gazebo.md), so the lidar is the witness: the returns on each
+actor's cylinder are fitted with a circle of its radius, whose centre must be within 1 cm of world.json's.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from support.gazebo import gazebo_install, lidar_robot_sdf, scan_ranges, scan_stamp, seen_centres
+
+import worldgen
+from worldgen.presets import generate_preset
+from worldgen.scene.motion import mover_names, mover_positions
+from worldgen.sim.gazebo import GazeboServer
+
+pytestmark = pytest.mark.gazebo
+
+#: How close the lidar's fitted centre must be to world.json (m).
+CENTRE_TOL = 0.01
+STEP = 0.002  # every world's physics step (s)
+
+
+@pytest.fixture(scope="module")
+def install():
+    return gazebo_install()
+
+
+def worlds():
+    # the people presets of the issue, and scripted movers in an empty room so that no obstacle hides them
+    return {
+        "person_crossing": lambda: generate_preset("person_crossing", seed=0),
+        "person_head_on": lambda: generate_preset("person_head_on", seed=0),
+        "movers": lambda: worldgen.generate("cluttered", seed=1, size=[8.0, 8.0], n_obstacles=0, n_movers=2),
+    }
+
+
+@pytest.mark.parametrize("name", sorted(worlds()))
+def test_actors_play_world_json_trajectories_as_a_gpu_lidar_sees_them(name, install, tmp_path):
+    world = worlds()[name]()
+    folder = world.write(tmp_path, preview=False, ros="fortress")
+    meta = json.loads((folder / "world.json").read_text())
+    lidar = meta["sensors"]["lidar"]
+    radii = {m["name"]: m["radius"] for m in meta.get("dynamic_obstacles", []) + meta.get("people", [])}
+    names = mover_names(meta)
+    x, y, _, _, _, yaw = meta["tasks"][0]["spawn"]
+    seen_at = []
+    with GazeboServer(folder / "ros2" / "world.sdf", install=install, headless_rendering=True) as gz:
+        # a dense lidar (0.25 degree): some 20 returns on a person 4.5 m away, enough to place the circle
+        gz.spawn(lidar_robot_sdf(lidar, samples=1440), "robot", (x, y, 0.0, yaw))
+        for until in (2.0, 7.5, 12.0):  # the persons: standing, walking, arrived
+            gz.step(max(1, round((until - gz.stats_time()) / STEP)), timeout=60)
+            scan = gz.echo("/scan", 1, step=5)[0]
+            t = scan_stamp(scan)
+            expected = {n: (c, radii[n]) for n, c in zip(names, mover_positions(meta, t))}
+            seen = seen_centres(scan, lidar["pose"], expected)
+            assert seen, f"{name}: the lidar sees no actor at t = {t} s ({scan_ranges(scan, 30.0).min():.3f} m nearest)"
+            for actor, (centre, rays) in seen.items():
+                off = float(np.linalg.norm(centre - expected[actor][0]))
+                seen_at.append((t, actor, off, rays))
+                assert off <= CENTRE_TOL, f"{actor} at t = {t:.3f} s: {off * 1000:.1f} mm from world.json ({rays} rays)"
+    assert {a for _, a, _, _ in seen_at} == set(names)
+    assert gz.problems() == []

@@ -1,0 +1,95 @@
+"""The parts of worldgen.sim that need no simulator: protobuf text, stopping a process group, finding Gazebo."""
+
+import subprocess
+import sys
+
+import pytest
+
+from worldgen.errors import SimulatorError
+from worldgen.sim import textproto
+from worldgen.sim.gazebo import GazeboMissingError, locate, problems_in
+from worldgen.sim.procs import group_members, run_tool, stop_group
+
+POSE_V = """header {
+  stamp {
+    sec: 2
+  }
+}
+pose {
+  name: "floor"
+  id: 4
+  position {
+    z: -0.05
+  }
+  orientation {
+    w: 1
+  }
+}
+pose {
+  name: "box \\"a\\""
+  id: 8
+  position {
+    x: 1.5e-3
+    y: -2
+  }
+}
+"""
+
+
+def test_pose_v_text_reads_with_omitted_fields_at_their_defaults():
+    message = textproto.parse(POSE_V)
+    assert textproto.first(textproto.first(message, "header"), "stamp") == {"sec": [2]}
+    assert textproto.poses_by_name(message) == {"floor": (0.0, 0.0, -0.05, 0.0, 0.0, 0.0, 1.0),
+                                                 'box "a"': (0.0015, -2.0, 0.0, 0.0, 0.0, 0.0, 1.0)}
+
+
+def test_several_printed_messages_split_and_bad_text_is_refused():
+    assert [textproto.parse(m)["data"] for m in textproto.split_messages("data: true\n\ndata: false\n")] == \
+        [["true"], ["false"]]
+    for bad in ("pose {", "}", "x: 1 {", '"floating"'):
+        with pytest.raises(SimulatorError):
+            textproto.parse(bad)
+
+
+def test_a_group_that_ignores_polite_signals_is_killed_and_nothing_survives():
+    # a parent and a child, both ignoring SIGINT and SIGTERM, as a server with a render engine may
+    script = ("import signal, subprocess, sys, time\n"
+              "for s in (signal.SIGINT, signal.SIGTERM): signal.signal(s, signal.SIG_IGN)\n"
+              "subprocess.Popen([sys.executable, '-c', 'import signal, time\\n"
+              "for s in (signal.SIGINT, signal.SIGTERM): signal.signal(s, signal.SIG_IGN)\\n"
+              "print(\\'child\\', flush=True); time.sleep(60)'])\n"
+              "print('up', flush=True); time.sleep(60)\n")
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, start_new_session=True)
+    # both have set their signals aside before anything is sent (on a loaded machine the child takes a while)
+    assert {proc.stdout.readline(), proc.stdout.readline()} == {b"up\n", b"child\n"}
+    assert len(group_members(proc.pid)) == 2
+    status = stop_group(proc, grace=1.0)
+    assert status == -9 and group_members(proc.pid) == []
+
+
+def test_a_tool_that_outlives_its_time_is_stopped():
+    with pytest.raises(subprocess.TimeoutExpired):
+        run_tool([sys.executable, "-c", "import time; time.sleep(30)"], {}, timeout=0.5)
+
+
+def test_a_missing_install_names_how_to_install(tmp_path):
+    with pytest.raises(GazeboMissingError, match="install Gazebo Fortress.*WORLDGEN_GAZEBO_SETUP"):
+        locate(tmp_path / "setup.sh")
+
+
+def test_only_known_harmless_lines_are_dropped_from_the_problems():
+    log = ("Library error: libignition-tools-backward.so not found. Improved backtrace generation will be disabled\n"
+           "\x1b[1;31m[Err] [Physics.cc:761] \x1b[0mFailed to find plugin\n[Msg] Loaded level [3]\n"
+           "[Wrn] [SdfEntityCreator.cc:1] something\n")
+    assert problems_in(log) == ["[Err] [Physics.cc:761] Failed to find plugin", "[Wrn] [SdfEntityCreator.cc:1] something"]
+
+
+def test_the_dynamic_poses_of_a_world_with_actors_are_refused_before_they_crash_gazebo(tmp_path):
+    import worldgen
+    from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboServer
+
+    folder = worldgen.generate("cluttered", seed=3, n_movers=1).write(tmp_path, preview=False)
+    server = GazeboServer(folder / "world.sdf", install=GazeboInstall(tmp_path / "setup.sh", {}, "6.18.0"))
+    assert server.actors == 1
+    with pytest.raises(GazeboError, match="dynamic_pose/info would crash Gazebo"):
+        server.poses(dynamic=True)

@@ -1,0 +1,63 @@
+"""``worldgen drive``: a thin click layer over :func:`worldgen.sim.drive.drive`.
+
+Exit status (docs/cli.md): 0 when the run is judged a success, 1 when it is not (a collision, the
+goal missed), 2 on a usage mistake or a missing simulator or extra (one line on stderr).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import click
+
+from worldgen.cli.context import CONTEXT as _CONTEXT
+
+__all__ = ["drive_command"]
+
+
+@click.command("drive", context_settings=_CONTEXT, epilog="""\b
+Examples:
+  worldgen drive worlds/cluttered-s0-55fec0f6 --sim gazebo --out runs
+  worldgen drive worlds/cluttered-s0-55fec0f6 --sim mujoco --out runs --straight   (into what stands between)
+""")
+@click.argument("world", type=click.Path(path_type=Path), metavar="WORLD")
+@click.option("--sim", type=click.Choice(["gazebo", "mujoco"]), default="mujoco", show_default=True,
+              help="The simulator: Gazebo Fortress headless, or MuJoCo (docs/drive.md).")
+@click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
+              help="Where the run's bag folder is written (DIR/<world id>-<task>-<sim>).")
+@click.option("--task", metavar="ID", help="The task to drive [default: the world's first].")
+@click.option("--speed", type=click.FloatRange(0, 2, min_open=True), default=0.5, show_default=True,
+              help="Forward speed, m/s.")
+@click.option("--straight", is_flag=True,
+              help="Drive spawn -> goal in a straight line instead of the reference path (a test hook: "
+                   "it drives into whatever stands between them).")
+def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: float, straight: bool) -> None:
+    """Drive a world's task in a simulator, record the run as a rosbag2 bag and judge it.
+
+    The robot (worldgen.export.robot in Gazebo, the RL environment's robot in MuJoCo) starts at the
+    task's spawn and follows the reference path by pure pursuit on the simulator's own pose; the run
+    stops at the goal, the time limit, or when the robot is stuck. The bag holds /clock, /odom, /tf,
+    /cmd_vel and /ground_truth and is judged as 'worldgen judge BAG --world WORLD' would judge it.
+    Exit status 0 when the run succeeds, 1 when it does not, 2 on bad input. Needs the ros extra.
+    """
+    from worldgen.ros.deps import require_rosbags
+    from worldgen.sim.drive import drive
+
+    require_rosbags()
+    outcome = drive(world, out, sim=sim, task=task, straight=straight, speed=speed)
+    run = outcome.run
+    collisions = run.get("collisions") or []
+    if run.get("success"):
+        what = f"reached the goal in {run['time_to_goal']:.2f} s, path {run['path_length']:.2f} m, no contact"
+    elif collisions:
+        first = collisions[0]
+        what = f"collision with {first['entity']} at t = {first['time']:.2f} s (first of {len(collisions)})"
+    else:
+        stopped = {"stuck": "stuck", "time_limit": "time limit", "goal": "at the goal"}[outcome.ended]
+        what = f"{run.get('reason') or 'judged a failure'} (the drive stopped: {stopped})"
+    click.echo(f"{sim}: {'PASS' if outcome.passed else 'FAIL'}: {what} ({outcome.sim_seconds:.2f} s simulated, "
+               f"{outcome.wall['drive']:.2f} s wall)")
+    click.echo(f"bag: {outcome.bag}")
+    if not outcome.passed:
+        raise click.exceptions.Exit(1)

@@ -1,0 +1,321 @@
+"""A differential-drive robot sized to a world's footprint: ``robot.sdf`` for Gazebo, ``robot.urdf`` for ROS.
+
+    >>> import worldgen
+    >>> from worldgen.export.robot import robot_sdf, robot_urdf
+    >>> world = worldgen.generate("cluttered", seed=0, size=[6, 6], n_obstacles=4)
+    >>> sdf = robot_sdf(world)                       # spawn it with Gazebo's create service
+    >>> '<model name="robot">' in sdf, "<topic>cmd_vel</topic>" in sdf
+    (True, True)
+    >>> robot_urdf(world).count("<link ")            # base_footprint, base_link, 2 wheels, 2 casters, lidar, imu
+    8
+
+The body is world.json's ``robot`` footprint: a cylinder of ``radius`` whose top is at
+``height``; everything else sits inside it. Two drive wheels on the y axis and two
+frictionless caster spheres (front and back) carry it; the chassis' collision starts a caster
+radius above the floor, so only wheels and casters touch it. Frames: the model's frame is
+``base_footprint`` (on the floor under the centre: the pose a spawn and world.json give),
+``base_link`` sits on the wheel axis above it, ``base_scan`` at world.json's lidar height and
+``imu_link`` at the centre of the chassis.
+
+Gazebo systems on the model (its own topics, as nav2 expects them, not gz-sim's
+``/model/<name>/...`` defaults): DiffDrive takes ``cmd_vel`` and publishes ``odom`` and ``tf``
+(``odom`` -> ``base_footprint``, starting at zero at the spawn); OdometryPublisher publishes the
+ground truth, the model's pose in the world frame (= the map frame), on ``ground_truth/odom``
+(``map`` -> ``base_footprint``) and its ``tf_topic`` on ``/model/<name>/pose``, the topic the
+ROS 2 bundle bridges as ``/ground_truth``. Sensors: a ``gpu_lidar`` on ``scan`` whose rays are
+world.json's ``sensors.lidar`` (samples, angles, range_min, range_max, height) with optional
+Gaussian noise, and an IMU on ``imu``. The lidar sits inside the footprint cylinder, as world.json
+puts it; the chassis' visual leaves a window around its plane so the lidar never sees the robot.
+
+The URDF is the same tree for robot_state_publisher and RViz (links, joints, inertias,
+geometry); Gazebo spawns the SDF. Both are bytes-stable: same world and arguments, same text.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Mapping
+
+from lxml import etree
+
+from worldgen.errors import ParameterError
+from worldgen.export.xml import sub, to_bytes
+from worldgen.floats import fmt, fmt_seq
+
+__all__ = ["DEFAULT_NAME", "GZ_RELEASES", "LIDAR_WINDOW", "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
+
+#: The model's name: the ROS 2 bundle's robot (worldgen.ros.bundle.DEFAULT_ROBOT_NAME).
+DEFAULT_NAME = "robot"
+#: How each Gazebo release names a model system's plugin (file, class): Fortress keeps the ignition names.
+GZ_RELEASES = {"fortress": ("ignition-gazebo-{}-system", "ignition::gazebo::systems::{}"),
+               "garden": ("gz-sim-{}-system", "gz::sim::systems::{}"),
+               "harmonic": ("gz-sim-{}-system", "gz::sim::systems::{}"),
+               "ionic": ("gz-sim-{}-system", "gz::sim::systems::{}")}
+#: Half-height (m) of the gap the chassis' visual leaves around the lidar's plane: what a gpu_lidar
+#: renders is visuals, and SDFormat 1.9 has no visibility mask for a lidar, so the window keeps the
+#: robot out of its own scan (the collision cylinder is whole).
+LIDAR_WINDOW = 0.01
+_CHASSIS_KG, _WHEEL_KG, _CASTER_KG = 10.0, 0.5, 0.2
+_COLOUR = "0.95 0.45 0.1 1"
+
+
+class Dimensions:
+    """Every length of the robot, m, from the footprint (radius, height) and the lidar's height."""
+
+    def __init__(self, radius: float, height: float, lidar_height: float):
+        if not (radius > 0 and height > 0 and math.isfinite(radius) and math.isfinite(height)):
+            raise ParameterError(f"robot radius and height must be finite and > 0, got {radius!r}, {height!r}")
+        self.radius, self.height, self.lidar_height = radius, height, lidar_height
+        self.wheel_radius = min(0.05, height / 4.0, radius / 4.0)
+        self.wheel_width = 0.8 * self.wheel_radius
+        # Each wheel's outer face sits at 0.9 r: the wheels stay inside the footprint cylinder.
+        self.wheel_separation = 2.0 * (0.9 * radius - self.wheel_width / 2.0)
+        self.caster_radius = self.wheel_radius / 2.0
+        self.caster_x = radius - 1.5 * self.caster_radius
+        # The chassis' collision spans [caster radius, height] above the floor: only wheels and casters touch it.
+        self.chassis_bottom = self.caster_radius
+
+
+def _meta(world) -> Mapping:
+    """world.json's content: a :class:`~worldgen.World`'s metadata, or a world.json already read."""
+    return world if isinstance(world, Mapping) else world.metadata
+
+
+def dimensions(world) -> Dimensions:
+    """The robot's :class:`Dimensions` for ``world`` (a World or world.json's content): its ``robot``
+    footprint and world.json's lidar height above the first spawn."""
+    meta = _meta(world)
+    lidar, robot = meta["sensors"]["lidar"], meta["robot"]
+    spawn_z = meta["tasks"][0]["spawn"][2]
+    return Dimensions(float(robot["radius"]), float(robot["height"]), float(lidar["pose"][2]) - float(spawn_z))
+
+
+def _release(gz_release: str) -> tuple[str, str]:
+    if gz_release not in GZ_RELEASES:
+        raise ParameterError(f"parameter 'gz_release' must be one of {', '.join(GZ_RELEASES)}, got {gz_release!r}")
+    return GZ_RELEASES[gz_release]
+
+
+def _inertia_cylinder(m: float, r: float, length: float) -> tuple[float, float, float]:
+    side = m * (3 * r * r + length * length) / 12.0
+    return side, side, m * r * r / 2.0
+
+
+def _sdf_inertial(link, mass: float, diag, pose: str = "0 0 0 0 0 0") -> None:
+    inertial = sub(link, "inertial")
+    sub(inertial, "pose", pose)
+    sub(inertial, "mass", fmt(mass))
+    inertia = sub(inertial, "inertia")
+    for key, value in zip(("ixx", "iyy", "izz"), diag):
+        sub(inertia, key, fmt(value))
+    for key in ("ixy", "ixz", "iyz"):
+        sub(inertia, key, "0")
+
+
+def _sdf_shape(parent, kind: str, name: str, shape: tuple, pose: str, mu: float | None = None) -> None:
+    el = sub(parent, kind, name=name)
+    sub(el, "pose", pose)
+    geometry = sub(el, "geometry")
+    if shape[0] == "cylinder":
+        cyl = sub(geometry, "cylinder")
+        sub(cyl, "radius", fmt(shape[1]))
+        sub(cyl, "length", fmt(shape[2]))
+    else:
+        sub(sub(geometry, "sphere"), "radius", fmt(shape[1]))
+    if kind == "visual":
+        material = sub(el, "material")
+        sub(material, "ambient", _COLOUR)
+        sub(material, "diffuse", _COLOUR)
+    elif mu is not None:
+        ode = sub(sub(sub(el, "surface"), "friction"), "ode")
+        sub(ode, "mu", fmt(mu))
+        sub(ode, "mu2", fmt(mu))
+
+
+def _parts(d: Dimensions) -> list[tuple]:
+    """(link, joint type, xyz from base_link, shape, mass, friction) of every body below base_link."""
+    y = d.wheel_separation / 2.0
+    rc, rw = d.caster_radius, d.wheel_radius
+    return [("left_wheel", "revolute", (0.0, y, 0.0), ("cylinder", rw, d.wheel_width), _WHEEL_KG, 1.0),
+            ("right_wheel", "revolute", (0.0, -y, 0.0), ("cylinder", rw, d.wheel_width), _WHEEL_KG, 1.0),
+            ("front_caster", "fixed", (d.caster_x, 0.0, rc - rw), ("sphere", rc), _CASTER_KG, 0.0),
+            ("back_caster", "fixed", (-d.caster_x, 0.0, rc - rw), ("sphere", rc), _CASTER_KG, 0.0)]
+
+
+def _chassis(d: Dimensions) -> tuple[float, float]:
+    """(length, z of its centre above base_link) of the chassis cylinder."""
+    length = d.height - d.chassis_bottom
+    return length, d.chassis_bottom + length / 2.0 - d.wheel_radius
+
+
+def _visual_bands(d: Dimensions) -> list[tuple[float, float]]:
+    """(bottom, top) above the floor of each piece of the chassis' visual: whole, or cut by the lidar window."""
+    low, high = d.lidar_height - LIDAR_WINDOW, d.lidar_height + LIDAR_WINDOW
+    if low <= d.chassis_bottom or high >= d.height:
+        return [(d.chassis_bottom, d.height)]
+    return [(d.chassis_bottom, low), (high, d.height)]
+
+
+def _sdf_links(model, d: Dimensions) -> None:
+    length, zc = _chassis(d)
+    base = sub(model, "link", name="base_link")
+    sub(base, "pose", fmt_seq((0, 0, d.wheel_radius, 0, 0, 0)))
+    _sdf_inertial(base, _CHASSIS_KG, _inertia_cylinder(_CHASSIS_KG, d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
+    _sdf_shape(base, "collision", "chassis_collision", ("cylinder", d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
+    for k, (low, high) in enumerate(_visual_bands(d)):
+        _sdf_shape(base, "visual", f"chassis_visual_{k}", ("cylinder", d.radius, high - low),
+                   fmt_seq((0, 0, (low + high) / 2.0 - d.wheel_radius, 0, 0, 0)))
+    for name, joint, xyz, shape, mass, mu in _parts(d):
+        link = sub(model, "link", name=name)
+        # A wheel's cylinder axis (its z) turns onto the model's y axis.
+        roll = -math.pi / 2 if shape[0] == "cylinder" else 0.0
+        sub(link, "pose", fmt_seq((xyz[0], xyz[1], xyz[2] + d.wheel_radius, roll, 0, 0)))
+        diag = _inertia_cylinder(mass, shape[1], shape[2]) if shape[0] == "cylinder" else (0.4 * mass * shape[1] ** 2,) * 3
+        _sdf_inertial(link, mass, diag)
+        _sdf_shape(link, "collision", "collision", shape, "0 0 0 0 0 0", mu)
+        _sdf_shape(link, "visual", "visual", shape, "0 0 0 0 0 0")
+        j = sub(model, "joint", name=f"{name}_joint", type=joint)
+        sub(j, "parent", "base_link")
+        sub(j, "child", name)
+        if joint == "revolute":
+            # In the wheel's frame (turned -90 deg about x) its z axis is the model's +y: forward is +rotation.
+            axis = sub(j, "axis")
+            sub(axis, "xyz", "0 0 1")
+
+
+def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_rate: float) -> None:
+    scan_link = sub(model, "link", name="base_scan")
+    sub(scan_link, "pose", fmt_seq((0, 0, d.lidar_height, 0, 0, 0)))
+    _sdf_inertial(scan_link, 0.01, (1e-5, 1e-5, 1e-5))
+    sensor = sub(scan_link, "sensor", name="lidar", type="gpu_lidar")
+    sub(sensor, "always_on", "true")
+    sub(sensor, "update_rate", fmt(lidar_rate))
+    sub(sensor, "visualize", "false")
+    sub(sensor, "topic", "scan")
+    ray = sub(sensor, "lidar")
+    horizontal = sub(sub(ray, "scan"), "horizontal")
+    sub(horizontal, "samples", str(int(lidar["samples"])))
+    sub(horizontal, "resolution", "1")
+    sub(horizontal, "min_angle", fmt(lidar["angle_min"]))
+    sub(horizontal, "max_angle", fmt(lidar["angle_max"]))
+    rng = sub(ray, "range")
+    sub(rng, "min", fmt(lidar["range_min"]))
+    sub(rng, "max", fmt(lidar["range_max"]))
+    sub(rng, "resolution", "0.001")
+    noise = sub(ray, "noise")
+    sub(noise, "type", "gaussian")
+    sub(noise, "mean", "0")
+    sub(noise, "stddev", fmt(lidar_noise))
+    for name in ("base_scan", "imu_link"):
+        j = sub(model, "joint", name=f"{name}_joint", type="fixed")
+        sub(j, "parent", "base_link")
+        sub(j, "child", name)
+    imu_link = sub(model, "link", name="imu_link")
+    sub(imu_link, "pose", fmt_seq((0, 0, d.wheel_radius + _chassis(d)[1], 0, 0, 0)))
+    _sdf_inertial(imu_link, 0.01, (1e-5, 1e-5, 1e-5))
+    imu = sub(imu_link, "sensor", name="imu", type="imu")
+    sub(imu, "always_on", "true")
+    sub(imu, "update_rate", "50")
+    sub(imu, "topic", "imu")
+
+
+def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: float) -> None:
+    filename, cls = _release(gz_release)
+    drive = sub(model, "plugin", filename=filename.format("diff-drive"), name=cls.format("DiffDrive"))
+    for key, value in (("left_joint", "left_wheel_joint"), ("right_joint", "right_wheel_joint"),
+                       ("wheel_separation", fmt(d.wheel_separation)), ("wheel_radius", fmt(d.wheel_radius)),
+                       ("odom_publish_frequency", fmt(odom_rate)), ("topic", "cmd_vel"), ("odom_topic", "odom"),
+                       ("tf_topic", "tf"), ("frame_id", "odom"), ("child_frame_id", "base_footprint")):
+        sub(drive, key, value)
+    truth = sub(model, "plugin", filename=filename.format("odometry-publisher"), name=cls.format("OdometryPublisher"))
+    for key, value in (("odom_frame", "map"), ("robot_base_frame", "base_footprint"),
+                       ("odom_publish_frequency", fmt(odom_rate)), ("odom_topic", "ground_truth/odom"),
+                       ("tf_topic", f"/model/{name}/pose"), ("dimensions", "2")):
+        sub(truth, key, value)
+    states = sub(model, "plugin", filename=filename.format("joint-state-publisher"),
+                 name=cls.format("JointStatePublisher"))
+    sub(states, "topic", "joint_states")
+
+
+def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_release: str = "harmonic",
+              sensors: bool = True, lidar_rate: float = 10.0, odom_rate: float = 50.0) -> str:
+    """``robot.sdf`` (SDFormat 1.9, one ``<model>``) of the robot for ``world`` (a World or world.json's content).
+
+    ``lidar_noise``: the lidar's Gaussian noise, standard deviation in m (0: exact ranges);
+    ``gz_release``: whose plugin names the systems get (``fortress``, ``garden``, ``harmonic``, ``ionic``);
+    ``sensors=False`` leaves lidar and IMU out (a run that reads no sensor needs no renderer);
+    ``lidar_rate``, ``odom_rate``: publishing rates, Hz.
+    """
+    if not (lidar_noise >= 0 and math.isfinite(lidar_noise)):
+        raise ParameterError(f"parameter 'lidar_noise' must be a finite standard deviation >= 0 m, got {lidar_noise!r}")
+    if not (lidar_rate > 0 and odom_rate > 0):
+        raise ParameterError(f"rates must be > 0 Hz, got lidar_rate={lidar_rate!r}, odom_rate={odom_rate!r}")
+    _release(gz_release)
+    d = dimensions(world)
+    root = etree.Element("sdf", version="1.9")
+    model = sub(root, "model", name=name)
+    sub(model, "pose", "0 0 0 0 0 0")
+    sub(model, "frame", name="base_footprint", attached_to="base_link").append(
+        _el("pose", fmt_seq((0, 0, -d.wheel_radius, 0, 0, 0)), relative_to="base_link"))
+    _sdf_links(model, d)
+    if sensors:
+        _sdf_sensors(model, d, _meta(world)["sensors"]["lidar"], float(lidar_noise), float(lidar_rate))
+    _sdf_plugins(model, d, name, gz_release, float(odom_rate))
+    return to_bytes(root).decode()
+
+
+def _el(tag: str, text: str, **attrs):
+    el = etree.Element(tag, attrs)
+    el.text = text
+    return el
+
+
+def _urdf_link(robot, name: str, shape=None, mass: float = 0.0, diag=(0, 0, 0), origin=(0, 0, 0, 0, 0, 0)) -> None:
+    link = sub(robot, "link", name=name)
+    if shape is None:
+        return
+    inertial = sub(link, "inertial")
+    sub(inertial, "origin", xyz=fmt_seq(origin[:3]), rpy=fmt_seq(origin[3:]))
+    sub(inertial, "mass", value=fmt(mass))
+    sub(inertial, "inertia", ixx=fmt(diag[0]), ixy="0", ixz="0", iyy=fmt(diag[1]), iyz="0", izz=fmt(diag[2]))
+    for kind in ("visual", "collision"):
+        el = sub(link, kind)
+        sub(el, "origin", xyz=fmt_seq(origin[:3]), rpy=fmt_seq(origin[3:]))
+        geometry = sub(el, "geometry")
+        if shape[0] == "cylinder":
+            sub(geometry, "cylinder", radius=fmt(shape[1]), length=fmt(shape[2]))
+        else:
+            sub(geometry, "sphere", radius=fmt(shape[1]))
+        if kind == "visual":
+            sub(sub(el, "material", name="robot_orange"), "color", rgba=_COLOUR)
+
+
+def _urdf_joint(robot, name: str, kind: str, parent: str, child: str, xyz, rpy=(0, 0, 0), axis=None) -> None:
+    joint = sub(robot, "joint", name=name, type=kind)
+    sub(joint, "parent", link=parent)
+    sub(joint, "child", link=child)
+    sub(joint, "origin", xyz=fmt_seq(xyz), rpy=fmt_seq(rpy))
+    if axis is not None:
+        sub(joint, "axis", xyz=axis)
+
+
+def robot_urdf(world, *, name: str = DEFAULT_NAME) -> str:
+    """``robot.urdf`` of the robot for ``world``: the SDF's links and joints, for robot_state_publisher."""
+    d = dimensions(world)
+    length, zc = _chassis(d)
+    robot = etree.Element("robot", name=name)
+    _urdf_link(robot, "base_footprint")
+    _urdf_link(robot, "base_link", ("cylinder", d.radius, length), _CHASSIS_KG,
+               _inertia_cylinder(_CHASSIS_KG, d.radius, length), (0, 0, zc, 0, 0, 0))
+    _urdf_joint(robot, "base_footprint_joint", "fixed", "base_footprint", "base_link", (0, 0, d.wheel_radius))
+    for part, kind, xyz, shape, mass, _ in _parts(d):
+        if shape[0] == "cylinder":
+            _urdf_link(robot, part, shape, mass, _inertia_cylinder(mass, shape[1], shape[2]))
+            _urdf_joint(robot, f"{part}_joint", "continuous", "base_link", part, xyz, (-math.pi / 2, 0, 0), "0 0 1")
+        else:
+            _urdf_link(robot, part, shape, mass, (0.4 * mass * shape[1] ** 2,) * 3)
+            _urdf_joint(robot, f"{part}_joint", "fixed", "base_link", part, xyz)
+    for part, z in (("base_scan", d.lidar_height - d.wheel_radius), ("imu_link", zc)):
+        _urdf_link(robot, part)  # a frame only: no body of its own
+        _urdf_joint(robot, f"{part}_joint", "fixed", "base_link", part, (0, 0, z))
+    return to_bytes(robot).decode()

@@ -1,0 +1,373 @@
+"""Running a world in a real Gazebo Sim server (Fortress, ``ign gazebo``), headless, from Python.
+
+The API (stable; the robot-driving loop builds on it)::
+
+    from worldgen.sim.gazebo import GazeboServer, locate
+
+    with GazeboServer("worlds/cluttered-s0-55fec0f6/world.sdf") as gz:   # started paused, world up
+        gz.step(500)                                  # 500 physics iterations, unthrottled
+        poses = gz.poses()                            # model name -> (x, y, z, qx, qy, qz, qw)
+        gz.spawn(robot_sdf_text, name="robot", pose=(1.0, 2.0, 0.0, 0.3))
+        gz.echo("/lidar", n=1)                        # parsed messages (worldgen.sim.textproto)
+    gz.problems()                                     # Gazebo's errors and warnings, known harmless ones removed
+
+- :func:`locate` finds an install (``WORLDGEN_GAZEBO_SETUP``, else ``/opt/gz-fortress2/setup.sh``) and reads its
+  setup script's exports into an environment (no shell runs it); :class:`GazeboMissingError` says how to install.
+- The server is a direct child (an argument list, never a shell) in its own process group; leaving the block
+  stops it (SIGINT, SIGTERM, then SIGKILL 3 s later: with a render engine it may ignore the polite signals) and
+  checks that no process of its group survives.
+- ``ign`` exits 0 even when it fails, so every call here judges by what it printed, not by its status.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import subprocess
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from worldgen.errors import SimulatorError, SimulatorMissingError
+from worldgen.sim import textproto
+from worldgen.sim.procs import group_members, run_tool, stop_group
+
+__all__ = ["GazeboMissingError", "GazeboError", "GazeboInstall", "GazeboServer", "locate", "SETUP_ENV",
+           "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name"]
+
+#: The environment variable naming an install's setup script, and the script used without it.
+SETUP_ENV = "WORLDGEN_GAZEBO_SETUP"
+DEFAULT_SETUP = Path("/opt/gz-fortress2/setup.sh")
+INSTALL_HINT = ("install Gazebo Fortress (on Debian 12: apt-get install libsdformat-dev libignition-fuel-tools-dev "
+                "libignition-msgs-dev libignition-plugin-dev libignition-transport-dev, then bash shared/gazebo/install.sh; "
+                "see docs/gazebo.md) or point WORLDGEN_GAZEBO_SETUP at its setup.sh")
+
+#: Lines Gazebo prints that say nothing about the world, each with why it is harmless.
+HARMLESS: dict[str, str] = {
+    "Library error: libignition-tools-backward.so not found":
+        "ign-tools' optional backtrace helper, absent from Debian's ign-tools; printed by every ign call",
+    "Error launching Remotery: Can't bind a socket for the server":
+        "ign-common's profiler (Remotery, compiled into the 6.18 build) listens on TCP port 1500 (measured: "
+        "whatever RMT_PORT says) and finds it taken when another Gazebo runs on the machine; profiling only",
+}
+
+_ANSI = re.compile(r"\x1b\[[0-9;]*m")
+#: The plugin Gazebo 6 asks for by default, and the file Debian 12's ign-physics5 ships instead (no unversioned link).
+_DART_DEFAULT = "libignition-physics-dartsim-plugin.so"
+_DART_DEBIAN = Path("/usr/lib/x86_64-linux-gnu/ign-physics-5/engine-plugins/libignition-physics5-dartsim-plugin.so.5")
+
+
+class GazeboMissingError(SimulatorMissingError):
+    """No usable Gazebo install: the message names where it looked and how to install one."""
+
+
+class GazeboError(SimulatorError):
+    """Gazebo ran but did not do what was asked (the world did not come up, a service did not answer)."""
+
+
+@dataclass(frozen=True)
+class GazeboInstall:
+    """One Gazebo install: its setup script, the environment that script builds, its ``ign gazebo`` version."""
+
+    setup: Path
+    env: dict[str, str] = field(repr=False)
+    version: str
+
+
+def _exports(setup: Path, base: dict[str, str]) -> dict[str, str]:
+    """The environment after ``export NAME=value`` lines of ``setup`` (``$VAR``/``${VAR:-}`` expanded)."""
+    env = dict(base)
+
+    def expand(value: str) -> str:
+        value = value.strip().strip('"').strip("'")
+        return re.sub(r"\$\{(\w+)(?::-[^}]*)?\}|\$(\w+)", lambda m: env.get(m.group(1) or m.group(2), ""), value)
+
+    for line in setup.read_text().splitlines():
+        m = re.match(r"\s*export\s+(\w+)=(.*)$", line)
+        if m:
+            env[m.group(1)] = expand(m.group(2)).rstrip(":")
+    return env
+
+
+def locate(setup: str | Path | None = None) -> GazeboInstall:
+    """The Gazebo install to use; the one place the tool-missing policy lives (raises :class:`GazeboMissingError`)."""
+    setup = Path(setup or os.environ.get(SETUP_ENV) or DEFAULT_SETUP)
+    if not setup.is_file():
+        raise GazeboMissingError(f"Gazebo not found: no setup script at {setup}; {INSTALL_HINT}")
+    env = _exports(setup, {k: v for k, v in os.environ.items()})
+    try:
+        out = run_tool(["ign", "gazebo", "--versions"], env, timeout=30)
+    except FileNotFoundError:
+        raise GazeboMissingError(f"Gazebo's 'ign' command is not on the PATH {setup} sets; {INSTALL_HINT}") from None
+    versions = [v for v in out.split() if re.fullmatch(r"\d+\.\d+\.\d+", v)]
+    if not versions:
+        raise GazeboMissingError(f"'ign gazebo --versions' with {setup} names no Gazebo ({out.strip()[:200]!r}); "
+                                 f"{INSTALL_HINT}")
+    return GazeboInstall(setup, env, versions[-1])
+
+
+def _physics_args(env: dict[str, str]) -> list[str]:
+    """``--physics-engine`` naming Debian's DART plugin when Gazebo's default name exists on none of its paths."""
+    dirs = [Path(d) for d in env.get("IGN_GAZEBO_PHYSICS_ENGINE_PATH", "").split(":") if d]
+    dirs += [Path(d) for d in env.get("LD_LIBRARY_PATH", "").split(":") if d] + [_DART_DEBIAN.parent]
+    if any((d / _DART_DEFAULT).exists() for d in dirs) or not _DART_DEBIAN.exists():
+        return []
+    return ["--physics-engine", _DART_DEBIAN.name]
+
+
+#: Lines a skin-less actor (worldgen's movers and people) makes Gazebo 6.18 print, once per actor, each with
+#: why it says nothing wrong about the world; :func:`problems_in` drops each at most once per actor.
+ACTOR_NOTES: dict[str, str] = {
+    "Link's parent entity": "the Physics system visits an actor's link, finds no model for it and skips it: "
+                            "actors have no physics in Gazebo Sim (the script moves them)",
+    "Collision's parent entity": "the same for the actor link's collision element",
+    "Invalid mesh filename extension": "the rendering scene tries the actor's skin, sdformat's placeholder name "
+                                       "__default__ (worldgen writes no skin), then draws the actor's links along "
+                                       "the script instead (gz-sim pull request 1947)",
+    "Actor skin mesh": "the same skin lookup, reported a second time",
+}
+
+
+def problems_in(log: str, actors: int = 0) -> list[str]:
+    """The error and warning lines of a Gazebo log, without colour codes, without :data:`HARMLESS` lines and
+    without up to ``actors`` of each :data:`ACTOR_NOTES` line."""
+    out, left = [], {note: actors for note in ACTOR_NOTES}
+    for line in _ANSI.sub("", log).splitlines():
+        if any(known in line for known in HARMLESS):
+            continue
+        note = next((n for n in ACTOR_NOTES if n in line), None)
+        if note is not None and left[note] > 0:
+            left[note] -= 1
+            continue
+        if "[Err]" in line or "[Wrn]" in line or "error" in line.lower():
+            out.append(line.strip())
+    return out
+
+
+def _without_harmless(text: str) -> str:
+    return "\n".join(x for x in text.splitlines() if not any(k in x for k in HARMLESS))
+
+
+def world_name(sdf_path: Path) -> tuple[str, int]:
+    """The ``<world name>`` of an SDF file and how many ``<actor>``s it holds (parsed without entities or network)."""
+    from lxml import etree
+
+    parser = etree.XMLParser(resolve_entities=False, no_network=True)
+    world = etree.parse(str(sdf_path), parser).getroot().find("world")
+    if world is None or not world.get("name"):
+        raise GazeboError(f"{sdf_path} holds no <world name=...>")
+    return str(world.get("name")), len(world.findall("actor"))
+
+
+class GazeboServer:
+    """One headless ``ign gazebo -s`` run of one world; a context manager (see the module's docstring).
+
+    ``headless_rendering`` loads the render engine through EGL (a gpu_lidar or camera in the world needs it);
+    ``verbosity`` is Gazebo's ``-v``; ``real_time_factor`` None runs unthrottled. The server starts paused:
+    simulation time moves only through :meth:`step`.
+    """
+
+    def __init__(self, world_sdf: str | Path, *, install: GazeboInstall | None = None, headless_rendering: bool = False,
+                 verbosity: int = 3, real_time_factor: float | None = None, start_timeout: float = 60.0):
+        self.world_sdf = Path(world_sdf).resolve()
+        self.install = install or locate()
+        # Gazebo's transport finds peers machine-wide: a partition of its own keeps this server and its
+        # ign calls apart from any other Gazebo on the machine (same world name, /stats, /clock).
+        self.env = dict(self.install.env, IGN_PARTITION=f"worldgen-{os.getpid()}-{id(self):x}")
+        self.world, self.actors = world_name(self.world_sdf)
+        self.headless_rendering = headless_rendering
+        self.verbosity = verbosity
+        self.real_time_factor = real_time_factor
+        self.start_timeout = start_timeout
+        self.load_seconds: float | None = None
+        self._proc: subprocess.Popen | None = None
+        self._logdir = tempfile.TemporaryDirectory(prefix="worldgen-gazebo-")
+        self._iterations = 0
+        self._scene: dict | None = None  # the last scene/info reply, until a spawn changes the scene
+
+    # -- life cycle --------------------------------------------------------------------------------------------
+    def command(self) -> list[str]:
+        """The server's argument list."""
+        args = ["ign", "gazebo", "-s", "-v", str(self.verbosity), "-z", str(self.real_time_factor or 1000000)]
+        if self.headless_rendering:
+            args.append("--headless-rendering")
+        return args + _physics_args(self.install.env) + [str(self.world_sdf)]
+
+    def start(self) -> GazeboServer:
+        logdir = Path(self._logdir.name)
+        started = time.monotonic()
+        with open(logdir / "stdout", "wb") as out, open(logdir / "stderr", "wb") as err:
+            self._proc = subprocess.Popen(self.command(), env=self.env, stdin=subprocess.DEVNULL, stdout=out,
+                                          stderr=err, start_new_session=True, cwd=str(self.world_sdf.parent))
+        try:
+            self._wait_up(started)
+        except BaseException:
+            self.stop()
+            raise
+        self.load_seconds = time.monotonic() - started
+        return self
+
+    def _wait_up(self, started: float) -> None:
+        """Until the world's scene service answers (it is served once the world is loaded)."""
+        while time.monotonic() - started < self.start_timeout:
+            if self._proc is None or self._proc.poll() is not None:
+                raise GazeboError(f"Gazebo exited while loading {self.world_sdf}: {self.problems()[:5]}")
+            # One long wait rather than short polls: a requester that gives up before a busy server answers
+            # makes the server print "error sending response: Host unreachable".
+            remaining = self.start_timeout - (time.monotonic() - started)
+            try:
+                reply = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty", "ignition.msgs.Scene",
+                                     "", timeout=max(1.0, remaining))
+            except GazeboError:
+                continue
+            if reply:
+                self._scene = reply
+                return
+        raise GazeboError(f"Gazebo did not serve world {self.world!r} within {self.start_timeout:.0f} s")
+
+    def __enter__(self) -> GazeboServer:
+        return self.start()
+
+    def __exit__(self, *exc) -> None:
+        self.stop()
+
+    def stop(self) -> int | None:
+        """Stop the server and its process group; returns its exit status. Raises if a process survives."""
+        if self._proc is None:
+            return None
+        status = stop_group(self._proc, grace=3.0)
+        left = group_members(self._proc.pid)
+        if left:
+            raise GazeboError(f"processes {left} of Gazebo's group {self._proc.pid} survived SIGKILL")
+        return status
+
+    # -- what it printed -------------------------------------------------------------------------------------
+    def log(self) -> tuple[str, str]:
+        """The server's (stdout, stderr) so far, colour codes removed."""
+        logdir = Path(self._logdir.name)
+        return tuple(_ANSI.sub("", (logdir / s).read_text(errors="replace")) if (logdir / s).exists() else ""
+                     for s in ("stdout", "stderr"))  # type: ignore[return-value]
+
+    def problems(self) -> list[str]:
+        """Gazebo's error and warning lines so far (stdout and stderr), without the known harmless ones (those
+        of :data:`ACTOR_NOTES` once per actor of the world)."""
+        out, err = self.log()
+        return problems_in(out + "\n" + err, self.actors)
+
+    # -- talking to it ---------------------------------------------------------------------------------------
+    def _ign(self, args: list[str], timeout: float) -> str:
+        try:
+            return run_tool(["ign"] + args, self.env, timeout=timeout)
+        except subprocess.TimeoutExpired:
+            raise GazeboError(f"'ign {' '.join(args[:3])}' got no answer within {timeout:.0f} s") from None
+
+    def echo(self, topic: str, n: int = 1, timeout: float = 20.0, step: int = 0) -> list[dict]:
+        """The next ``n`` messages on a topic, parsed (:mod:`worldgen.sim.textproto`).
+
+        ``step`` > 0 keeps the world stepping that many iterations at a time until they came: for a topic
+        published only while simulation time moves (a sensor), as the server waits paused otherwise."""
+        args = ["ign", "topic", "-e", "-t", topic, "-n", str(n)]
+        if not step:
+            return self._parse_echo(self._ign(args[1:], timeout))
+        with tempfile.TemporaryFile() as sink:
+            proc = subprocess.Popen(args, env=self.env, stdin=subprocess.DEVNULL, stdout=sink,
+                                    stderr=subprocess.STDOUT, start_new_session=True)
+            deadline = time.monotonic() + timeout
+            try:
+                while proc.poll() is None and time.monotonic() < deadline:
+                    self.step(step)
+            finally:
+                if proc.poll() is None:
+                    stop_group(proc, grace=0.5)
+                    raise GazeboError(f"no {n} message(s) on {topic} within {timeout:.0f} s of stepping")
+            sink.seek(0)
+            return self._parse_echo(sink.read().decode("utf-8", errors="replace"))
+
+    @staticmethod
+    def _parse_echo(text: str) -> list[dict]:
+        return [textproto.parse(m) for m in textproto.split_messages(_without_harmless(text))]
+
+    def service(self, name: str, reqtype: str, reptype: str, req: str, timeout: float = 10.0) -> dict:
+        """Call a service; its reply parsed. Raises :class:`GazeboError` when it does not answer."""
+        ms = str(int(timeout * 1000))
+        text = self._ign(["service", "-s", name, "--reqtype", reqtype, "--reptype", reptype, "--timeout", ms,
+                          "--req", req], timeout + 5)
+        body = _without_harmless(text).strip()
+        if not body or "timed out" in body.lower() or "error" in body.lower():
+            raise GazeboError(f"service {name} did not answer: {body[:200]!r}")
+        return textproto.parse(body)
+
+    def stats(self) -> dict:
+        """One ``/world/<name>/stats`` message (iterations, sim_time, real_time_factor, paused)."""
+        return self.echo(f"/world/{self.world}/stats", 1)[0]
+
+    def stats_time(self) -> float:
+        """The world's simulation time (s), from one ``stats`` message."""
+        sim = textproto.first(self.stats(), "sim_time", {})
+        return float(textproto.first(sim, "sec", 0)) + float(textproto.first(sim, "nsec", 0)) * 1e-9
+
+    def step(self, iterations: int, timeout: float = 120.0) -> int:
+        """Run ``iterations`` physics steps, then stay paused; returns the world's iteration count."""
+        target = self._iterations + int(iterations)
+        reply = self.service(f"/world/{self.world}/control", "ignition.msgs.WorldControl", "ignition.msgs.Boolean",
+                             f"pause: true, multi_step: {int(iterations)}")
+        if textproto.first(reply, "data") is not True and textproto.first(reply, "data") != "true":
+            raise GazeboError(f"world control refused {iterations} steps: {reply}")
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            done = int(textproto.first(self.stats(), "iterations", 0))
+            if done >= target:
+                self._iterations = done
+                return done
+        raise GazeboError(f"world {self.world!r} did not reach iteration {target} within {timeout:.0f} s")
+
+    def scene_names(self) -> dict[int, str]:
+        """Entity id -> scoped name (``model``, ``model::link``) of every model and link, from ``scene/info``
+        (asked once, and again after a spawn)."""
+        if self._scene is None:
+            self._scene = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty",
+                                       "ignition.msgs.Scene", "")
+        scene = self._scene
+        names: dict[int, str] = {}
+
+        def walk(model: dict, prefix: str) -> None:
+            scoped = prefix + str(textproto.first(model, "name", ""))
+            names[int(textproto.first(model, "id", 0))] = scoped
+            for link in model.get("link", []):
+                names[int(textproto.first(link, "id", 0))] = f"{scoped}::{textproto.first(link, 'name', '')}"
+            for nested in model.get("model", []):
+                walk(nested, scoped + "::")
+
+        for model in scene.get("model", []):
+            walk(model, "")
+        return names
+
+    def poses(self, dynamic: bool = False, timeout: float = 20.0) -> dict[str, tuple[float, ...]]:
+        """Scoped name (``model``, ``model::link``) -> (x, y, z, qx, qy, qz, qw) from one ``pose/info`` (or
+        ``dynamic_pose/info``) message. A model's pose is in the world frame, a link's in its model's frame
+        (as Gazebo publishes them); entities that are neither (lights, visuals) are left out."""
+        if dynamic and self.actors:
+            # SceneBroadcaster::PoseUpdate (gz-sim 6.18 and 8.9) reads the Static component of every link's
+            # parent once dynamic_pose/info has a subscriber; an actor's link has the actor as its parent,
+            # which has none: the server dies of a null dereference (measured here, SIGSEGV).
+            raise GazeboError(f"dynamic_pose/info would crash Gazebo: world {self.world!r} has actors "
+                              "(docs/gazebo.md); read pose/info, which carries the moving bodies too")
+        topic = f"/world/{self.world}/{'dynamic_pose' if dynamic else 'pose'}/info"
+        message = self.echo(topic, 1, timeout)[0]
+        names = self.scene_names()
+        return {names[int(textproto.first(p, "id", 0))]: textproto.pose_of(p) for p in message.get("pose", [])
+                if int(textproto.first(p, "id", 0)) in names}
+
+    def spawn(self, sdf: str, name: str, pose: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)) -> None:
+        """Create a model from SDF text (a ``<sdf>`` document) at (x, y, z, yaw) through ``/world/<name>/create``."""
+        import json
+        import math
+
+        x, y, z, yaw = pose
+        req = (f"sdf: {json.dumps(sdf)}, name: {json.dumps(name)}, allow_renaming: false, pose: {{position: "
+               f"{{x: {x!r}, y: {y!r}, z: {z!r}}}, orientation: {{z: {math.sin(yaw / 2)!r}, w: {math.cos(yaw / 2)!r}}}}}")
+        self._scene = None
+        reply = self.service(f"/world/{self.world}/create", "ignition.msgs.EntityFactory", "ignition.msgs.Boolean", req)
+        if textproto.first(reply, "data") is not True and textproto.first(reply, "data") != "true":
+            raise GazeboError(f"Gazebo refused to create {name!r}: {reply}")
