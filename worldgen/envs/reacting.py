@@ -28,16 +28,24 @@ class Walkers:
     def __init__(self, movers: list, wall_gap=None):
         from worldgen.people.react import Reactions
 
-        self.script = MoverScript(movers)
+        self.script = MoverScript(movers)  # everyone on its world.json track: the reset's and the picture's
         self.z = self.script.z
         self.names = [str(m["name"]) for m in movers]
-        self.reacting = np.array([i for i, m in enumerate(movers) if m.get("behaviour")], dtype=np.int64)
+        loops = np.array([bool(m.get("loop", False)) for m in movers], dtype=bool)
+        self.loopers, self.people = np.flatnonzero(loops), np.flatnonzero(~loops)
+        self._loop_script = MoverScript([movers[i] for i in self.loopers])
+        # Every person (impassive ones walk their tracks exactly) goes through one Reactions: one look-up
+        # for all of them a period, where np.interp took two calls a person.
+        who = [movers[i] for i in self.people]
+        #: Each reacting person's place among ``people``.
+        self.reacting = np.array([k for k, m in enumerate(who) if m.get("behaviour")], dtype=np.int64)
         self.reactions: Optional[Reactions] = None
-        if len(self.reacting):
-            who = [movers[i] for i in self.reacting]
-            self.reactions = Reactions([np.asarray(m["trajectory"], dtype=float) for m in who],
-                                       [float(m["radius"]) for m in who], [str(m["behaviour"]) for m in who],
-                                       [Tube(float(m["tube"]["d"]), float(m["tube"]["tau"])) for m in who], wall_gap)
+        if len(who):
+            self.reactions = Reactions(
+                [np.asarray(m["trajectory"], dtype=float) for m in who], [float(m["radius"]) for m in who],
+                [str(m.get("behaviour", "impassive")) for m in who],
+                [Tube(float(m["tube"]["d"]), float(m["tube"]["tau"])) if m.get("tube") else Tube(0.0, 0.0)
+                 for m in who], wall_gap if len(self.reacting) else None)
         self.rows: list[list[tuple[float, float, float]]] = []
         self._rows, self._rows_of = None, None
         self.reset()
@@ -49,25 +57,26 @@ class Walkers:
         """Everyone back on its start, the records cleared."""
         if self.reactions is not None:
             self.reactions.reset()
-            self.rows = [[(0.0, float(x), float(y))] for x, y in self.reactions.p]
+            self.rows = [[(0.0, float(x), float(y))] for x, y in self.reactions.p[self.reacting]]
 
     def positions(self, times: np.ndarray) -> np.ndarray:
         """(len(times), movers, 2) where the scripts have everyone (reacting people: where they are now)."""
         xy = self.script.positions(times)
-        if self.reactions is not None:
-            xy[:, self.reacting] = self.reactions.p
+        if len(self.reacting):
+            xy[:, self.people[self.reacting]] = self.reactions.p[self.reacting]
         return xy
 
     def period(self, t0: float, h: float, n: int, robot_xy, robot_v, robot_radius: float) -> np.ndarray:
         """(n, movers, 2) everyone at the start of each of the ``n`` physics steps of ``h`` s from ``t0``,
-        the reacting people stepped once to the period's end against the robot."""
-        xy = self.script.positions(t0 + h * np.arange(n))
+        the people stepped once to the period's end against the robot."""
+        xy = np.empty((n, len(self.names), 2))
+        if len(self.loopers):
+            xy[:, self.loopers] = self._loop_script.positions(t0 + h * np.arange(n))
         r = self.reactions
         if r is not None:
             r.step(n * h, robot_xy, robot_v, robot_radius)
-            if not r.calm:  # calm: everyone walked the recorded trajectory, which the scripts already have
-                xy[:, self.reacting] = r.positions(np.arange(n) / n)
-            for rows, (x, y) in zip(self.rows, r.p):
+            xy[:, self.people] = r.positions(np.arange(n) / n)
+            for rows, (x, y) in zip(self.rows, r.p[self.reacting]):
                 rows.append((round(r.t, 9), float(x), float(y)))
         return xy
 
@@ -88,12 +97,12 @@ class Walkers:
         """{person's name: steps its tube clipped a reaction} of the reacting people."""
         if self.reactions is None:
             return {}
-        return {self.names[i]: int(c) for i, c in zip(self.reacting, self.reactions.clips)}
+        return {self.names[self.people[k]]: int(self.reactions.clips[k]) for k in self.reacting}
 
     @property
     def reacted(self) -> dict:
         """{person's name: (k, 3) ``t, x, y`` rows it actually walked} of the reacting people."""
-        return {self.names[i]: np.array(rows) for i, rows in zip(self.reacting, self.rows)}
+        return {self.names[self.people[k]]: np.array(rows) for k, rows in zip(self.reacting, self.rows)}
 
 
 def walkers_of(world) -> Walkers:

@@ -74,7 +74,7 @@ class Reactions:
         self.tau = np.array([t.tau for t in tubes], dtype=float).reshape(self.n)
         self.model = model
         # How far each reacts from: its behaviour's range, the robot's repulsion's (negligible beyond 4 m).
-        self._range = np.array([(0.0, 4.0, SURPRISE_RANGE, 4.0, CURIOUS_RANGE)[k] for k in self.kind])
+        self._range = np.array([(-np.inf, 4.0, SURPRISE_RANGE, 4.0, CURIOUS_RANGE)[k] for k in self.kind])
         # All the tracks in one array, person i's times shifted by i * _SHIFT: one search finds everyone's leg.
         times, xy, vel, room, first = [], [], [], [], [0]
         for i, (track, r) in enumerate(zip(self.tracks, self.radius)):
@@ -117,11 +117,13 @@ class Reactions:
     # -- the recorded trajectory ----------------------------------------------------------------------
     def _locate(self, s: np.ndarray, who: np.ndarray):
         """(leg (global row index), share of the way along it) of person ``who[k]`` at phase ``s[k]``."""
-        sc = np.clip(s, self._t0[who], self._t1[who]) + who * _SHIFT
-        k = np.clip(np.searchsorted(self._t, sc, side="right") - 1, self._first[who],
-                    np.maximum(self._last[who] - 1, self._first[who]))
+        # np.minimum / np.maximum rather than np.clip: a step is a hundred small operations, and clip's
+        # Python wrapper costs more than the arithmetic.
+        sc = np.minimum(np.maximum(s, self._t0[who]), self._t1[who]) + who * _SHIFT
+        k = np.minimum(np.maximum(np.searchsorted(self._t, sc, side="right") - 1, self._first[who]),
+                       np.maximum(self._last[who] - 1, self._first[who]))
         span = self._t[np.minimum(k + 1, len(self._t) - 1)] - self._t[k]
-        share = np.clip((sc - self._t[k]) / np.where(span > 0, span, 1.0), 0.0, 1.0)
+        share = np.minimum(np.maximum((sc - self._t[k]) / np.where(span > 0, span, 1.0), 0.0), 1.0)
         return k, share
 
     def _at(self, s: np.ndarray, who: np.ndarray) -> np.ndarray:
@@ -170,16 +172,17 @@ class Reactions:
             self.v = self._u
             return self.p
         self.calm = False
-        rate = np.clip(1.0 + (self.t - s) / RETURN, 0.0, RATE_MAX)
+        rate = np.minimum(np.maximum(1.0 + (self.t - s) / RETURN, 0.0), RATE_MAX)
         want = rate[:, None] * u - o / RETURN
         force, heading, seen = self._robot_force(rel, dist, u, np.asarray(robot_v, dtype=float), robot_radius)
         kind = np.where(self.spent & (self.kind >= 2) & (self.kind != 3), 1, self.kind)
         scared = (kind == 3) & (dist < SCARED_RANGE)
-        gap = np.maximum(dist - self.radius - robot_radius, 1e-3)
-        force[scared] += ((20.0 * m.r / gap) / dist)[scared, None] * rel[scared]
+        if scared.any():
+            gap = np.maximum(dist - self.radius - robot_radius, 1e-3)
+            force[scared] += ((20.0 * m.r / gap) / dist)[scared, None] * rel[scared]
+            fast = np.hypot(want[:, 0], want[:, 1])
+            want[scared] *= np.minimum(1.0, _SCARED_SPEED / np.maximum(fast, 1e-9))[scared, None]
         force = self._aside(force, rel, heading, seen)
-        fast = np.hypot(want[:, 0], want[:, 1])
-        want[scared] *= np.minimum(1.0, _SCARED_SPEED / np.maximum(fast, 1e-9))[scared, None]
         acc = (want - self.v) / m.tau + np.where((kind == 1)[:, None] | scared[:, None], force, 0.0)
         curious = (kind == 4) & (dist < CURIOUS_RANGE)
         if curious.any():
@@ -200,12 +203,12 @@ class Reactions:
     def _advance(self, t1: float, p, s, u, move, rate, dt: float, near) -> None:
         """Split ``move`` into phase and offset, clip both onto the tube, and count the clips; a person out
         of the robot's reach within :data:`SNAP` of its recorded trajectory is put back on it."""
-        uu = np.einsum("ij,ij->i", u, u)
-        ds = np.where(uu > 1e-12, np.einsum("ij,ij->i", move, u) / np.maximum(uu, 1e-12), rate * dt)
-        s_new = s + np.clip(ds, 0.0, 2.0 * RATE_MAX * dt)
+        uu = u[:, 0] * u[:, 0] + u[:, 1] * u[:, 1]
+        ds = np.where(uu > 1e-12, (move[:, 0] * u[:, 0] + move[:, 1] * u[:, 1]) / np.maximum(uu, 1e-12), rate * dt)
+        s_new = s + np.minimum(np.maximum(ds, 0.0), 2.0 * RATE_MAX * dt)
         lo, hi = t1 - self.tau, t1 + self.tau
         clipped = (s_new < lo - 1e-9) | (s_new > hi + 1e-9)
-        s_new = np.clip(s_new, lo, hi)
+        s_new = np.minimum(np.maximum(s_new, lo), hi)
         xy, u_new, room = self._state(s_new)
         o_new = p + move - xy
         room = np.minimum(self.d, room)
