@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from support.reftools_mujoco import load_and_step
-from support.reftools_sdf import check_sdf
+from support.reftools_sdf import check_robot_sdf
 from support.reftools_urdf import check_urdf
 
 import worldgen
@@ -38,7 +38,7 @@ def _floats(text: str) -> list[float]:
 def _check_files(tmp_path, world, **kw):
     sdf = tmp_path / "robot.sdf"
     sdf.write_text(robot_export.robot_sdf(world, **kw))
-    ok, messages = check_sdf(sdf)
+    ok, messages = check_robot_sdf(sdf)
     assert ok, messages
     urdf = tmp_path / "robot.urdf"
     urdf.write_text(robot_export.robot_urdf(world))

@@ -6,7 +6,7 @@ import re
 
 import numpy as np
 import pytest
-from support.reftools_sdf import check_sdf
+from support.reftools_sdf import check_robot_sdf
 
 import worldgen
 from worldgen.ros import bundle as ros2
@@ -76,7 +76,7 @@ def test_the_shipped_robot_publishes_what_the_bridge_takes(release, tmp_path):
     sdf = files["ros2/robot.sdf"].decode()
     path = tmp_path / "robot.sdf"
     path.write_text(sdf)
-    ok, messages = check_sdf(path)
+    ok, messages = check_robot_sdf(path)
     assert ok, messages
     assert '<model name="bot_1">' in sdf and "<robot name=\"bot_1\"" in files["ros2/robot.urdf"].decode()
     prefix = "ignition-gazebo-" if release == "fortress" else "gz-sim-"

@@ -36,11 +36,12 @@ def worlds(tmp_path_factory) -> dict[str, Path]:
 
 @pytest.mark.parametrize("generator", ["cluttered", "minimal"])
 def test_one_scan_agrees_with_world_json_and_misses_only_on_edges(worlds, generator):
-    from worldgen.sim.scan import edge_rays, gazebo_scan
+    from worldgen.sim.scan import edge_rays, read_scan
 
     folder = worlds[generator]
     truth = np.array(json.loads((folder / "world.json").read_text())["sensors"]["lidar"]["ranges"])
-    got = gazebo_scan(folder)
+    got, frame = read_scan(folder)
+    assert frame == "base_scan"  # the URDF's frame (gz_frame_id), not Gazebo's scoped sensor name
     assert got.shape == truth.shape
     error = np.abs(got - truth)
     assert np.median(error) < 0.01, f"median |error| {np.median(error):.4f} m"

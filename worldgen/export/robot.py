@@ -42,15 +42,23 @@ from worldgen.errors import ParameterError
 from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
 
-__all__ = ["DEFAULT_NAME", "GZ_RELEASES", "LIDAR_WINDOW", "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
+__all__ = ["DEFAULT_NAME", "GZ_RELEASES", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW",
+           "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
 
 #: The model's name: the ROS 2 bundle's robot (worldgen.ros.bundle.DEFAULT_ROBOT_NAME).
 DEFAULT_NAME = "robot"
-#: How each Gazebo release names a model system's plugin (file, class): Fortress keeps the ignition names.
-GZ_RELEASES = {"fortress": ("ignition-gazebo-{}-system", "ignition::gazebo::systems::{}"),
-               "garden": ("gz-sim-{}-system", "gz::sim::systems::{}"),
-               "harmonic": ("gz-sim-{}-system", "gz::sim::systems::{}"),
-               "ionic": ("gz-sim-{}-system", "gz::sim::systems::{}")}
+#: How each Gazebo release names a system's plugin (file, class) and its message package: Fortress (ROS 2
+#: Humble) keeps the ignition names, Garden and later the gz-sim ones (gz-sim's include/gz/sim/server.config
+#: and include/ignition/gazebo/server.config). The ROS 2 bundle reads this table too.
+GZ_RELEASES = {"fortress": ("ignition-gazebo-{}-system", "ignition::gazebo::systems::{}", "ignition.msgs"),
+               "garden": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
+               "harmonic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
+               "ionic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs")}
+#: The element Gazebo's sensors take their message frame from. Without it a scan's frame is the scoped
+#: sensor name (``robot::base_scan::lidar``, measured in Fortress 6.18), a frame no URDF has, and AMCL and
+#: the costmaps drop the scans. ``gz_frame_id`` is read by Fortress 6.18's ign-sensors and by gz-sensors 8
+#: (Harmonic); it is a Gazebo extension, not SDFormat, so a strict libsdformat check flags it.
+SENSOR_FRAME_ELEMENT = "gz_frame_id"
 #: Half-height (m) of the gap the chassis' visual leaves around the lidar's plane: what a gpu_lidar
 #: renders is visuals, and SDFormat 1.9 has no visibility mask for a lidar, so the window keeps the
 #: robot out of its own scan (the collision cylinder is whole).
@@ -93,7 +101,8 @@ def dimensions(world) -> Dimensions:
 def _release(gz_release: str) -> tuple[str, str]:
     if gz_release not in GZ_RELEASES:
         raise ParameterError(f"parameter 'gz_release' must be one of {', '.join(GZ_RELEASES)}, got {gz_release!r}")
-    return GZ_RELEASES[gz_release]
+    filename, cls, _msgs = GZ_RELEASES[gz_release]
+    return filename, cls
 
 
 def _inertia_cylinder(m: float, r: float, length: float) -> tuple[float, float, float]:
@@ -192,6 +201,7 @@ def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_ra
     sub(sensor, "update_rate", fmt(lidar_rate))
     sub(sensor, "visualize", "false")
     sub(sensor, "topic", "scan")
+    sub(sensor, SENSOR_FRAME_ELEMENT, "base_scan")
     ray = sub(sensor, "lidar")
     horizontal = sub(sub(ray, "scan"), "horizontal")
     sub(horizontal, "samples", str(int(lidar["samples"])))
@@ -217,6 +227,7 @@ def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_ra
     sub(imu, "always_on", "true")
     sub(imu, "update_rate", "50")
     sub(imu, "topic", "imu")
+    sub(imu, SENSOR_FRAME_ELEMENT, "imu_link")
 
 
 def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: float) -> None:

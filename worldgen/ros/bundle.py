@@ -28,6 +28,8 @@ from importlib import resources
 from typing import Any, Mapping, Optional
 
 from worldgen.errors import ParameterError
+from worldgen.export.robot import DEFAULT_NAME as DEFAULT_ROBOT_NAME
+from worldgen.export.robot import GZ_RELEASES
 
 __all__ = ["BUNDLE_DIR", "ROBOT_SDF", "ROBOT_URDF", "GZ_RELEASES", "GZ_SERVERS", "DEFAULT_GZ_RELEASE",
            "DEFAULT_ROBOT_NAME", "TOPICS", "RECORDED_TOPICS", "ros_name", "release_of", "plugins", "with_plugins",
@@ -36,16 +38,6 @@ __all__ = ["BUNDLE_DIR", "ROBOT_SDF", "ROBOT_URDF", "GZ_RELEASES", "GZ_SERVERS",
 BUNDLE_DIR = "ros2"
 #: The shipped robot's files in the bundle (worldgen.export.robot).
 ROBOT_SDF, ROBOT_URDF = "robot.sdf", "robot.urdf"
-DEFAULT_ROBOT_NAME = "robot"
-#: Gazebo releases the bundle's world.sdf can be written for: how their system plugins are named.
-#: Fortress (ROS 2 Humble) still uses the ignition names; Garden and later the gz-sim ones
-#: (gz-sim's include/gz/sim/server.config and include/ignition/gazebo/server.config).
-GZ_RELEASES = {
-    "fortress": ("ignition-gazebo-{}-system", "ignition::gazebo::systems::{}", "ignition.msgs"),
-    "garden": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
-    "harmonic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
-    "ionic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
-}
 #: Gazebo's server command per release, whether it takes ``--seed`` (gz-sim 8's cmdsim.rb has it; gz-sim 7's
 #: and ign-gazebo 6's do not) and the variable it reads system plugin paths from. The launch file runs it
 #: without a shell: ros_gz_sim's gz_sim.launch.py runs ``ruby $(which gz) sim`` through one, the shell does

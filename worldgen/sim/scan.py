@@ -22,7 +22,7 @@ import numpy as np
 from worldgen.files import METADATA_NAME
 from worldgen.sim.gazebo import GazeboError, GazeboServer, locate
 
-__all__ = ["gazebo_scan", "edge_rays", "EDGE_JUMP"]
+__all__ = ["gazebo_scan", "read_scan", "edge_rays", "EDGE_JUMP"]
 
 #: A ray is an edge ray where the true range differs from a neighbour's by more than this (m).
 EDGE_JUMP = 0.1
@@ -36,7 +36,13 @@ def _world_with_sensors(folder: Path, sdf_name: str) -> str:
 
 
 def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> np.ndarray:
-    """The first scan the robot's gpu_lidar publishes at the first task's spawn in ``world`` (a folder)."""
+    """The ranges (m) of the first scan the robot's gpu_lidar publishes at the first task's spawn in ``world``."""
+    return read_scan(world, lidar_noise=lidar_noise, timeout=timeout)[0]
+
+
+def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> tuple[np.ndarray, str]:
+    """(ranges, m; the message's header ``frame_id``) of the first scan the robot's gpu_lidar publishes at the
+    first task's spawn in ``world`` (a folder). The frame is what a ROS 2 bridge passes on."""
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.textproto import first
 
@@ -55,8 +61,10 @@ def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> np
     ranges = np.array([float(r) for r in got[0].get("ranges", [])])
     if len(ranges) != int(first(got[0], "count", len(ranges))):
         raise GazeboError(f"/scan held {len(ranges)} ranges for a count of {first(got[0], 'count')}")
+    frame = next((first(d, "value") for h in got[0].get("header", []) for d in h.get("data", [])
+                  if first(d, "key") == "frame_id"), "")
     # Gazebo reports +inf for a ray that hits nothing (REP 117); world.json writes range_max there.
-    return np.where(np.isposinf(ranges), float(meta["sensors"]["lidar"]["range_max"]), ranges)
+    return np.where(np.isposinf(ranges), float(meta["sensors"]["lidar"]["range_max"]), ranges), str(frame)
 
 
 def edge_rays(truth) -> np.ndarray:
