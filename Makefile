@@ -81,6 +81,7 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_people.py
 	$(PY) benchmarks/bench_reacting.py
 	$(PY) benchmarks/bench_drive.py
+	nice -n 10 $(PY) benchmarks/bench_requests.py
 
 ## bench-learning: PPO (stable-baselines3) on one core learns worldgen/Navigation-v0 with the default
 ## reward and with `walkthrough`, against random, heuristic and path-follower baselines on held-out

@@ -50,9 +50,34 @@ def test_the_same_request_gives_the_same_world_from_the_cli_in_another_process(t
     draws = len(meta["difficulty_request"]["draws"])
     assert folder.name == f"L7-r3--{meta['world_id']}"
     assert done.stdout == f"{folder}\tpath {meta['tasks'][0]['path']['length']:.3f} m\tlevel 7/10, request seed 3" \
-                          f"\tdraws {draws}\n"
+                          f"\tdraws {draws}\tattempts 1\n"  # and the attempts of the draw that landed
     assert meta["metrics"]["difficulty_level"] == 7 and meta["difficulty_request"]["level"] == "7/10"
     checked = run("check", folder)  # a received world at a level re-verifies, its request included
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+
+
+PEOPLE = {"n_people": 4, "people_duration": 20.0}
+
+
+def test_a_level_with_people_walks_them_once_per_landed_draw_and_is_the_same_in_another_process(tmp_path, monkeypatch):
+    from worldgen.people import crowd
+
+    walks = []
+    walk_plan = crowd.walk_plan
+    monkeypatch.setattr(crowd, "walk_plan", lambda *a, **k: walks.append(1) or walk_plan(*a, **k))
+    world = worldgen.generate("cluttered", seed=3, difficulty="6/10", **PEOPLE)
+    draws = world.metadata["difficulty_request"]["draws"]
+    assert len(draws) == 9 and len(walks) == 1  # nine draws judged without people, the people walked on the last
+    assert world.metadata["metrics"]["difficulty_level"] == 6 and len(world.metadata["people"]) == 4
+    # Regenerable like any world: its own seed and params (people included) give it without the request.
+    assert worldgen.generate("cluttered", world.seed, **world.params).content_hash == world.content_hash
+    done = run("generate", "cluttered", "--difficulty", "6/10", "--seed", "3", *(f"--set={k}={v}" for k, v in
+                                                                                  PEOPLE.items()), "--out", tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.rstrip().endswith("level 6/10, request seed 3\tdraws 9\tattempts 1"), done.stdout
+    (folder,) = world_dirs(tmp_path)
+    assert (folder / "world.json").read_bytes() == world.read("world.json")
+    checked = run("check", folder)
     assert checked.returncode == 0, checked.stdout + checked.stderr
 
 

@@ -9,8 +9,9 @@ caller allowed, only on which one succeeded).
 
 from __future__ import annotations
 
+import logging
 from collections import Counter
-from typing import Any
+from typing import Any, Optional
 
 from worldgen import feasibility
 from worldgen.errors import InfeasibleError, ParameterError
@@ -23,6 +24,9 @@ from worldgen.seeding import attempt_rng, check_seed, mover_rng, people_rng
 from worldgen.world import World
 
 __all__ = ["generate"]
+
+#: Where a long request says what it is doing, one level below the request's own line (worldgen.cli.progress).
+_progress = logging.getLogger("worldgen.progress.attempt")
 
 
 # long: the pipeline's stages in the order they run (validate, draw, movers, people, prove, record); one reads it top to bottom
@@ -44,7 +48,7 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             raise ParameterError("parameter 'difficulty' asks for a drivable world; it excludes allow_infeasible")
         from worldgen.leveling import generate_at_level
 
-        return generate_at_level(generate, spec.name, seed, difficulty, params)
+        return generate_at_level(generate, spec.name, seed, difficulty, params, people_on=_people_on)
     try:
         resolved = spec.resolve(params)
     except InfeasibleError:
@@ -64,9 +68,11 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
     budget = resolved["max_attempts"]
     map_extent = None
     for attempt in range(budget):
+        _progress.info("%s seed %d: attempt %d of max_attempts=%d", name, seed, attempt + 1, budget)
         draft = spec.build(resolved, attempt_rng(seed, attempt))
+        plan = None
         if not draft.rejected:
-            draft = _with_common_extras(spec, resolved, draft, robot, seed, attempt)
+            draft, plan = _with_common_extras(spec, resolved, draft, robot, seed, attempt)
         if draft.rejected:
             failures[draft.rejected] += 1
             details.setdefault(draft.rejected, draft.detail)
@@ -74,17 +80,25 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
         assert draft.scene is not None, "a draft that is not rejected has a scene"
         if map_extent is None:  # the map's size follows from the floor: refuse before planning on it
             map_extent = occupancy.extent(draft.scene, resolved["map_resolution"])
-        report = feasibility.check(draft.scene, draft.tasks, robot)
-        if resolved.get("n_people"):
+        scene = draft.scene
+        report = feasibility.check(scene, draft.tasks, robot)  # static: people are movers, which it never reads
+        if plan is not None and (report.feasible or allow_infeasible or resolved.get("infeasible")):
+            # The people walk (the costly part) only on a draw that can still be kept: one that failed a static
+            # check is refused here as it would be after the walk (docs/people.md, "Refusal").
+            _progress.info("%s seed %d: attempt %d of max_attempts=%d: walking %d people", name, seed, attempt + 1,
+                           budget, resolved["n_people"])
             from worldgen.people.behaviours import behaviours_of
+            from worldgen.people.crowd import walk_plan
             from worldgen.people.timed import certify
-            report = certify(report, draft.scene, draft.tasks, robot, resolved["robot_speed"], behaviours_of(resolved))
-        world = World(name, seed, resolved, draft.scene, draft.tasks, robot, report, attempt + 1, allow_infeasible)
+            scene = scene.with_movers(scene.movers + walk_plan(scene, draft.tasks, robot, resolved, plan))
+            report = certify(report, scene, draft.tasks, robot, resolved["robot_speed"], behaviours_of(resolved))
+        elif plan is not None:
+            _count(failures, details, report)
+            continue
+        world = World(name, seed, resolved, scene, draft.tasks, robot, report, attempt + 1, allow_infeasible)
         if report.feasible or (resolved.get("infeasible") and _infeasible_on_purpose(report)):
             return world
-        for failed in report.failed():
-            failures[failed.name] += 1
-            details.setdefault(failed.name, failed.detail)
+        _count(failures, details, report)
         last = world
     if allow_infeasible and last is not None:
         return last
@@ -99,33 +113,71 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
     )
 
 
-def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt: int) -> Draft:
-    """The draft with what every generator offers through common parameters (see the modules).
+def _people_on(world: World, params: dict) -> Optional[World]:
+    """What ``generate(world.generator, world.seed, **params)`` gives when ``params`` are ``world``'s with people
+    added and the people pass on the attempt ``world`` passed on without them; None when they do not (the seed
+    then passes at a later attempt or at none). Every earlier attempt failed its static checks, which never read
+    the people, so it fails with them too: the world is the one ``generate`` returns. For a level request
+    (worldgen.leveling), which judges draws without people and walks them only on a draw that landed."""
+    spec = get(world.generator)
+    resolved = spec.resolve(params)
+    robot = robot_from_params(resolved)
+    from worldgen.people.prechecks import refuse_unplayable
+    refuse_unplayable(spec, resolved, robot)  # a script no draw can play ends the request here, in one line
+    attempt = world.attempts - 1
+    draft = spec.build(resolved, attempt_rng(world.seed, attempt))
+    draft, plan = _with_common_extras(spec, resolved, draft, robot, world.seed, attempt) if not draft.rejected \
+        else (draft, None)
+    if draft.rejected or plan is None or draft.scene is None:
+        return None
+    scene, report = draft.scene, world.feasibility
+    if scene.content_hash() != world.scene.content_hash():  # never expected: then prove it afresh
+        report = feasibility.check(scene, draft.tasks, robot)
+    from worldgen.people.crowd import walk_plan
+    from worldgen.people.timed import certify
+    _progress.info("%s seed %d: attempt %d: walking %d people", world.generator, world.seed, attempt + 1,
+                   resolved["n_people"])
+    scene = scene.with_movers(scene.movers + walk_plan(scene, draft.tasks, robot, resolved, plan))
+    report = certify(report, scene, draft.tasks, robot, resolved["robot_speed"])
+    if not report.feasible:
+        return None
+    return World(world.generator, world.seed, resolved, scene, draft.tasks, robot, report, attempt + 1, False)
+
+
+def _count(failures: Counter, details: dict, report) -> None:
+    """Counts the checks ``report`` failed, keeping the first detail of each."""
+    for failed in report.failed():
+        failures[failed.name] += 1
+        details.setdefault(failed.name, failed.detail)
+
+
+def _with_common_extras(spec, resolved, draft: Draft, robot, seed: int, attempt: int):
+    """(draft, people's plan or None): the draft with what every generator offers through common parameters.
 
     ``infeasible``: every goal walled in (worldgen.generators.infeasible), unless the generator
     declares its own ``infeasible`` parameter; ``n_movers``: movers on their own
     RNG stream (worldgen.generators.movers), laid out after any goal walls so they avoid them;
-    ``n_people``: people on theirs, walked by the crowd model (worldgen.people.crowd), after
-    the movers (docs/people.md).
+    ``n_people``: people on theirs, drawn after the movers (worldgen.people.places; docs/people.md)
+    and walked by the crowd model by the caller once the draft passed its static checks.
     """
     scene = draft.scene
     assert scene is not None, "a draft that is not rejected has a scene"
     if resolved.get("infeasible") and "infeasible" not in {p.name for p in spec.params}:
         scene, reason = wall_in_goals(scene, draft.tasks, robot, resolved["friction"])
         if reason:
-            return Draft(scene, draft.tasks, rejected="infeasible_placement", detail=reason)
+            return Draft(scene, draft.tasks, rejected="infeasible_placement", detail=reason), None
     if resolved.get("n_movers"):
         movers, reason = place_movers(scene, draft.tasks, robot, resolved, mover_rng(seed, attempt))
         if reason:
-            return Draft(scene, draft.tasks, rejected="mover_placement", detail=reason)
+            return Draft(scene, draft.tasks, rejected="mover_placement", detail=reason), None
         scene = scene.with_movers(movers)
+    plan = None
     if resolved.get("n_people"):
-        from worldgen.people.crowd import walk_people
-        people, reason = walk_people(scene, draft.tasks, robot, resolved, people_rng(seed, attempt))
-        if reason:
-            return Draft(scene, draft.tasks, rejected="people_placement", detail=reason)
-        scene = scene.with_movers(scene.movers + people)
-    return draft if scene is draft.scene else Draft(scene, draft.tasks)
+        from worldgen.people.places import draw_people
+        plan, reason = draw_people(scene, draft.tasks, robot, resolved, people_rng(seed, attempt))
+        if plan is None:
+            return Draft(scene, draft.tasks, rejected="people_placement", detail=reason or ""), None
+    return (draft if scene is draft.scene else Draft(scene, draft.tasks)), plan
 
 
 def _infeasible_on_purpose(report) -> bool:

@@ -17,6 +17,12 @@ lands in the level, each draw a whole world of its own:
 GENERATOR`` prints it) and a generator without a knob (:data:`NO_LEVELS`) are
 refused up front in one line.
 
+With people (``n_people``) a draw is judged on its world without them (``n_people=0``; the level never
+reads the people) and the people are walked only on a draw that landed, on the attempt it landed on; where
+they refuse it (no timed path) the draw is recorded with no level and the next draw keeps the knob. Such
+refusals have their own budget of :data:`MAX_DRAWS` beside the misses' (docs/metrics.md). Walking them on
+every attempt of every draw made a 10-draw request 133 s of CPU.
+
 The world is an ordinary one: its ``seed`` and ``params`` (with the knob's
 value) regenerate it without any of this. world.json's ``difficulty_request``
 records how it was reached: the level asked for, the request's seed and every
@@ -26,6 +32,7 @@ any process.
 
 from __future__ import annotations
 
+import logging
 import re
 from dataclasses import dataclass
 from typing import Any, Callable, Mapping, Optional
@@ -34,6 +41,9 @@ from worldgen.errors import InfeasibleError, ParameterError, quoted
 from worldgen.floats import finite_or_none
 from worldgen.groundtruth import difficulty, truth
 from worldgen.seeding import level_seed
+
+#: Where a long request says what it is doing (worldgen.cli.progress shows it on a terminal; nothing else does).
+_progress = logging.getLogger("worldgen.progress")
 
 __all__ = ["LEVELS", "MAX_DRAWS", "STEP", "START", "MAX_KNOB", "Knob", "KNOBS", "NO_LEVELS", "reachable",
            "describe_levels", "parse_level", "check_request", "score", "generate_at_level"]
@@ -201,9 +211,11 @@ def check_request(name: str, level_value: Any, params: Mapping[str, Any]) -> tup
     return level, knob.param
 
 
-def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any]):
+def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any],
+                      people_on: Optional[Callable] = None):
     """A world of generator ``name`` at the level ``level_value`` asks for (see the module); ``generate`` is
-    :func:`worldgen.generate`."""
+    :func:`worldgen.generate`, ``people_on(world, params)`` the world with people of the same draw and attempt,
+    or None where they refuse it (worldgen.api)."""
     level, param = check_request(name, level_value, params)
     knob = KNOBS[name]
     scale = 1.0
@@ -213,17 +225,34 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
     value = float(knob.start[level - 1] or 0.0) * scale
     low, high, step = knob.low * scale, knob.high * scale, knob.step * scale
     fixed = {**params, **knob.sets(level)}
-    draws = []
-    for k in range(MAX_DRAWS):
+    people = bool(params.get("n_people"))
+    draws: list[dict] = []
+    refused = 0  # landed draws the people refused: a budget of their own, beside the draws' (see the module)
+    for k in range(2 * MAX_DRAWS):
+        if len(draws) - refused >= MAX_DRAWS or refused >= MAX_DRAWS:
+            break
         draw_seed = level_seed(seed, k)
         n = knob.value(value)
+        _progress.info("%s at level %d/%d, seed %d: draw %d of at most %d (%s=%s)%s", name, level, LEVELS, seed,
+                       len(draws) - refused + 1, MAX_DRAWS, param, n, _last(draws))
         try:
-            world = generate(name, draw_seed, **{**fixed, param: n})
+            # With people the level is judged on the draw without them, and they are added only to a draw that
+            # landed (see the module): the people are walked once per landed draw, not once per draw.
+            world = generate(name, draw_seed, **{**(_without_people(fixed) if people else fixed), param: n})
         except InfeasibleError:  # too crowded to place or drive: ease off
             draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
             value = max(low, value - step)
             continue
         got = score(world)
+        if people and got["difficulty_level"] == level and people_on is not None:
+            _progress.info("%s at level %d/%d, seed %d: draw %d landed; walking %d people", name, level, LEVELS,
+                           seed, len(draws) - refused + 1, params["n_people"])
+            with_people = people_on(world, {**fixed, param: n})
+            if with_people is None:  # no timed path among them on the landed attempt: same knob, next draw
+                draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
+                refused += 1
+                continue
+            world = with_people
         draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"], "level": got["difficulty_level"]})
         if got["difficulty_level"] == level:
             return world.set_provenance(difficulty_request={"level": f"{level}/{LEVELS}", "seed": seed, "knob": param,
@@ -231,9 +260,24 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         missed = level - (got["difficulty_level"] or level)
         value = min(max(value + step * missed, low), high)
     reached = sorted({d["level"] for d in draws if d["level"] is not None})
-    raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws "
+    also = f" and {refused} landed draws the people refused (no timed path among them)" if refused else ""
+    raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws{also} "
                           f"(levels reached: {', '.join(map(str, reached)) or 'none'}); try another seed or a "
                           f"level nearer {_nearest(reached, level)}", {"difficulty_level": MAX_DRAWS})
+
+
+def _without_people(params: Mapping[str, Any]) -> dict:
+    """``params`` with every people parameter left out (a world without people refuses them)."""
+    from worldgen.params import PEOPLE_PARAMS
+
+    return {k: v for k, v in params.items() if k not in PEOPLE_PARAMS}
+
+
+def _last(draws: list) -> str:
+    """", the last at level K" for the progress line (", the last refused" for a draw that could not be built)."""
+    if not draws:
+        return ""
+    return ", the last refused" if draws[-1]["level"] is None else f", the last at level {draws[-1]['level']}"
 
 
 def _nearest(reached: list, level: int) -> str:

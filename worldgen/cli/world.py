@@ -199,18 +199,32 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
     if seed + count - 1 > MAX_SEED:
         raise ParameterError(f"parameter 'count' must be in [1, {MAX_SEED - seed + 1}] for seed {seed}, got {count}")
     _check_out(out)
-    for s in range(seed, seed + count):
-        world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, difficulty=level, **params)
-        world.set_provenance(preset=preset.name if preset is not None else None)  # names the folder <preset>--<world_id>
-        folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
-                             ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)
-        lengths = ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
-        failed = ",".join(c.name for c in world.feasibility.failed())
-        verdict = f"\tinfeasible: {failed}" if failed else ""
-        request = world.difficulty_request  # a level request: the level, its seed and every draw it took
-        tried = (f"level {request['level']}, request seed {request['seed']}\tdraws {len(request['draws'])}" if request
-                 else f"attempts {world.attempts}")
-        click.echo(f"{folder}\tpath {lengths} m\t{tried}{verdict}")
+    from worldgen.cli.progress import shown
+
+    with shown() as echo:  # a request that runs long says what it is doing, on a terminal only
+        for s in range(seed, seed + count):
+            world = worldgen.generate(spec.name, seed=s, allow_infeasible=allow_infeasible, difficulty=level, **params)
+            world.set_provenance(preset=preset.name if preset is not None else None)  # names the folder <preset>--<world_id>
+            folder = world.write(out, formats=chosen, sdf_version=sdf_version, overwrite=overwrite,
+                                 ros=(gz_release or DEFAULT_GZ_RELEASE) if ros else False)
+            echo(f"{folder}\tpath {_lengths(world)} m\t{_draws(world)}{_verdict(world)}")
+
+
+def _lengths(world) -> str:
+    return ",".join("-" if p is None else f"{p.length:.3f}" for p in world.feasibility.paths)
+
+
+def _draws(world) -> str:
+    """"attempts N": the generator's attempts for the world's own seed (1: its first draw passed); a level request
+    first says the level, its seed and "draws K", the worlds drawn to reach the level (each with its own attempts)."""
+    request = world.difficulty_request  # a level request: the level, its seed and every draw it took
+    levels = f"level {request['level']}, request seed {request['seed']}\tdraws {len(request['draws'])}\t" if request else ""
+    return f"{levels}attempts {world.attempts}"
+
+
+def _verdict(world) -> str:
+    failed = ",".join(c.name for c in world.feasibility.failed())
+    return f"\tinfeasible: {failed}" if failed else ""
 
 
 @click.command("preview", context_settings=_CONTEXT)
@@ -236,6 +250,7 @@ def check_command(world_dirs: Sequence[Path]) -> None:
 
     Prints "OK DIR" or "FAIL DIR: CHECK: DETAIL" per folder; exit status 1 if any failed.
     """
+    from worldgen.cli.progress import shown
     from worldgen.files import METADATA_NAME
     from worldgen.verify import check_folder
 
@@ -245,10 +260,11 @@ def check_command(world_dirs: Sequence[Path]) -> None:
             raise ParameterError(f"'{folder}' is a folder of {len(inner)} world folders, not a world folder "
                                  f"(no {METADATA_NAME}); give them: worldgen check {folder}/*")
     failed = 0
-    for folder in world_dirs:
-        outcome = check_folder(folder)
-        failed += not outcome.ok
-        click.echo(outcome.line())
+    with shown() as echo:
+        for folder in world_dirs:
+            outcome = check_folder(folder)
+            failed += not outcome.ok
+            echo(outcome.line())
     if failed:
         raise click.exceptions.Exit(1)
 

@@ -11,9 +11,9 @@ Each person ``a`` accelerates as
   passed when the next one is in sight (checked every :data:`LOOK` steps), and the path is planned
   again from where the person stands when its waypoint has been out of sight for :data:`REPLAN`
   checks (unless the waypoint before it is in sight: then the person walks back to that one, which
-  leads on); a person who has moved
-  less than :data:`STUCK` m a look for ``2 x REPLAN`` looks in a row (held by others or by a wall's
-  push near a place) gives that place up and walks to the next;
+  leads on); a person who has moved less than :data:`STUCK` m a look for ``2 x REPLAN`` looks in a row
+  (held by others or by a wall's push near a place) gives that place up and walks to the next; a place
+  in another pocket of the floor (:mod:`~worldgen.people.reach`) is given up without asking the planner;
 - ``f_ab = -grad V(b)``, ``V = V0 exp(-(b - 2 r) / sigma)``, ``b`` the semi-minor axis of the
   ellipse of the paper (``2 b = sqrt((|r_ab| + |r_ab - v_b dt_h|)^2 - |v_b dt_h|^2)``), less the two
   radii: the paper's pedestrians are points, ours discs;
@@ -53,10 +53,11 @@ from worldgen.floats import round_float
 from worldgen.people.behaviours import widest_tube
 from worldgen.people.groups import GroupForce, group_force
 from worldgen.people.places import PERSON_HEIGHT, SLACK, draw_people, people_footprints
+from worldgen.people.reach import Pockets
 from worldgen.scene import Mover, Robot, Scene, Task
 
 __all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF", "ROADMAP_ROWS_PER_PERSON_S",
-           "ROADMAP_MAX_CIRCLES", "simulate", "walk_people"]
+           "ROADMAP_MAX_CIRCLES", "simulate", "walk_people", "walk_plan"]
 
 #: The integration step (s); the trajectories are written at it.
 DT = 0.1
@@ -181,8 +182,7 @@ class _Walls:
 
 
 def _runs(who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(first index of each run, its value) of ``who`` sorted (np.nonzero's row order): per person, where
-    its candidates start, for one ``np.minimum.reduceat`` over all of them."""
+    """(first index of each run, its value) of sorted ``who``: where each person's candidates start, for one reduceat."""
     first = np.flatnonzero(np.r_[True, who[1:] != who[:-1]]) if len(who) else np.zeros(0, dtype=np.int64)
     return first, who[first]
 
@@ -191,9 +191,9 @@ class _Router:
     """Each person's places and the planned path to the current one; ``target`` the waypoint steered to."""
 
     def __init__(self, planner: ExactPlanner, sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
-        # Sight is tested in a configuration space SLACK thinner than the planner's: a waypoint on a
-        # planner's circle is then in sight, not touching.
-        self.planner, self.sight, self.places = planner, sight, places
+        # Sight is tested in a configuration space SLACK thinner than the planner's (a waypoint on a planner's
+        # circle is then in sight, not touching); places in another pocket are skipped without a query.
+        self.planner, self.sight, self.places, self.pockets = planner, sight, places, Pockets(planner.cs)
         n = len(starts)
         self.place = np.full(n, -1)
         self.route: list[np.ndarray] = [np.zeros((0, 2))] * n
@@ -216,7 +216,8 @@ class _Router:
         self.target[i] = at
 
     def _plan(self, i: int, at: np.ndarray) -> bool:
-        route = self.planner.shortest(at, self.places[i, self.place[i]])
+        goal = self.places[i, self.place[i]]
+        route = None if self.pockets.apart(at, goal) else self.planner.shortest(at, goal)
         if route is None:
             return False
         # The route keeps its start, so that the waypoint before the one steered at always exists.
@@ -377,8 +378,12 @@ def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     """The people of ``params`` drawn (:func:`~worldgen.people.places.draw_people`) and walked:
     (movers with ``person=True``, None), or ((), reason) when they do not fit."""
     plan, reason = draw_people(scene, tasks, robot, params, rng)
-    if plan is None:
-        return (), reason
+    return ((), reason) if plan is None else (walk_plan(scene, tasks, robot, params, plan), None)
+
+
+def walk_plan(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping[str, Any], plan) -> tuple[Mover, ...]:
+    """The people of a drawn ``plan`` walked: movers with ``person=True`` (the costly half of :func:`walk_people`,
+    which the pipeline runs only on a draw that passed its static checks)."""
     obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot, widest_tube(params)))
     track = simulate(obstacles, scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius, plan.duration,
                      depart=plan.depart, groups=plan.groups)
@@ -391,4 +396,4 @@ def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
         keep = np.r_[True, ~still, True]
         rows = np.column_stack([times[keep], xy[keep]])
         people.append(Mover(f"person_{i}", plan.radius, PERSON_HEIGHT, rows, False, params["friction"], person=True))
-    return tuple(people), None
+    return tuple(people)

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import logging
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 from typing import Any, Optional
@@ -53,6 +54,8 @@ CHECKS = ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "
 #: Recorded and re-run path lengths may differ by this much (m): the 1e-6 of the
 #: contract plus half a unit in the 6th decimal that world.json rounds to.
 LENGTH_TOLERANCE = 1e-6 + 5e-7
+#: Where a long check says which stage it is in (worldgen.cli.progress shows it on a terminal).
+_progress = logging.getLogger("worldgen.progress")
 
 
 @dataclass(frozen=True)
@@ -81,13 +84,19 @@ def check_folder(folder) -> Outcome:
     """Run every check on ``folder``; never raises for a bad world, only reports it."""
     folder = Path(folder)
     try:
+        _progress.info("checking %s: hashes", folder)
         meta = _metadata(folder)
         entries = _paths(folder, meta)
         _files(folder, entries)
+        _progress.info("checking %s: schema", folder)
         _schema(meta)
+        _progress.info("checking %s: regenerating %s seed %s (its own seed, no level draws)", folder,
+                       meta.get("generator"), meta.get("seed"))
         world = _regenerate(meta)
+        _progress.info("checking %s: feasibility and timed paths", folder)
         _feasibility(meta, world)
         _timed(meta, world)
+        _progress.info("checking %s: rendering every file again", folder)
         note = _reproduce(folder, meta, world, entries)
     except _Fail as f:
         return Outcome(folder, False, f.check, f.detail)
