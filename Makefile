@@ -63,7 +63,8 @@ test-gazebo: $(TEST_STAMP)
 ## (ratios over 40 worlds per generator) and barn_metrics' speed, `worldgen judge` on a 60 s bag and
 ## its peak memory over batches of 10 to 1,000 bags, the difficulty score against the probes' failures
 ## over 1,600 worlds, worlds made to a level, the reactive probe's success per level, a curriculum
-## reset against a plain one, worlds with people (10, 20, 50) generated and certified, and `worldgen
+## reset against a plain one, worlds with people (10, 20, 50) generated and certified, 1,000 episodes
+## of the timed path among reacting people with the step's and the certificate's cost, and `worldgen
 ## drive` of a 10 m path in Gazebo (skipped without it) and MuJoCo; tables on
 ## stdout with each target met or missed,
 ## JSON in benchmarks/results/
@@ -78,6 +79,7 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	nice -n 10 $(PY) benchmarks/bench_ladder.py
 	$(PY) benchmarks/bench_curriculum.py
 	$(PY) benchmarks/bench_people.py
+	$(PY) benchmarks/bench_reacting.py
 	$(PY) benchmarks/bench_drive.py
 	nice -n 10 $(PY) benchmarks/bench_requests.py
 

@@ -23,6 +23,15 @@ OUT_DIR/worlds/. The bags are then judged as ``worldgen judge OUT_DIR/bags/*
 them (each bag names its world in its metadata) against the acceptance criteria
 below and each world's scenario.yaml: the report folder holds report.json,
 report.csv, report.md and a picture per run. The exit status is 1 when a criterion fails.
+
+With ``--people`` (``examples/diffdrive_mujoco.py OUT_DIR N_WORLDS --people``) each world also has four
+people who react to the robot (regular, surprised, scared, curious; docs/people.md), and the robot drives
+the task's timed path instead: every control step the robot's pose and velocity feed the people's
+reactions (``worldgen.people.react.Reactions``), and their mocap bodies follow, inside their tubes, at every
+physics step. The people as they actually walked are written beside each bag
+(OUT_DIR/people/<bag>.json, ``{name: [[t, x, y], ...]}``); the bag is judged against world.json's
+recorded trajectories plus each tube (the report's ``social`` figures: ``min_tube_gap``), and the run is
+checked against the people as they walked: no contact.
 """
 
 from __future__ import annotations
@@ -145,6 +154,101 @@ def drive(world) -> tuple[np.ndarray, np.ndarray]:
     return np.array(rows), np.array(commands)
 
 
+CATCH_UP = 0.58  # m/s, under the criteria's max_velocity
+PEOPLE = {"n_people": 4, "people_duration": 20.0, "people_behaviour": "regular,surprised,scared,curious"}
+
+
+def reactions_of(world):
+    """The reacting people of an in-memory world, kept off its walls, and their mocap body ids."""
+    from worldgen.feasibility.geometry import Obstacles2D
+    from worldgen.people.behaviours import Tube
+    from worldgen.people.places import PERSON_HEIGHT
+    from worldgen.people.react import Reactions, wall_gap_of
+    from worldgen.scene.footprint import scene_footprints
+
+    people = [p for p in world.metadata.get("people") or [] if p.get("behaviour")]
+    gap = wall_gap_of(Obstacles2D.from_footprints(scene_footprints(world.scene, PERSON_HEIGHT)), world.scene.bounds)
+    reactions = Reactions([np.asarray(p["trajectory"], dtype=float) for p in people], [p["radius"] for p in people],
+                          [p["behaviour"] for p in people], [Tube(**p["tube"]) for p in people], gap)
+    return reactions, [p["name"] for p in people]
+
+
+def drive_among_people(world) -> tuple[np.ndarray, np.ndarray, dict]:
+    """One run along the timed path among reacting people: (trajectory, commands, {name: walked rows})."""
+    from worldgen.scene.motion import drive_mocap
+
+    meta = world.metadata
+    task = meta["tasks"][0]
+    xml, (x0, y0, yaw0) = with_robot(world.to_mjcf(), meta)
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    jx, jy, jyaw = (model.joint(n).qposadr[0] for n in ("robot_x", "robot_y", "robot_yaw"))
+    data.qpos[[jx, jy, jyaw]] = (x0, y0, yaw0)
+    reactions, names = reactions_of(world)
+    mocap = [int(model.body(n).mocapid[0]) for n in names]
+    timed = np.asarray(task["timed_path"], dtype=float)
+    period = CONTROL_EVERY * model.opt.timestep
+    rows, commands, walked = [], [], {n: [] for n in names}
+    last = np.array([x0, y0])
+    for k in range(int((task["arrival_time"] + 2.0) / model.opt.timestep)):
+        xy, yaw = np.array([data.qpos[jx], data.qpos[jy]]), float(data.qpos[jyaw])
+        if k % RECORD_EVERY == 0:
+            rows.append((data.time, xy[0], xy[1], yaw))
+        if k % CONTROL_EVERY == 0:  # the robot's pose feeds the people; then the timed path's next point
+            reactions.step(period, xy, (xy - last) / period, meta["robot"]["radius"])
+            last = xy
+            for name, (px, py) in zip(names, reactions.p):
+                walked[name].append([round(reactions.t, 6), float(px), float(py)])
+            goal = np.array([np.interp(data.time + period, timed[:, 0], timed[:, c]) for c in (1, 2)])
+            dx, dy = goal - xy
+            err = (math.atan2(dy, dx) - yaw + math.pi) % (2 * math.pi) - math.pi if np.hypot(dx, dy) > 1e-6 else 0.0
+            # The timed path's speed (0.5 m/s) and a little to catch up after turning a corner on the spot.
+            v = 0.0 if abs(err) > 0.3 else min(CATCH_UP, float(np.hypot(dx, dy)) / period * math.cos(err))
+            commands.append((data.time, v, err / period))
+            data.ctrl[:] = (v * math.cos(yaw), v * math.sin(yaw), err / period)
+        drive_mocap(model, data, meta, data.time)  # movers and impassive people on their tracks
+        here = reactions.positions([(k % CONTROL_EVERY) / CONTROL_EVERY])[0]
+        data.mocap_pos[mocap, :2] = here
+        mujoco.mj_step(model, data)
+    commands.append((data.time, 0.0, 0.0))
+    return np.array(rows), np.array(commands), walked
+
+
+def people_main(out_dir: str, n_worlds: int) -> int:
+    """The --people run: drive, record the bags and the people as they walked, judge, check for contacts."""
+    import json
+
+    from worldgen.groundtruth.ground import Ground
+    from worldgen.testing.proxemics import social_split
+
+    out = Path(out_dir)
+    bags, touched = [], 0
+    for seed in range(n_worlds):
+        world = worldgen.generate("cluttered", seed=seed, size=[10, 10], n_obstacles=8, **PEOPLE)
+        world.write(out / "worlds", preview=False)
+        trajectory, commands, walked = drive_among_people(world)
+        task = world.metadata["tasks"][0]
+        spawn = task["spawn"]
+        bag = out / "bags" / f"{world.world_id}-{task['id']}-run0"
+        write_run(bag, trajectory, commands=commands, spawn=(spawn[0], spawn[1], spawn[5]), storage="mcap",
+                  distro="jazzy", world_id=world.world_id, task=task["id"], run=bag.name)
+        (out / "people").mkdir(parents=True, exist_ok=True)
+        (out / "people" / f"{bag.name}.json").write_text(json.dumps(walked))
+        as_walked = dict(world.metadata, people=[dict(p, trajectory=walked.get(p["name"], p["trajectory"]),
+                                                      recorded_trajectory=p["trajectory"])
+                                                 for p in world.metadata["people"]])
+        split = social_split(trajectory, Ground(as_walked, scene=world.scene))["by_behaviour"]["all"]
+        touched += split["robot_on_person"] + split["person_on_robot"]
+        print(f"{bag.name}: intimate {split['intimate']:.2f} s, personal {split['personal']:.2f} s, "
+              f"contacts {split['robot_on_person'] + split['person_on_robot']}, "
+              f"least gap to a tube {split['min_tube_gap']:.3f} m")
+        bags.append(bag)
+    result = judge(bags, CRITERIA, pack=out / "worlds")
+    write_report(result, out / "report")
+    print(f"{n_worlds} runs among reacting people: {touched} contacts; judged: {'PASS' if result.passed else 'FAIL'}")
+    return 0 if result.passed and touched == 0 else 1
+
+
 def main(out_dir: str, n_worlds: int = 20) -> int:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -177,5 +281,7 @@ def main(out_dir: str, n_worlds: int = 20) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp(prefix="worldgen-diffdrive-"),
-                  int(sys.argv[2]) if len(sys.argv) > 2 else 20))
+    args = [a for a in sys.argv[1:] if a != "--people"]
+    run_main = people_main if "--people" in sys.argv[1:] else main
+    sys.exit(run_main(args[0] if args else tempfile.mkdtemp(prefix="worldgen-diffdrive-"),
+                      int(args[1]) if len(args) > 1 else 20))

@@ -117,3 +117,20 @@ def test_barn_recipe_is_barn_s_300_worlds_and_each_setting_can_be_crossed():
     for job in recipe.jobs[::25]:  # the first seed of each setting
         world = worldgen.generate(job.generator, job.seed, **job.param_dict)
         assert world.feasibility.feasible and (world.params["grid_cols"], world.params["cell_size"]) == (30, 0.15)
+
+
+def test_diffdrive_example_among_reacting_people(tmp_path):
+    """--people: the robot drives the timed path while four people react to it; no contact with the people
+    as they walked, the bags pass the criteria, and the walked trajectories are written beside them."""
+    import json
+
+    script = EXAMPLES[0].parent / "diffdrive_mujoco.py"
+    _need_extra(script)
+    run = subprocess.run([sys.executable, str(script), str(tmp_path), "3", "--people"], capture_output=True,
+                         text=True, timeout=300)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert run.stdout.splitlines()[-1] == "3 runs among reacting people: 0 contacts; judged: PASS"
+    walked = [json.loads(p.read_text()) for p in sorted((tmp_path / "people").iterdir())]
+    assert len(walked) == 3 and all(len(w) == 4 and all(len(rows) > 10 for rows in w.values()) for w in walked)
+    report = json.loads((tmp_path / "report" / "report.json").read_text())
+    assert all(r["social"]["by_behaviour"]["all"]["min_tube_gap"] > 0 for r in report["runs"])

@@ -16,7 +16,7 @@ import worldgen
 from worldgen import presets
 from worldgen.errors import InfeasibleError, ParameterError
 
-SHIPPED = ["clutter_50_boxes", "door_crossing", "drl_arena", "empty_room", "group_in_corridor", "lidar_wall",
+SHIPPED = ["clutter_50_boxes", "crowd_reacting", "door_crossing", "drl_arena", "empty_room", "group_in_corridor", "lidar_wall",
            "narrow_corridor", "person_crossing", "person_head_on", "person_in_doorway", "person_overtaking",
            "room_5_obstacles"]
 
@@ -272,6 +272,12 @@ def _passing_headings(world):
 
 
 CLAIMS = {
+    "crowd_reacting": [
+        (rf"{N} people walking for {N} s", lambda w, k, t: len(_people(w)) == k and w.params["people_duration"] == t
+         and [p.get("behaviour") for p in w.metadata["people"]] == ["regular", "surprised", "scared", "curious"] * 2),
+        (rf"{N} x {N} m walled room with {N} random obstacles",
+         lambda w, a, b, k: _extent(w) == (a, b) and len(roles(w, "obstacle")) == k and len(roles(w, "wall")) == 4),
+    ],
     "person_overtaking": [
         (rf"along its {N} m straight path in an empty {N} x {N} m room",
          lambda w, length, a, b: _line(w)[4] == pytest.approx(length) and _extent(w) == (a, b)
@@ -504,7 +510,7 @@ def test_bad_preset_files_get_one_line_naming_file_and_key(tmp_path, text, patte
 
 
 def test_unknown_preset_names_the_available_ones(tmp_path):
-    with pytest.raises(ParameterError, match=r"^unknown preset 'nope'; available: clutter_50_boxes, door_crossing"):
+    with pytest.raises(ParameterError, match=r"^unknown preset 'nope'; available: clutter_50_boxes, crowd_reacting, door_crossing"):
         worldgen.generate_preset("nope")
     with pytest.raises(ParameterError, match=r"^preset file '.*missing.yaml' does not exist$"):
         worldgen.generate_preset(str(tmp_path / "missing.yaml"))

@@ -87,10 +87,11 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             # check is refused here as it would be after the walk (docs/people.md, "Refusal").
             _progress.info("%s seed %d: attempt %d of max_attempts=%d: walking %d people", name, seed, attempt + 1,
                            budget, resolved["n_people"])
+            from worldgen.people.behaviours import behaviours_of
             from worldgen.people.crowd import walk_plan
             from worldgen.people.timed import certify
             scene = scene.with_movers(scene.movers + walk_plan(scene, draft.tasks, robot, resolved, plan))
-            report = certify(report, scene, draft.tasks, robot, resolved["robot_speed"])
+            report = certify(report, scene, draft.tasks, robot, resolved["robot_speed"], behaviours_of(resolved))
         elif plan is not None:
             _count(failures, details, report)
             continue

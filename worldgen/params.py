@@ -163,6 +163,9 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
         # people existed keeps its params, content_hash and bytes (docs/people.md).
         for name in PEOPLE_PARAMS:
             resolved.pop(name, None)
+    if resolved.get("people_behaviour") == "impassive":
+        # Recorded only when people react to the robot: worlds made before reactions keep their bytes.
+        resolved.pop("people_behaviour")
     if resolved.get("group_size") == 1:
         # Recorded only when people walk in groups: worlds with people alone keep their bytes.
         resolved.pop("group_size")
@@ -177,7 +180,8 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
 
 
 #: The people's parameters: recorded in a world's params only when it has people (n_people > 0).
-PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration", "people_scenario", "group_size")
+PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration", "people_scenario", "group_size",
+                 "people_behaviour")
 
 
 def parse_value(p: Param, text: str) -> Any:
@@ -246,6 +250,10 @@ COMMON_PARAMS: tuple[Param, ...] = (
           choices=("walk", "head_on", "crossing", "overtaking", "group_passing", "doorway")),
     Param("group_size", "int", 1, "people walk in groups of this many that keep together (Moussaid et al. 2010; "
           "docs/people.md); 1: alone", 1, 8),
+    Param("people_behaviour", "words", "impassive", "how people react to the robot (HuNavSim's behaviours, "
+          "docs/people.md): one for everyone, or a comma-separated list cycled over the people; each reaction "
+          "stays inside a tube round the person's recorded walk that the timed path is certified clear of",
+          choices=("impassive", "regular", "surprised", "scared", "curious")),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
     # Ground truth written with every world (worldgen.groundtruth).
     Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn",

@@ -248,3 +248,48 @@ def test_a_timed_path_that_does_not_start_at_the_spawn_fails_timed(head_on, caps
     rows = json.loads((head_on / "world.json").read_text())["tasks"][0]["timed_path"]
     _timed(head_on, [[t + 1.0, x, y] for t, x, y in rows])
     _fails(capsys, head_on, "timed", "not at t = 0 at the spawn")
+
+
+# -- timed among reacting people: the certificate against every tube ---------------------------------------
+
+@pytest.fixture(scope="module")
+def reacting(tmp_path_factory) -> Path:
+    """A cluttered world whose five people react (regular, scared, curious, surprised, regular)."""
+    out = tmp_path_factory.mktemp("reacting")
+    return worldgen.generate("cluttered", 0, size=[8.0, 8.0], n_obstacles=4, n_people=5, people_duration=12.0,
+                             people_behaviour="regular,scared,curious,surprised").write(out)
+
+
+def test_a_world_of_reacting_people_passes_timed(reacting, capsys):
+    meta = json.loads((reacting / "world.json").read_text())
+    assert [p["behaviour"] for p in meta["people"]] == ["regular", "scared", "curious", "surprised", "regular"]
+    assert meta["people"][2]["tube"] == {"d": 0.8, "tau": 2.0}
+    assert _check(capsys, reacting) == (0, [f"OK {reacting}"])
+
+
+@pytest.mark.parametrize("field, value, words", [
+    ("d", 0.9, ("person_0's tube d = 0.9 m, tau = 1.5 s is not its behaviour regular's",)),
+    ("tau", 3.0, ("tau = 3.0 s is not its behaviour regular's",)),
+])
+def test_a_tampered_tube_fails_timed(reacting, tmp_path, capsys, field, value, words):
+    folder = Path(shutil.copytree(reacting, tmp_path / reacting.name))
+    _edit_json(folder, lambda meta: meta["people"][0]["tube"].__setitem__(field, value))
+    _fails(capsys, folder, "timed", *words)
+
+
+def test_a_timed_path_into_a_tube_fails_timed(reacting, tmp_path, capsys):
+    """The recorded timed path made 0.3 s earlier throughout (as fast as allowed): it meets a tube."""
+    folder = Path(shutil.copytree(reacting, tmp_path / reacting.name))
+    task = json.loads((folder / "world.json").read_text())["tasks"][0]
+    task_rows = task["timed_path"]
+    spawn, goal = task["spawn"][:2], task["goal"][:2]
+    way = task["path"]["waypoints"]
+    length = sum(((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2) ** 0.5 for a, b in zip(way, way[1:]))
+    rows, t = [[0.0, *spawn]], 0.0
+    for a, b in zip(way, way[1:]):  # straight down the path at 0.499 m/s, no waiting
+        t += ((b[0] - a[0]) ** 2 + (b[1] - a[1]) ** 2) ** 0.5 / 0.499
+        rows.append([round(t, 6), *b])
+    assert task_rows[-1][0] > length / 0.5 + 0.5  # the certificate waits for somebody's tube
+    _timed(folder, rows)
+    line = _fails(capsys, folder, "timed", "recorded positions within", "its tube's d")
+    assert goal == rows[-1][1:] and "\n" not in line

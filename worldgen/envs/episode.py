@@ -66,6 +66,8 @@ class Episode:
         #: The entities the robot touched at the last physics step checked.
         self.touching: frozenset = frozenset()
         self.done = False
+        #: The world's movers and people (:class:`~worldgen.envs.reacting.Walkers`), set by the environment.
+        self.walkers = None
 
     def record(self, t: float, x: float, y: float, yaw: float) -> None:
         self.rows.append((t, x, y, yaw))
@@ -97,7 +99,7 @@ class Episode:
         """The figures of the run so far, under the oracles' names (see the module's docstring)."""
         from worldgen.testing import figures as oracles
 
-        ground = self.world.ground()
+        ground = self._as_walked(self.world.ground())
         traj = self.trajectory
         task = self.world.task
         length = oracles.path_length(traj)
@@ -120,5 +122,28 @@ class Episode:
         out = run.as_dict()
         out.update(success=ok, spl=spl(ok, ref, length), reference_path_length=ref,
                    doors_opened=[{"time": c.time, "entity": c.entity} for c in self.door_openings])
+        if ground.meta.get("people"):
+            from worldgen.testing.proxemics import social_split
+
+            out["social"] = social_split(traj, ground)
+            out["people_clips"] = dict(self.walkers.clips) if self.walkers is not None else {}
         return out
+
+    def _as_walked(self, ground):
+        """``ground`` with each reacting person's trajectory the one it walked in this episode (its
+        world.json trajectory kept as ``recorded_trajectory``): the run is judged against the people as
+        they moved."""
+        reacted = self.walkers.reacted if self.walkers is not None else {}
+        if not reacted:
+            return ground
+        import copy
+
+        walked = copy.copy(ground)
+        people = []
+        for p in ground.meta.get("people") or []:
+            rows = reacted.get(str(p["name"]))
+            people.append(p if rows is None or len(rows) < 2 else
+                          dict(p, trajectory=rows.tolist(), recorded_trajectory=p["trajectory"]))
+        walked.meta = dict(ground.meta, people=people)
+        return walked
 

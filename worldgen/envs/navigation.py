@@ -78,7 +78,7 @@ from worldgen.envs.doors import Openers, add_openers
 from worldgen.envs.episode import Episode
 from worldgen.envs.geodesic import GeodesicField
 from worldgen.envs.lidar import Lidar
-from worldgen.envs.movers import MoverScript
+from worldgen.envs.reacting import walkers_of
 from worldgen.envs.reward import StepOutcome, reward
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.envs.source import PackSource, make_source
@@ -175,7 +175,7 @@ class NavigationEnv(gym.Env):
         t1 = time.perf_counter()
         cfg = self.config
         spawn = world.task["spawn"]
-        movers = MoverScript(world.movers)
+        movers = walkers_of(world)  # people who react to the robot among them (docs/people.md)
         add_robot(world.mjcf, world.robot.radius, world.robot.height, cfg.linear_velocity, cfg.angular_velocity)
         add_openers(world.mjcf, world.doors, cfg.doors)
         sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), sorted(world.floor),
@@ -205,6 +205,7 @@ class NavigationEnv(gym.Env):
         self._lidar_height = cfg.lidar_height if cfg.lidar_height is not None else world.lidar_height
         self._last_action = np.zeros(2)
         self.episode = Episode(world, *sim.pose())
+        self.episode.walkers = movers
         self._painter = None
         obs = self._observe()
         #: Seconds the last reset spent getting the world (generating or reading it), adding the robot and
@@ -300,7 +301,12 @@ class NavigationEnv(gym.Env):
         model, data = sim.model, sim.data
         n = self._substeps
         movers = self._movers
-        xy = movers.positions(data.time + model.opt.timestep * np.arange(n)) if len(movers) else None
+        xy = None
+        if len(movers):  # reacting people see the robot where it is, moving as it did over the last period
+            rows = ep.rows
+            (t0, x0, y0, _), (t1, x1, y1, _) = rows[max(len(rows) - 2, 0)], rows[-1]
+            v = ((x1 - x0) / (t1 - t0), (y1 - y0) / (t1 - t0)) if t1 > t0 else (0.0, 0.0)
+            xy = movers.period(data.time, model.opt.timestep, n, (x1, y1), v, self.world.robot.radius)
         began = False
         for k in range(n):
             if xy is not None:

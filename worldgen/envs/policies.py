@@ -23,7 +23,7 @@ import numpy as np
 
 from worldgen.seeding import policy_rng
 
-__all__ = ["GapHeuristic", "PathFollower", "RandomPolicy"]
+__all__ = ["GapHeuristic", "PathFollower", "RandomPolicy", "TimedFollower", "drive_timed"]
 
 
 class PathFollower:
@@ -80,6 +80,43 @@ class PathFollower:
         return np.array([max(v, 0.0), w], dtype=np.float32)
 
 
+class TimedFollower:
+    """Drives a task's timed path (world.json ``tasks[].timed_path``: ``t, x, y`` rows): each step it heads
+    for where the timed path is at the step's end and asks the speed that gets there in ``period`` s
+    (turning first where that point lies more than ``turn_in_place`` rad off the heading), within ``v_max``
+    and ``w_max``. A robot that keeps to its timed path keeps the certificate's distance from every
+    person's tube (docs/people.md), however the people react. Give it turn rates well above the path's:
+    the timed path turns its corners on the spot."""
+
+    def __init__(self, rows, v_max: float, w_max: float, period: float, turn_in_place: float = 0.3):
+        self.rows = np.asarray(rows, dtype=float).reshape(-1, 3)
+        self.v_max, self.w_max, self.period = float(v_max), float(w_max), float(period)
+        self.turn_in_place = float(turn_in_place)
+
+    @classmethod
+    def for_env(cls, env, **kwargs) -> "TimedFollower":
+        """A follower of the current episode's timed path, within the env's action limits."""
+        env = env.unwrapped
+        return cls(env.task["timed_path"], float(env.action_space.high[0]), float(env.action_space.high[1]),
+                   env.config.control_period, **kwargs)
+
+    def at(self, t: float) -> np.ndarray:
+        """(2,) where the timed path has the robot at time ``t`` (at the goal after its last row)."""
+        r = self.rows
+        return np.array([np.interp(t, r[:, 0], r[:, 1]), np.interp(t, r[:, 0], r[:, 2])])
+
+    def action(self, x: float, y: float, yaw: float, t: float) -> np.ndarray:
+        """(v, w) as float32 for the robot at (x, y) heading ``yaw`` at time ``t``."""
+        dx, dy = self.at(t + self.period) - np.array([x, y])
+        dist = math.hypot(dx, dy)
+        if dist < 1e-6:
+            return np.zeros(2, dtype=np.float32)
+        err = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi
+        w = float(np.clip(err / self.period, -self.w_max, self.w_max))
+        v = 0.0 if abs(err) > self.turn_in_place else min(self.v_max, dist / self.period * math.cos(err))
+        return np.array([max(v, 0.0), w], dtype=np.float32)
+
+
 class RandomPolicy:
     """Uniform actions in ``action_space`` from its own generator seeded with ``seed``."""
 
@@ -133,3 +170,15 @@ class GapHeuristic:
         room = min(1.0, max(0.0, (front - self.slow) / max(self.free - self.slow, 1e-9)))
         v = 0.0 if abs(target) > self.turn_in_place else self.v_max * math.cos(target) * room
         return np.array([max(v, 0.0), w], dtype=np.float32)
+
+
+def drive_timed(env, **reset) -> dict:
+    """Reset ``env`` (``reset`` goes to ``env.reset``) and drive the episode's timed path with a
+    :class:`TimedFollower` to the episode's end; the end's info."""
+    env.reset(**reset)
+    follower = TimedFollower.for_env(env)
+    u = env.unwrapped
+    while True:
+        _, _, terminated, truncated, info = env.step(follower.action(*u.robot_pose, u.episode.rows[-1][0]))
+        if terminated or truncated:
+            return info

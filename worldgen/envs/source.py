@@ -95,21 +95,28 @@ def _task_of_world(world) -> dict:
     from worldgen.export.tasks import task_entry
 
     path = world.feasibility.paths[0] if world.feasibility.paths else None
-    return _checked_task(world.world_id, task_entry(world, world.tasks[0], path))
+    task = task_entry(world, world.tasks[0], path)
+    timed = getattr(world.feasibility, "timed_paths", ())
+    if timed and timed[0] is not None:  # among people: the certificate, as world.json has it
+        task.update(timed_path=timed[0].rows.tolist(), arrival_time=timed[0].arrival)
+    return _checked_task(world.world_id, task)
 
 
 def episode_world(world) -> EpisodeWorld:
     """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
-    from worldgen.export.metadata import mover_entry
+    from worldgen.export.metadata import mover_entry, person_entry
     from worldgen.export.xml import parse_bytes
     from worldgen.groundtruth.ground import Ground
     from worldgen.scene.doors import door_records
 
     task = _task_of_world(world)
-    movers = [mover_entry(m, world.params) for m in world.scene.movers]
+    # People after the movers (the MJCF's order); a person's entry carries its behaviour and tube, if any.
+    movers = [dict(person_entry(m, world.params), loop=False) if m.person else mover_entry(m, world.params)
+              for m in world.scene.movers]
     robot = world.robot
     leaves = frozenset(n.name for n in world.scene.nodes if n.role == "door")
-    light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": movers,
+    light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": [m for m in movers if m["loop"]],
+             "people": [m for m in movers if not m["loop"]],
              "robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance},
              "doors": [{"name": name} for name in sorted(leaves)]}
     return EpisodeWorld(
@@ -234,7 +241,7 @@ class PackSource:
         params = dict(meta.get("params", {}))
         return EpisodeWorld(
             world_id=pw.world_id, mjcf=root, robot=_Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
-            task=task, movers=list(meta.get("dynamic_obstacles") or []),
+            task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
             floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
             lidar_height=float(params.get("lidar_height", 0.3)), params=params,
             _ground=lambda: ground_of(pw), _metadata=lambda: meta, _scene=lambda: self._regenerated(pw, meta).scene,

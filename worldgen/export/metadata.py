@@ -137,9 +137,13 @@ def mover_entry(mover, params: Mapping[str, Any], files: Iterable[str] = ()) -> 
 def person_entry(person, params: Mapping[str, Any], files: Iterable[str] = ()) -> dict:
     """A person's ``people[]`` entry of world.json: a mover's, without ``loop`` (a person walks once
     and then stands where it stopped)."""
+    from worldgen.people.behaviours import behaviours_of, reaction_entry
+
     entry = mover_entry(person, params, files)
     del entry["loop"]
-    return entry
+    index = int(person.name.rsplit("_", 1)[1])
+    behaviours = behaviours_of(params)
+    return entry | reaction_entry(behaviours[index] if index < len(behaviours) else "impassive")
 
 
 def free_area_ratio(scene, height: float) -> float:

@@ -50,6 +50,7 @@ from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.exact import GRAPH_MAX_CIRCLES, GRAPH_ROWS_PER_QUERY, ExactPlanner, exact_planner
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.floats import round_float
+from worldgen.people.behaviours import widest_tube
 from worldgen.people.groups import GroupForce, group_force
 from worldgen.people.places import PERSON_HEIGHT, SLACK, draw_people, people_footprints
 from worldgen.people.reach import Pockets
@@ -383,7 +384,7 @@ def walk_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
 def walk_plan(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping[str, Any], plan) -> tuple[Mover, ...]:
     """The people of a drawn ``plan`` walked: movers with ``person=True`` (the costly half of :func:`walk_people`,
     which the pipeline runs only on a draw that passed its static checks)."""
-    obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot))
+    obstacles = Obstacles2D.from_footprints(people_footprints(scene, tasks, robot, widest_tube(params)))
     track = simulate(obstacles, scene.bounds, plan.starts, plan.places, plan.speeds, plan.radius, plan.duration,
                      depart=plan.depart, groups=plan.groups)
     times = np.array([round_float(k * DT) for k in range(len(track))])

@@ -33,6 +33,7 @@ from typing import Any, Mapping, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.people.behaviours import widest_tube
 from worldgen.scene import Robot, Scene, Task
 from worldgen.scene.doors import door_records
 from worldgen.scene.footprint import Footprint, FootprintIndex, scene_footprints
@@ -99,12 +100,13 @@ class PeoplePlan:
     groups: Optional[np.ndarray] = None
 
 
-def people_footprints(scene: Scene, tasks: Sequence[Task], robot: Robot) -> list[Footprint]:
+def people_footprints(scene: Scene, tasks: Sequence[Task], robot: Robot, reach: float = 0.0) -> list[Footprint]:
     """What people walk round: every collider's floor shadow below :data:`PERSON_HEIGHT`, and a disc of
-    radius ``robot.inflation + KEEP_OUT`` at every task's spawn and goal."""
+    radius ``robot.inflation + KEEP_OUT + reach`` at every task's spawn and goal (``reach``: the widest
+    tube a reacting person may stray in, so that a robot waiting there is outside every tube too)."""
     prints = scene_footprints(scene, PERSON_HEIGHT)
     keep_out = [Footprint(f"{task.id}_{which}", "keep_out", centre=(p.x, p.y),
-                          radius=robot.inflation + KEEP_OUT)
+                          radius=robot.inflation + KEEP_OUT + reach)
                 for task in tasks for which, p in (("spawn", task.spawn), ("goal", task.goal))]
     return prints + keep_out
 
@@ -120,7 +122,8 @@ def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     (x0, y0), (x1, y1) = scene.bounds
     if x1 - x0 <= 2 * clear_r or y1 - y0 <= 2 * clear_r:
         return None, f"the floor is too small for people of radius {r:g} m"
-    pool = _Pool(rng, FootprintIndex(people_footprints(scene, tasks, robot)), scene.bounds, clear_r)
+    pool = _Pool(rng, FootprintIndex(people_footprints(scene, tasks, robot, widest_tube(params))), scene.bounds,
+                 clear_r)
     speeds = np.round(rng.uniform(lo, hi, n), 6)
     k = min(MAX_PLACES, math.ceil(duration * hi * 1.3 / LEG_MIN) + 1)
     starts: list[np.ndarray] = []

@@ -13,6 +13,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from worldgen.errors import InfeasibleError
+from worldgen.people.behaviours import widest_tube
 from worldgen.people.places import SLACK, _scripted, people_footprints
 from worldgen.scene import Robot
 from worldgen.scene.footprint import FootprintIndex
@@ -33,7 +34,7 @@ def refuse_unplayable(spec, params: Mapping[str, Any], robot: Robot) -> None:
     bare = spec.build({**params, "n_obstacles": 0}, attempt_rng(0, 0))
     if bare.rejected or bare.scene is None or not bare.tasks:
         return
-    index = FootprintIndex(people_footprints(bare.scene, bare.tasks, robot))
+    index = FootprintIndex(people_footprints(bare.scene, bare.tasks, robot, widest_tube(params)))
     speed = float(params["person_speed"][0])
     radius = params["person_radius"] + 2 * SLACK
     placed, reason = _scripted(scenario, bare.scene, bare.tasks[0], speed, params, index, radius)

@@ -29,9 +29,10 @@ from typing import Optional, Sequence
 import numpy as np
 
 from worldgen.feasibility.report import Check, FeasibilityReport
+from worldgen.people.behaviours import Tube, tube_of
 from worldgen.scene.motion import positions_at
 
-__all__ = ["DT", "CELLS_PER_STEP", "MARGIN", "SPARE", "TimedPath", "timed_path", "person_speed", "certify"]
+__all__ = ["DT", "CELLS_PER_STEP", "MARGIN", "SPARE", "TimedPath", "timed_path", "person_speed", "certify", "tube_steps"]
 
 #: Time step (s) of the sweep, and the largest one between two rows of a timed path.
 DT = 0.05
@@ -67,9 +68,12 @@ def person_speed(tracks: Sequence[np.ndarray]) -> float:
 
 
 def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Sequence[float], inflation: float,
-               max_speed: float) -> Optional[TimedPath]:
+               max_speed: float, tubes: Optional[Sequence[Tube]] = None) -> Optional[TimedPath]:
     """The earliest timed path along ``waypoints`` (k, 2) at up to ``max_speed`` that keeps the robot's
-    disc (``inflation``) and every person's (its (m, 3) track, not looping, and radius) apart, or None."""
+    disc (``inflation``) and every person's (its (m, 3) track, not looping, and radius) apart, or None.
+
+    ``tubes`` (one per person, default the recorded line): the robot keeps clear of the whole tube, every
+    recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`_free_cells`)."""
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     s, corner = _cells(w, max_speed * DT / CELLS_PER_STEP * (1 - SPARE))
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(w, axis=0).T))])
@@ -88,6 +92,9 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     steps = math.ceil((end + length / max_speed + AFTER) / DT)
     times = np.arange(steps + 1) * DT
     reach = np.asarray(radii, dtype=float) + inflation + MARGIN + (max_speed + person_speed(tracks)) * DT / 2
+    tubes = list(tubes) if tubes is not None else [Tube(0.0, 0.0)] * len(tracks)
+    reach = reach + np.array([tube.d for tube in tubes], dtype=float).reshape(len(tracks))
+    window = np.array([tube_steps(tube.tau) for tube in tubes], dtype=np.int64).reshape(len(tracks))
     # Which cells are free at which step, worked out a chunk of steps at a time as the sweep gets there:
     # the sweep usually stops long before the last person stops (each row depends on its step alone).
     free = np.zeros((steps + 1, n_cells + 1), dtype=bool)
@@ -97,7 +104,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     for k in range(0, steps + 1):
         if k == known:
             known = min(k + FREE_CHUNK, steps + 1)
-            free[k:known] = _free_cells(w, cum, s, tracks, reach, times[k:known])
+            free[k:known] = _free_cells(w, cum, s, tracks, reach, times[k:known], window)
         if k == 0:
             sets[0, 0] = free[0, 0]
             continue
@@ -135,7 +142,8 @@ def _cells(w: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(parts), np.array(corner)
 
 
-def certify(report: FeasibilityReport, scene, tasks, robot, max_speed: float) -> FeasibilityReport:
+def certify(report: FeasibilityReport, scene, tasks, robot, max_speed: float,
+            behaviours: Optional[Sequence[str]] = None) -> FeasibilityReport:
     """``report`` with the check ``timed_path`` and each task's certificate among the scene's people.
 
     A task without a static path has no certificate either; the check fails then, and where the
@@ -144,9 +152,10 @@ def certify(report: FeasibilityReport, scene, tasks, robot, max_speed: float) ->
     people = [m for m in scene.movers if m.person]
     tracks = [np.asarray(m.trajectory, dtype=float) for m in people]
     radii = [m.radius for m in people]
+    tubes = [tube_of(b) for b in behaviours] if behaviours is not None else None
     found, missing = [], []
     for task, path in zip(tasks, report.paths):
-        timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, max_speed)
+        timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, max_speed, tubes)
         found.append(timed)
         if timed is None:
             why = "no static path" if path is None else f"the people leave no way through at <= {max_speed:g} m/s"
@@ -165,7 +174,35 @@ def _at(w: np.ndarray, cum: np.ndarray, s: np.ndarray) -> np.ndarray:
     return np.column_stack([np.interp(s, cum, w[:, 0]), np.interp(s, cum, w[:, 1])])
 
 
-def _free_cells(w, cum, s, tracks, reach, times) -> np.ndarray:
+def tube_steps(tau: float) -> int:
+    """Steps either side of a step whose recorded positions its tube of ``tau`` s must keep clear of: every
+    time within ``tau`` of an instant between this step and the next half-way is within DT / 2 of one of
+    them (0 for the recorded line itself, whose instant is within DT / 2 of the step)."""
+    return 0 if tau <= 0 else math.ceil(tau / DT + 0.5 - 1e-9)
+
+
+def _free_cells(w, cum, s, tracks, reach, times, window=None) -> np.ndarray:
+    """(steps + 1, cells) bool: no person's recorded position within ``window`` steps of the step (its
+    tube's, :func:`tube_steps`) within its ``reach`` of the cell's point.
+
+    People with the same window are taken together: the cells they block at the steps from ``window``
+    before the first to ``window`` after the last, then each step blocked where any of its window is.
+    """
+    window = np.zeros(len(tracks), dtype=np.int64) if window is None else window
+    free = np.ones((len(times), len(s)), dtype=bool)
+    for m in np.unique(window):
+        who = np.flatnonzero(window == m)
+        m = int(m)
+        ext = np.concatenate([times[0] - DT * np.arange(m, 0, -1), times, times[-1] + DT * np.arange(1, m + 1)])
+        blocked = ~_free_at(w, cum, s, [tracks[j] for j in who], reach[who], ext)
+        if m:
+            c = np.concatenate([np.zeros((1, len(s)), dtype=np.int32), np.cumsum(blocked, axis=0, dtype=np.int32)])
+            blocked = (c[2 * m + 1:] - c[:-2 * m - 1]) > 0
+        free &= ~blocked
+    return free
+
+
+def _free_at(w, cum, s, tracks, reach, times) -> np.ndarray:
     """(steps + 1, cells) bool: no person within its ``reach`` of the cell's point at the step's time.
 
     Only (step, person) pairs within reach of the polyline are looked at; each blocks the cells

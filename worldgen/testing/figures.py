@@ -25,6 +25,7 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 from worldgen.groundtruth.ground import Ground, as_trajectory, leaves_of, load
+from worldgen.testing.proxemics import social_split
 from worldgen.testing.social import disc_gaps, discs, social_figures, timed_samples
 
 __all__ = [
@@ -218,9 +219,14 @@ class Run:
     min_person_distance: Optional[float] = None
     personal_space_time: Optional[float] = None
     min_time_to_collision: Optional[float] = None
+    #: With people: the figures users compare across tools, split by behaviour
+    #: (:func:`worldgen.testing.proxemics.social_split`); left out of :meth:`as_dict` without people.
+    social: Optional[dict] = None
 
     def as_dict(self) -> dict[str, Any]:
         d = {k: getattr(self, k) for k in self.__dataclass_fields__}
+        if d["social"] is None:
+            del d["social"]
         for key in ("collisions", "door_contacts"):
             d[key] = [{"time": c.time, "entity": c.entity} for c in getattr(self, key)]
         return d
@@ -249,6 +255,7 @@ def run(trajectory, world, task: Optional[str] = None) -> Run:
         reference_length=float(ref) if ref else None,
         door_contacts=tuple(c for c in contacts if c.entity in leaves),
         min_person_distance=person_gap, personal_space_time=personal_time, min_time_to_collision=ttc,
+        social=social_split(trajectory, ground, task) if ground.meta.get("people") else None,
     )
 
 

@@ -38,6 +38,7 @@ from worldgen.testing.figures import (
     run,
     time_to_goal,
 )
+from worldgen.testing.proxemics import ZONES, social_split
 from worldgen.testing.social import PERSONAL_SPACE, min_person_distance, min_time_to_collision, personal_space_time
 
 __all__ = [
@@ -45,4 +46,5 @@ __all__ = [
     "path_length", "path_efficiency", "time_to_goal", "reached_goal", "min_clearance",
     "collisions", "door_contacts", "DOOR_DEBOUNCE", "min_separation", "run", "evaluate", "barn_score",
     "min_person_distance", "personal_space_time", "min_time_to_collision", "PERSONAL_SPACE",
+    "social_split", "ZONES",
 ]

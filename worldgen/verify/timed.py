@@ -10,6 +10,14 @@ regenerated scene, doors at their open limit, as the path was proven); and, samp
 never closer than ``robot.radius + robot.clearance + radius`` plus ``w TIMED_STEP / 2``, ``w`` the
 robot's top speed plus the fastest any person walks: what two discs moving straight at those speeds
 could close between two samples.
+
+A person who reacts to the robot (``people[].behaviour``) may be anywhere in its ``tube``: within ``d``
+of a position its trajectory has at a time within ``tau`` of now. Against such a person each sample
+at t is checked against the exact distance to the trajectory's part from ``t - tau - h / 2`` to
+``t + tau + h / 2`` (``h`` = :data:`TIMED_STEP`; every instant is within ``h / 2`` of a sample),
+which must be at least ``robot.radius + robot.clearance + radius + d`` plus ``robot.max_speed h / 2``
+(how far the robot moves in half a step). The tube itself must be its behaviour's
+(:data:`worldgen.people.behaviours.TUBES`): a widened or narrowed tube fails.
 """
 
 from __future__ import annotations
@@ -38,6 +46,7 @@ def check_timed(meta: dict, world) -> None:
     inflation, v_max = robot["radius"] + robot["clearance"], float(robot["max_speed"])
     tracks = [(str(p["name"]), np.asarray(p["trajectory"], dtype=float).reshape(-1, 3), float(p["radius"]))
               for p in people]
+    tubes = [_tube(p) for p in people]
     fastest = max((_speeds(track).max(initial=0.0) for _, track, _ in tracks), default=0.0)
     colliders = None
     for task in meta["tasks"]:
@@ -66,7 +75,10 @@ def check_timed(meta: dict, world) -> None:
         reach = (v_max + fastest) * TIMED_STEP / 2
         t = np.arange(0.0, rows[-1, 0] + TIMED_STEP, TIMED_STEP)
         me = _at(rows, t)
-        for name, track, radius in tracks:
+        for (name, track, radius), tube in zip(tracks, tubes):
+            if tube is not None:
+                _check_tube(task["id"], name, me, t, track, inflation + radius, tube, v_max)
+                continue
             gap = np.hypot(*(me - _at(track, t)).T) - (inflation + radius)
             k = int(np.argmin(gap))
             if gap[k] < reach:
@@ -74,6 +86,39 @@ def check_timed(meta: dict, world) -> None:
                                      f"{gap[k] + radius + inflation:.4f} m from {name}'s centre, under "
                                      "robot.radius + robot.clearance + its radius = "
                                      f"{inflation + radius:.4f} m (+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
+
+
+def _tube(person: dict):
+    """(d, tau) of a reacting person's tube, checked against its behaviour's; None for an impassive one."""
+    from worldgen.people.behaviours import TUBES
+
+    name, behaviour, tube = person["name"], person.get("behaviour"), person.get("tube")
+    if behaviour is None and tube is None:
+        return None
+    if behaviour not in TUBES or tube is None:
+        raise TimedPathError(f"{name} has behaviour {behaviour!r} and tube {tube!r}: a reacting person needs both, "
+                             f"behaviour one of {', '.join(sorted(TUBES))}")
+    want = TUBES[behaviour]
+    if float(tube["d"]) != want.d or float(tube["tau"]) != want.tau:
+        raise TimedPathError(f"{name}'s tube d = {tube['d']} m, tau = {tube['tau']} s is not its behaviour "
+                             f"{behaviour}'s (d = {want.d} m, tau = {want.tau} s)")
+    return float(tube["d"]), float(tube["tau"])
+
+
+def _check_tube(task_id: str, name: str, me: np.ndarray, t: np.ndarray, track: np.ndarray, contact: float,
+                tube: tuple, v_max: float) -> None:
+    """Every sample of the robot at ``me`` (times ``t``) far enough from the person's whole tube."""
+    from worldgen.people.behaviours import tube_distance
+
+    d, tau = tube
+    reach = v_max * TIMED_STEP / 2
+    gap = tube_distance(me, t, track, tau + TIMED_STEP / 2) - (contact + d)
+    k = int(np.argmin(gap))
+    if gap[k] < reach:
+        raise TimedPathError(f"{task_id} timed_path at t = {t[k]:.3f} s comes {gap[k] + contact:.4f} m from "
+                             f"{name}'s recorded positions within {tau:g} s of then, under robot.radius + "
+                             f"robot.clearance + its radius + its tube's d = {contact + d:.4f} m "
+                             f"(+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
 
 
 def _speeds(rows: np.ndarray) -> np.ndarray:
