@@ -15,8 +15,9 @@ from support.cli import run as run_cli
 
 import worldgen
 from worldgen import oracles
+from worldgen.envs.policies import PathFollower
 from worldgen.ros import read_run
-from worldgen.sim.drive import Pursuit, drive
+from worldgen.sim.drive import LOOKAHEAD, TURN_RATE, drive
 
 pytest.importorskip("rosbags")
 
@@ -70,13 +71,13 @@ def test_a_straight_drive_collides_with_the_obstacle_in_the_way(blocked, tmp_pat
     assert outcome.run["collisions"][0]["entity"] == first_in_the_way(blocked)
 
 
-def test_pursuit_follows_a_corner_and_turns_on_the_spot_when_facing_away():
-    p = Pursuit([[0, 0], [1, 0], [1, 1]], speed=0.5, lookahead=0.3)
-    v, w = p.command(0.0, 0.0, 0.0)
+def test_the_drive_controller_follows_a_corner_and_turns_on_the_spot_when_facing_away():
+    p = PathFollower([[0, 0], [1, 0], [1, 1]], v_max=0.5, w_max=TURN_RATE, lookahead=LOOKAHEAD)
+    v, w = p.action(0.0, 0.0, 0.0)
     assert v == pytest.approx(0.5) and w == pytest.approx(0.0)
-    v, w = p.command(0.0, 0.0, math.pi)          # facing away: turn, do not drive
+    v, w = p.action(0.0, 0.0, math.pi)           # facing away: turn, do not drive
     assert v == 0.0 and abs(w) == pytest.approx(2.0)
-    v, w = p.command(0.95, 0.0, 0.0)             # near the corner the target lies up the second leg: turn left
+    v, w = p.action(0.95, 0.0, 0.0)              # near the corner the target lies up the second leg: turn left
     assert w > 0
 
 

@@ -8,18 +8,18 @@ bag and judged, the loop of a Gazebo + nav2 test closed without ROS.
     >>> outcome.passed, outcome.ended, outcome.run["collisions"], outcome.bag.name
     (True, 'goal', [], 'minimal-s2-...-task_0-mujoco')
 
-The controller is pure pursuit with differential-drive (unicycle) kinematics, fed back from the
-simulator's own pose of the robot every control step: a forward speed along the heading and a turn
-rate toward the point :data:`LOOKAHEAD` further along the path than the robot's projection on it,
-turning on the spot when far off heading. It stops at the goal (within half its tolerance), at the
-time limit, or when the robot has been stuck (it moved less than :data:`STUCK_MOVE` in
-:data:`STUCK_SECONDS`). ``straight=True`` drives spawn -> goal in a straight line instead of the path: a
-test hook that drives into whatever stands between them.
+The controller is the environment's reference-path follower (:class:`worldgen.envs.policies.PathFollower`:
+pure pursuit with differential-drive kinematics), fed back from the simulator's own pose of the robot
+every control step: a forward speed along the heading and a turn rate toward the point :data:`LOOKAHEAD`
+further along the path than the robot's projection on it, turning on the spot when far off heading.
+It stops at the goal (within half its tolerance), at the time limit, or when the robot has been stuck
+(it moved less than :data:`STUCK_MOVE` in :data:`STUCK_SECONDS`). ``straight=True`` drives spawn -> goal in
+a straight line instead of the path: a test hook that drives into whatever stands between them.
 
-The run is written with :func:`worldgen.ros.write_run` (mcap, Jazzy definitions): ``/clock``, ``/odom``
-and ``/tf`` (the pose since the spawn, no drift), ``/cmd_vel`` (the controller's commands) and
-``/ground_truth`` (the simulator's pose in the map frame, what ``read_run`` reads first), then judged
-with :func:`worldgen.judge.judge` against the world's scenario (default criteria: the run meets it).
+The run is written with :func:`worldgen.ros.write_run` (mcap, Jazzy definitions): ``/clock``, ``/odom`` and ``/tf``
+(the pose since the spawn, no drift), ``/cmd_vel`` (the controller's commands) and ``/ground_truth`` (the
+simulator's pose in the map frame, what ``read_run`` reads first), then judged with
+:func:`worldgen.judge.judge` against the world's scenario (default criteria: the run meets it).
 """
 
 from __future__ import annotations
@@ -33,9 +33,10 @@ from typing import Optional
 
 import numpy as np
 
+from worldgen.envs.policies import PathFollower
 from worldgen.errors import OutputError, ParameterError
 
-__all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "Pursuit", "Outcome",
+__all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "Outcome",
            "drive", "run_loop", "steps_per_command"]
 
 #: Simulators ``worldgen drive --sim`` knows.
@@ -44,44 +45,10 @@ SPEED = 0.5            # m/s forward
 LOOKAHEAD = 0.3        # m along the path ahead of the robot's projection on it
 #: s between commands: 20 Hz, nav2 controller_server's default controller_frequency.
 CONTROL_PERIOD = 0.05
+#: rad/s, the largest turn rate the controller asks for.
+TURN_RATE = 2.0
 STUCK_SECONDS = 2.0
 STUCK_MOVE = 0.02      # m
-
-
-class Pursuit:
-    """Pure pursuit of a polyline ``path`` ((n, 2) world x, y): :meth:`command` gives (v, w) for a pose."""
-
-    def __init__(self, path, speed: float = SPEED, lookahead: float = LOOKAHEAD):
-        self.path = np.asarray(path, dtype=float).reshape(-1, 2)
-        if len(self.path) < 2:
-            raise ParameterError("a path to follow needs at least two points")
-        self.speed, self.lookahead, self.progress = float(speed), float(lookahead), 0
-
-    def _target(self, xy: np.ndarray) -> np.ndarray:
-        path = self.path
-        while True:  # past the end of a segment: follow the next one
-            a, b = path[self.progress], path[self.progress + 1]
-            seg = b - a
-            s = float(np.clip(np.dot(xy - a, seg) / max(float(np.dot(seg, seg)), 1e-12), 0.0, 1.0))
-            if s < 1.0 or self.progress == len(path) - 2:
-                break
-            self.progress += 1
-        along = s * float(np.hypot(*seg)) + self.lookahead
-        for k in range(self.progress, len(path) - 1):
-            length = float(np.hypot(*(path[k + 1] - path[k])))
-            if along <= length:
-                return path[k] + (path[k + 1] - path[k]) * (along / max(length, 1e-12))
-            along -= length
-        return path[-1]
-
-    def command(self, x: float, y: float, yaw: float) -> tuple[float, float]:
-        xy = np.array([x, y])
-        dx, dy = self._target(xy) - xy
-        err = (math.atan2(dy, dx) - yaw + math.pi) % (2 * math.pi) - math.pi
-        w = float(np.clip(3.0 * err, -2.0, 2.0))
-        # Turn on the spot when far off heading (a differential drive can): the robot stays on the path.
-        v = 0.0 if abs(err) > 0.35 else self.speed * math.cos(err) * min(1.0, float(np.hypot(dx, dy)) / self.lookahead)
-        return v, w
 
 
 @dataclass
@@ -106,7 +73,7 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED) 
     """Drive ``task`` in a started-or-not ``backend``: the (n, 4) trajectory, (m, 3) commands and why it ended."""
     spawn, goal = task["spawn"], np.asarray(task["goal"][:2], dtype=float)
     path = [spawn[:2], goal] if straight else task["path"]["waypoints"]
-    pursuit = Pursuit(path, speed)
+    pursuit = PathFollower(path, v_max=speed, w_max=TURN_RATE, lookahead=LOOKAHEAD)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
     per = steps_per_command(backend.dt)
     limit = t + float(task["time_limit"])
@@ -121,7 +88,7 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED) 
         elif t - still_since > STUCK_SECONDS:
             ended = "stuck"
             break
-        v, w = pursuit.command(x, y, yaw)
+        v, w = (float(a) for a in pursuit.action(x, y, yaw))
         commands.append((t, v, w))
         t, x, y, yaw = backend.step(v, w, per)
         rows.append((t, x, y, yaw))
