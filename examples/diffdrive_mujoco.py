@@ -124,15 +124,20 @@ def pursue(path: np.ndarray, xy: np.ndarray, yaw: float, progress: int) -> tuple
     return v, w, progress
 
 
-def drive(world) -> tuple[np.ndarray, np.ndarray]:
-    """Simulate one run; return the recorded (n, 4) ``t, x, y, yaw`` trajectory and the (m, 3) ``t, v, w`` commands."""
-    meta = world.metadata
-    task = meta["tasks"][0]
-    xml, (x0, y0, yaw0) = with_robot(world.to_mjcf(), meta)
+def placed_robot(world):
+    """MuJoCo's model and data of ``world`` with the robot at its first task's spawn, and the robot's joints."""
+    xml, (x0, y0, yaw0) = with_robot(world.to_mjcf(), world.metadata)
     model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
-    jx, jy, jyaw = (model.joint(n).qposadr[0] for n in ("robot_x", "robot_y", "robot_yaw"))
-    data.qpos[[jx, jy, jyaw]] = (x0, y0, yaw0)
+    joints = tuple(model.joint(n).qposadr[0] for n in ("robot_x", "robot_y", "robot_yaw"))
+    data.qpos[list(joints)] = (x0, y0, yaw0)
+    return model, data, joints
+
+
+def drive(world) -> tuple[np.ndarray, np.ndarray]:
+    """Simulate one run; return the recorded (n, 4) ``t, x, y, yaw`` trajectory and the (m, 3) ``t, v, w`` commands."""
+    task = world.metadata["tasks"][0]
+    model, data, (jx, jy, jyaw) = placed_robot(world)
     mujoco.mj_forward(model, data)
     path = np.asarray(task["path"]["waypoints"], dtype=float)
     goal = np.asarray(task["goal"][:2])
@@ -179,11 +184,8 @@ def drive_among_people(world) -> tuple[np.ndarray, np.ndarray, dict]:
 
     meta = world.metadata
     task = meta["tasks"][0]
-    xml, (x0, y0, yaw0) = with_robot(world.to_mjcf(), meta)
-    model = mujoco.MjModel.from_xml_string(xml)
-    data = mujoco.MjData(model)
-    jx, jy, jyaw = (model.joint(n).qposadr[0] for n in ("robot_x", "robot_y", "robot_yaw"))
-    data.qpos[[jx, jy, jyaw]] = (x0, y0, yaw0)
+    model, data, (jx, jy, jyaw) = placed_robot(world)
+    x0, y0 = data.qpos[jx], data.qpos[jy]
     reactions, names = reactions_of(world)
     mocap = [int(model.body(n).mocapid[0]) for n in names]
     timed = np.asarray(task["timed_path"], dtype=float)
