@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import ast
 import hashlib
-import importlib.util
 import json
 import math
 import re
@@ -24,10 +23,11 @@ import pytest
 import yaml
 from hypothesis import given
 from hypothesis import strategies as st
+from support.bundle import bundle_world
+from support.bundle import load_script as load
 from support.cli import QUICK, run, world_dirs
 from support.reftools_sdf import check_sdf
 
-import worldgen
 from worldgen.errors import ParameterError
 from worldgen.ros import bundle as ros2
 
@@ -99,20 +99,12 @@ def valid_topic(name: str) -> bool:
 
 @pytest.fixture(scope="module")
 def world():
-    return worldgen.generate("cluttered", seed=7, size=[6, 6], n_obstacles=6, n_tasks=2)
+    return bundle_world()
 
 
 @pytest.fixture(scope="module")
 def folder(world, tmp_path_factory):
     return world.write(tmp_path_factory.mktemp("ros"), ros=True)
-
-
-def load(path: Path, name: str):
-    """A bundle script as a module (they import only the standard library and PyYAML at the top)."""
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture(scope="module")

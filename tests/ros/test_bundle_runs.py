@@ -9,7 +9,6 @@ verified where.
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import subprocess
 import sys
@@ -18,26 +17,20 @@ from pathlib import Path
 
 import pytest
 import yaml
+from support.bundle import bundle_world
+from support.bundle import load_script as load
 
-import worldgen
 from worldgen.ros import bundle as ros2
 
 
 @pytest.fixture(scope="module")
 def world():
-    return worldgen.generate("cluttered", seed=7, size=[6, 6], n_obstacles=6, n_tasks=2)
+    return bundle_world()
 
 
 @pytest.fixture(scope="module")
 def folder(world, tmp_path_factory):
     return world.write(tmp_path_factory.mktemp("ros"), ros=True)
-
-
-def load(path: Path, name: str):
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 # -- stand-ins of ROS's launch API ------------------------------------------------
