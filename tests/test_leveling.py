@@ -133,3 +133,19 @@ def test_every_generator_has_its_levels_or_says_why_not():
 def test_list_says_which_levels_a_generator_reaches(generator, line):
     done = run("list", generator)
     assert done.returncode == 0 and line in " ".join(done.stdout.split())  # wrapped to the terminal
+
+
+def test_a_level_with_reacting_people_is_certified_against_their_tubes(monkeypatch):
+    """The people added to a landed draw are certified as generate certifies them, against their tubes (they were
+    certified against the recorded lines only)."""
+    from worldgen.people import timed
+
+    seen = []
+    certify = timed.certify
+    monkeypatch.setattr(timed, "certify", lambda *a, **k: seen.append(a[5:] + tuple(k.values())) or certify(*a, **k))
+    world = worldgen.generate("cluttered", seed=3, difficulty="4/10", n_people=3, people_duration=20.0,
+                              people_behaviour="regular")
+    assert {p.get("behaviour") for p in world.metadata["people"]} == {"regular"}
+    assert seen and all(args and list(args[-1]) == ["regular"] * 3 for args in seen), seen  # behaviours given
+    again = worldgen.generate("cluttered", world.seed, **world.params)
+    assert again.metadata["tasks"] == world.metadata["tasks"]

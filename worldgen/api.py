@@ -87,11 +87,7 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
             # check is refused here as it would be after the walk (docs/people.md, "Refusal").
             _progress.info("%s seed %d: attempt %d of max_attempts=%d: walking %d people", name, seed, attempt + 1,
                            budget, resolved["n_people"])
-            from worldgen.people.behaviours import behaviours_of
-            from worldgen.people.crowd import walk_plan
-            from worldgen.people.timed import certify
-            scene = scene.with_movers(scene.movers + walk_plan(scene, draft.tasks, robot, resolved, plan))
-            report = certify(report, scene, draft.tasks, robot, resolved["robot_speed"], behaviours_of(resolved))
+            scene, report = _walk_and_certify(scene, draft.tasks, robot, resolved, plan, report)
         elif plan is not None:
             _count(failures, details, report)
             continue
@@ -133,15 +129,23 @@ def _people_on(world: World, params: dict) -> Optional[World]:
     scene, report = draft.scene, world.feasibility
     if scene.content_hash() != world.scene.content_hash():  # never expected: then prove it afresh
         report = feasibility.check(scene, draft.tasks, robot)
-    from worldgen.people.crowd import walk_plan
-    from worldgen.people.timed import certify
     _progress.info("%s seed %d: attempt %d: walking %d people", world.generator, world.seed, attempt + 1,
                    resolved["n_people"])
-    scene = scene.with_movers(scene.movers + walk_plan(scene, draft.tasks, robot, resolved, plan))
-    report = certify(report, scene, draft.tasks, robot, resolved["robot_speed"])
+    scene, report = _walk_and_certify(scene, draft.tasks, robot, resolved, plan, report)
     if not report.feasible:
         return None
     return World(world.generator, world.seed, resolved, scene, draft.tasks, robot, report, attempt + 1, False)
+
+
+def _walk_and_certify(scene, tasks, robot, resolved: dict, plan, report):
+    """(scene with its people walked, ``report`` with the timed certificate among them and their tubes): the one
+    place a draft gets its people, for a plain request and for a level request's landed draw alike."""
+    from worldgen.people.behaviours import behaviours_of
+    from worldgen.people.crowd import walk_plan
+    from worldgen.people.timed import certify
+
+    scene = scene.with_movers(scene.movers + walk_plan(scene, tasks, robot, resolved, plan))
+    return scene, certify(report, scene, tasks, robot, resolved["robot_speed"], behaviours_of(resolved))
 
 
 def _count(failures: Counter, details: dict, report) -> None:
