@@ -20,6 +20,7 @@ __all__ = [
     "BagError",
     "CallOrderError",
     "require_optional",
+    "optional_available",
     "quoted",
     "did_you_mean",
     "read_user_text",
@@ -101,6 +102,17 @@ class BagError(WorldgenError, ValueError):
 
     The reader library's own exceptions never reach a caller: they are re-raised as this, with the reason.
     """
+
+
+def optional_available(module: str) -> bool:
+    """True when the optional ``module`` can be imported; nothing is imported by asking. A module blocked in
+    ``sys.modules`` (``sys.modules[name] = None``) or a broken entry counts as missing."""
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec(module) is not None
+    except (ImportError, ValueError):
+        return False
 
 
 def require_optional(module: str, extra: str, needs: str):

@@ -23,7 +23,6 @@ import pytest
 import yaml
 from hypothesis import given
 from hypothesis import strategies as st
-from support.bundle import bundle_world
 from support.bundle import load_script as load
 from support.cli import QUICK, run, world_dirs
 from support.reftools_sdf import check_sdf
@@ -97,14 +96,6 @@ def valid_topic(name: str) -> bool:
     return bool(TOPIC_NAME.match(name)) and "__" not in name
 
 
-@pytest.fixture(scope="module")
-def world():
-    return bundle_world()
-
-
-@pytest.fixture(scope="module")
-def folder(world, tmp_path_factory):
-    return world.write(tmp_path_factory.mktemp("ros"), ros=True)
 
 
 @pytest.fixture(scope="module")

@@ -17,21 +17,9 @@ from pathlib import Path
 
 import pytest
 import yaml
-from support.bundle import bundle_world
 from support.bundle import load_script as load
 
 from worldgen.ros import bundle as ros2
-
-
-@pytest.fixture(scope="module")
-def world():
-    return bundle_world()
-
-
-@pytest.fixture(scope="module")
-def folder(world, tmp_path_factory):
-    return world.write(tmp_path_factory.mktemp("ros"), ros=True)
-
 
 # -- stand-ins of ROS's launch API ------------------------------------------------
 

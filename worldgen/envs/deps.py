@@ -6,9 +6,7 @@ is where worldgen.envs asks for it, and where a missing install becomes one line
 
 from __future__ import annotations
 
-import importlib.util
-
-from worldgen.errors import MissingDependencyError, require_optional
+from worldgen.errors import MissingDependencyError, optional_available, require_optional
 
 __all__ = ["MissingDependencyError", "INSTALL_HINT", "gymnasium_available", "require_gymnasium"]
 
@@ -18,10 +16,7 @@ INSTALL_HINT = "pip install 'worldgen[rl]'"
 
 def gymnasium_available() -> bool:
     """True when Gymnasium can be imported (it is not imported by asking)."""
-    try:
-        return importlib.util.find_spec("gymnasium") is not None
-    except (ImportError, ValueError):  # a ``sys.modules['gymnasium'] = None`` block, or a broken entry
-        return False
+    return optional_available("gymnasium")
 
 
 def require_gymnasium():

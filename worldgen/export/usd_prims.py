@@ -11,13 +11,12 @@ shortest round-tripping form.
 
 from __future__ import annotations
 
-import importlib
 import math
 from typing import Any, Iterable, Optional, Sequence
 
 import numpy as np
 
-from worldgen.errors import WorldgenError, require_optional
+from worldgen.errors import WorldgenError, optional_available, require_optional
 from worldgen.floats import DECIMALS, round_float
 from worldgen.scene.shapes import Box, Cylinder, Mesh, Sphere
 
@@ -31,10 +30,7 @@ INSTALL_HINT = "pip install 'worldgen[usd]'"  # what require_optional's message 
 
 def usd_available() -> bool:
     """True when ``pxr`` (usd-core) can be imported; nothing is imported by asking."""
-    try:
-        return importlib.util.find_spec("pxr") is not None
-    except (ImportError, ValueError):  # a ``sys.modules['pxr'] = None`` block, or a broken entry
-        return False
+    return optional_available("pxr")
 
 
 def require_pxr():
