@@ -53,16 +53,27 @@ def test_actors_play_world_json_trajectories_as_a_gpu_lidar_sees_them(name, inst
     with GazeboServer(folder / "ros2" / "world.sdf", install=install, headless_rendering=True) as gz:
         # a dense lidar (0.25 degree): some 20 returns on a person 4.5 m away, enough to place the circle
         gz.spawn(lidar_robot_sdf(lidar, samples=1440), "robot", (x, y, 0.0, yaw))
-        for until in (2.0, 7.5, 12.0):  # the persons: standing, walking, arrived
-            gz.step(max(1, round((until - gz.stats_time()) / STEP)), timeout=60)
-            scan = gz.echo("/scan", 1, step=5)[0]
-            t = scan_stamp(scan)
-            expected = {n: (c, radii[n]) for n, c in zip(names, mover_positions(meta, t))}
-            seen = seen_centres(scan, lidar["pose"], expected)
-            assert seen, f"{name}: the lidar sees no actor at t = {t} s ({scan_ranges(scan, 30.0).min():.3f} m nearest)"
-            for actor, (centre, rays) in seen.items():
-                off = float(np.linalg.norm(centre - expected[actor][0]))
-                seen_at.append((t, actor, off, rays))
-                assert off <= CENTRE_TOL, f"{actor} at t = {t:.3f} s: {off * 1000:.1f} mm from world.json ({rays} rays)"
+        # subscribed before the world moves: the lidar renders on schedule (worldgen/sim/topics.py says why)
+        with gz.subscribe("/scan") as scans:
+            for until in (2.0, 7.5, 12.0):  # the persons: standing, walking, arrived
+                gz.step(max(1, round((until - gz.stats_time()) / STEP)), timeout=60)
+                # the lidar (10 Hz from t = 0) renders at `until` itself
+                scan = scans.wait(1, timeout=20, where=lambda s: scan_stamp(s) >= until - 1e-9)[0]
+                assert scan_stamp(scan) == pytest.approx(until, abs=1e-9)
+                seen_at += _check_scan(name, scan, meta, lidar, names, radii)
     assert {a for _, a, _, _ in seen_at} == set(names)
     assert gz.problems() == []
+
+
+def _check_scan(name, scan, meta, lidar, names, radii):
+    """(t, actor, offset, rays) of every actor the scan sees, each asserted within CENTRE_TOL of world.json."""
+    seen_at = []
+    t = scan_stamp(scan)
+    expected = {n: (c, radii[n]) for n, c in zip(names, mover_positions(meta, t))}
+    seen = seen_centres(scan, lidar["pose"], expected)
+    assert seen, f"{name}: the lidar sees no actor at t = {t} s ({scan_ranges(scan, 30.0).min():.3f} m nearest)"
+    for actor, (centre, rays) in seen.items():
+        off = float(np.linalg.norm(centre - expected[actor][0]))
+        seen_at.append((t, actor, off, rays))
+        assert off <= CENTRE_TOL, f"{actor} at t = {t:.3f} s: {off * 1000:.1f} mm from world.json ({rays} rays)"
+    return seen_at

@@ -93,3 +93,29 @@ def test_the_dynamic_poses_of_a_world_with_actors_are_refused_before_they_crash_
     assert server.actors == 1
     with pytest.raises(GazeboError, match="dynamic_pose/info would crash Gazebo"):
         server.poses(dynamic=True)
+
+
+def _printer(script: str) -> list[str]:
+    """A stand-in subscriber: a Python process printing as ``ign topic -e`` does (messages, blank lines)."""
+    return [sys.executable, "-u", "-c", script]
+
+
+def test_a_subscription_keeps_every_complete_message_and_never_a_half_written_one():
+    from worldgen.sim.topics import Subscription
+
+    script = ("import sys, time\n"
+              "for i in range(3):\n"
+              "    print(f'stamp {{\\n  sec: {i}\\n}}\\n'); sys.stdout.flush()\n"
+              "print('stamp {', end=''); sys.stdout.flush()\n"  # a message cut short
+              "time.sleep(60)\n")
+    steps = []
+    with Subscription("/t", _printer(script), {}, steps.append, lambda text: [textproto.parse(m) for m in
+                      textproto.split_messages(text)], SimulatorError) as sub:
+        got = sub.wait(3, step=7, timeout=20)
+        assert [textproto.first(textproto.first(m, "stamp"), "sec") for m in got] == [0, 1, 2]
+        assert sub.wait(1, where=lambda m: textproto.first(textproto.first(m, "stamp"), "sec") == 2)
+        with pytest.raises(SimulatorError, match="3 of 4 message"):
+            sub.wait(4, timeout=0.3)
+        proc = sub._proc
+    assert proc.poll() is not None and not group_members(proc.pid)  # the subscriber stopped with its block
+    assert len(sub.messages()) == 3 and steps == [7] * len(steps)

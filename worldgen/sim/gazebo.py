@@ -9,6 +9,8 @@ The API (stable; the robot-driving loop builds on it)::
         poses = gz.poses()                            # model name -> (x, y, z, qx, qy, qz, qw)
         gz.spawn(robot_sdf_text, name="robot", pose=(1.0, 2.0, 0.0, 0.3))
         gz.echo("/lidar", n=1)                        # parsed messages (worldgen.sim.textproto)
+        with gz.subscribe("/scan") as scans:          # a subscriber that stays while the world steps
+            gz.step(500); scans.messages()
     gz.problems()                                     # Gazebo's errors and warnings, known harmless ones removed
 
 - :func:`locate` finds an install (``WORLDGEN_GAZEBO_SETUP``, else ``/opt/gz-fortress2/setup.sh``) and reads its
@@ -32,6 +34,7 @@ from pathlib import Path
 from worldgen.errors import SimulatorError, SimulatorMissingError
 from worldgen.sim import textproto
 from worldgen.sim.procs import group_members, run_tool, stop_group
+from worldgen.sim.topics import Subscription
 
 __all__ = ["GazeboMissingError", "GazeboError", "GazeboInstall", "GazeboServer", "locate", "SETUP_ENV",
            "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name"]
@@ -260,29 +263,32 @@ class GazeboServer:
         try:
             return run_tool(["ign"] + args, self.env, timeout=timeout)
         except subprocess.TimeoutExpired:
-            raise GazeboError(f"'ign {' '.join(args[:3])}' got no answer within {timeout:.0f} s") from None
+            raise GazeboError(f"'ign {' '.join(args[:3])}' got no answer within {timeout:.0f} s ({self._state()})") from None
+
+    def _state(self) -> str:
+        """Whether the server still runs, for an error message: a live server that stopped answering is stuck."""
+        if self._proc is None:
+            return "the server was not started"
+        status = self._proc.poll()
+        if status is not None:
+            return f"Gazebo exited with status {status}; it said: {self.problems()[-3:]}"
+        return "Gazebo still runs but its simulation loop stopped answering; docs/gazebo.md, 'A server that hangs'"
 
     def echo(self, topic: str, n: int = 1, timeout: float = 20.0, step: int = 0) -> list[dict]:
         """The next ``n`` messages on a topic, parsed (:mod:`worldgen.sim.textproto`).
 
-        ``step`` > 0 keeps the world stepping that many iterations at a time until they came: for a topic
-        published only while simulation time moves (a sensor), as the server waits paused otherwise."""
-        args = ["ign", "topic", "-e", "-t", topic, "-n", str(n)]
+        ``step`` > 0 keeps the world stepping that many iterations at a time until they came: for a sensor,
+        which publishes only while simulation time moves. Ask for a sensor this way only before the world
+        has moved, or keep a :meth:`subscribe` open from then on (:mod:`worldgen.sim.topics` says why)."""
         if not step:
-            return self._parse_echo(self._ign(args[1:], timeout))
-        with tempfile.TemporaryFile() as sink:
-            proc = subprocess.Popen(args, env=self.env, stdin=subprocess.DEVNULL, stdout=sink,
-                                    stderr=subprocess.STDOUT, start_new_session=True)
-            deadline = time.monotonic() + timeout
-            try:
-                while proc.poll() is None and time.monotonic() < deadline:
-                    self.step(step)
-            finally:
-                if proc.poll() is None:
-                    stop_group(proc, grace=0.5)
-                    raise GazeboError(f"no {n} message(s) on {topic} within {timeout:.0f} s of stepping")
-            sink.seek(0)
-            return self._parse_echo(sink.read().decode("utf-8", errors="replace"))
+            return self._parse_echo(self._ign(["topic", "-e", "-t", topic, "-n", str(n)], timeout))
+        with self.subscribe(topic) as sub:
+            return sub.wait(n, step, timeout)[:n]
+
+    def subscribe(self, topic: str) -> Subscription:
+        """A subscriber to ``topic`` that stays until closed (a context manager): :class:`Subscription`."""
+        return Subscription(topic, ["ign", "topic", "-e", "-t", topic], self.env, self.step, self._parse_echo,
+                            GazeboError)
 
     @staticmethod
     def _parse_echo(text: str) -> list[dict]:
