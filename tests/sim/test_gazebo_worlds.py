@@ -9,7 +9,9 @@ stepped, and the bodies that can move (door leaves on their hinges) read again f
 
 from __future__ import annotations
 
+import dataclasses
 import json
+from pathlib import Path
 
 import pytest
 from support.gazebo import gazebo_install, pose_errors
@@ -66,3 +68,16 @@ def test_the_doors_world_holds_every_state_and_swing():
     pairs = {(d["state"], "push" if d["passage"]["normal"][0] > 0 else "pull") for d in meta["doors"]}
     assert pairs == {(s, w) for s in ("closed", "ajar", "open") for w in ("push", "pull")}
     assert worldgen.generate("door", seed=7, **DOORS).params["swing"] == "random"
+
+
+def test_a_run_leaves_the_users_gazebo_home_as_it_was(install, tmp_path):
+    # Gazebo writes ~/.ignition/gazebo/6/server.config on a first run and a log folder on every run; the one
+    # 6.18 writes names plugins a 6.7 install cannot load (docs/gazebo.md). The server gets a home of its own.
+    user = tmp_path / "user"
+    user.mkdir()
+    install = dataclasses.replace(install, env=dict(install.env, HOME=str(user)))
+    folder = worldgen.generate("minimal", seed=0).write(tmp_path / "worlds", preview=False)
+    with GazeboServer(folder / "world.sdf", install=install) as gz:
+        assert gz.step(10) == 10
+        assert (Path(gz.env["HOME"]) / ".ignition" / "gazebo").is_dir()  # where Gazebo wrote instead
+    assert list(user.iterdir()) == []

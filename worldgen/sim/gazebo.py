@@ -175,9 +175,17 @@ class GazeboServer:
                  verbosity: int = 3, real_time_factor: float | None = None, start_timeout: float = 60.0):
         self.world_sdf = Path(world_sdf).resolve()
         self.install = install or locate()
+        self._logdir = tempfile.TemporaryDirectory(prefix="worldgen-gazebo-")
+        home = Path(self._logdir.name) / "home"
+        home.mkdir()
         # Gazebo's transport finds peers machine-wide: a partition of its own keeps this server and its
         # ign calls apart from any other Gazebo on the machine (same world name, /stats, /clock).
-        self.env = dict(self.install.env, IGN_PARTITION=f"worldgen-{os.getpid()}-{id(self):x}")
+        # A home of its own: Gazebo writes ~/.ignition/gazebo/6/server.config on its first run (6.18 writes
+        # gz::sim plugin names, which a 6.7 install then cannot load: measured) and a log folder per run; a
+        # test run must not change the user's Gazebo. The cache stays the user's (Mesa's compiled shaders).
+        cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+        self.env = dict(self.install.env, IGN_PARTITION=f"worldgen-{os.getpid()}-{id(self):x}", HOME=str(home),
+                        XDG_CACHE_HOME=cache)
         self.world, self.actors = world_name(self.world_sdf)
         self.headless_rendering = headless_rendering
         self.verbosity = verbosity
@@ -185,7 +193,6 @@ class GazeboServer:
         self.start_timeout = start_timeout
         self.load_seconds: float | None = None
         self._proc: subprocess.Popen | None = None
-        self._logdir = tempfile.TemporaryDirectory(prefix="worldgen-gazebo-")
         self._iterations = 0
         self._scene: dict | None = None  # the last scene/info reply, until a spawn changes the scene
 
