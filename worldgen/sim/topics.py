@@ -18,6 +18,7 @@ from __future__ import annotations
 import subprocess
 import tempfile
 import time
+from pathlib import Path
 from typing import Callable
 
 from worldgen.sim.procs import stop_group
@@ -35,12 +36,17 @@ class Subscription:
                  parse: Callable[[str], list[dict]], error: type[Exception]):
         self.topic = topic
         self._step, self._parse, self._error = step, parse, error
-        self._sink = tempfile.TemporaryFile()
-        self._read = 0  # bytes of the sink parsed into self._got
+        self._folder = tempfile.TemporaryDirectory(prefix="worldgen-topic-")
+        path = Path(self._folder.name) / "messages.txt"
+        # The subscriber appends through a file object of its own: one shared with the reader would share its
+        # offset too, and a seek to read would move where the subscriber writes.
+        with open(path, "ab") as out:
+            self._proc: subprocess.Popen | None = subprocess.Popen(
+                command, env=env, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
+                start_new_session=True)
+        self._reader = open(path, "rb")
+        self._read = 0  # bytes of the file parsed into self._got
         self._got: list[dict] = []
-        self._proc: subprocess.Popen | None = subprocess.Popen(
-            command, env=env, stdin=subprocess.DEVNULL, stdout=self._sink, stderr=subprocess.STDOUT,
-            start_new_session=True)
 
     def __enter__(self) -> Subscription:
         return self
@@ -51,9 +57,9 @@ class Subscription:
     def messages(self) -> list[dict]:
         """Every complete message so far, oldest first. ``ign topic -e`` ends each message with a blank line:
         what follows the last one is a message still being written (or cut short by :meth:`close`)."""
-        if not self._sink.closed:
-            self._sink.seek(self._read)
-            new = self._sink.read()
+        if not self._reader.closed:
+            self._reader.seek(self._read)
+            new = self._reader.read()
             cut = new.rfind(b"\n\n")
             if cut >= 0:  # parsed once: a subscriber to a sensor gathers megabytes over a long run
                 self._got += self._parse(new[:cut + 1].decode("utf-8", errors="replace"))
@@ -83,6 +89,7 @@ class Subscription:
             stop_group(self._proc, grace=0.5)
             self._proc = None
             got = self.messages()
-            self._sink.close()
+            self._reader.close()
+            self._folder.cleanup()
             return got
         return self.messages()
