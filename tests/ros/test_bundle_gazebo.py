@@ -47,8 +47,12 @@ def run_setup(install, tmp_path_factory):
     spec = importlib.util.spec_from_file_location("gz_launch", path)
     launch = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(launch)
-    # A transport partition of its own: another Gazebo on this machine (a parallel test) is not this one.
-    env = dict(install.env, IGN_PARTITION=f"worldgen-bundle-{os.getpid()}")
+    # A transport partition of its own: another Gazebo on this machine (a parallel test) is not this one;
+    # a home of its own: Gazebo writes its config and logs under ~/.ignition (docs/gazebo.md); the logs
+    # of this test go there too.
+    cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    env = dict(install.env, IGN_PARTITION=f"worldgen-bundle-{os.getpid()}", XDG_CACHE_HOME=cache,
+               HOME=str(tmp_path_factory.mktemp("home")))
     if _DART.exists():  # Debian 12 ships DART's plugin without the unversioned name Gazebo asks for
         engines = tmp_path_factory.mktemp("engines")
         (engines / "libignition-physics-dartsim-plugin.so").symlink_to(_DART)
@@ -116,7 +120,7 @@ def _stop_as_launch_does(proc: subprocess.Popen) -> str:
 
 
 def _start(args, env, shell=False) -> tuple[subprocess.Popen, Path]:
-    log = Path(os.environ.get("TMPDIR", "/tmp")) / f"gz-{os.getpid()}-{time.monotonic_ns()}.log"
+    log = Path(env["HOME"]) / f"gz-{time.monotonic_ns()}.log"
     proc = subprocess.Popen(args, env=env, shell=shell, stdin=subprocess.DEVNULL, stdout=log.open("w"),
                             stderr=subprocess.STDOUT, start_new_session=True)
     return proc, log
