@@ -8,6 +8,7 @@ person within 1 mm of world.json's trajectory (and halfway between samples, wher
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
 import subprocess
@@ -392,6 +393,44 @@ def test_without_usd_core_one_line_and_no_folder(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["b"]  # the world without usd, and nothing else
     assert {p.name for p in next((tmp_path / "b").iterdir()).iterdir()} >= {"world.sdf", "world.mjcf.xml", "world.urdf"}
     assert not any(p.name == "world.usda" for p in (tmp_path / "b").rglob("*"))
+
+
+_CHECK_BLOCKED = (
+    "import sys\n"
+    "sys.modules['pxr'] = None  # as if usd-core were not installed\n"
+    "from worldgen.verify import check_folder\n"
+    "for folder in sys.argv[1:]:\n"
+    "    print(check_folder(folder).line())\n"
+)
+
+
+def test_check_without_usd_core_reproduces_every_other_file_and_says_what_it_left(tmp_path):
+    """A folder with world.usda checked where usd-core is not installed: every other file is rendered again
+    and compared, the usda's hash against world.json; a tampered SDF still fails, a tampered usda too."""
+    world = generate_preset("person_crossing", 0)  # people: world.json names usd in their formats notes
+    good = world.write(tmp_path / "good", formats=["sdf", "mjcf", "usd"])
+    bad_sdf = world.write(tmp_path / "bad_sdf", formats=["sdf", "mjcf", "usd"])
+    bad_usda = world.write(tmp_path / "bad_usda", formats=["sdf", "mjcf", "usd"])
+    for folder, name in ((bad_sdf, "world.sdf"), (bad_usda, "world.usda")):
+        (folder / name).write_text((folder / name).read_text() + "\n")
+        meta = json.loads((folder / "world.json").read_text())
+        key = "sdf" if name == "world.sdf" else "usd"
+        meta["files"][key]["sha256"] = hashlib.sha256((folder / name).read_bytes()).hexdigest()
+        (folder / "world.json").write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    res = subprocess.run([sys.executable, "-c", _CHECK_BLOCKED, str(good), str(bad_sdf), str(bad_usda)],
+                         capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-2000:]
+    lines = res.stdout.splitlines()
+    assert lines[0] == (f"OK {good} (world.usda not rendered again: its optional dependency is not installed "
+                        "(its sha256 matches world.json))")
+    # the edited SDF with its hash re-recorded: world.json then differs from a fresh export (files.sdf)
+    assert lines[1].startswith(f"FAIL {bad_sdf}: reproduce: world.json differs from a fresh export at files.sdf.sha256")
+    # the edited usda with its hash re-recorded is not rendered again here: world.json itself is compared,
+    # and its files.usd entry was left out of that comparison, so only usd-core can tell (below)
+    assert lines[2].startswith(f"OK {bad_usda}")
+    from worldgen.verify import check_folder
+
+    assert check_folder(good).ok and not check_folder(bad_usda).ok  # with usd-core: rendered and compared
 
 
 def test_a_pack_recipe_with_usd_and_without_usd_core(tmp_path):

@@ -17,7 +17,7 @@ from typing import Any, Iterable, Mapping, Optional
 from worldgen.errors import ParameterError
 
 __all__ = ["Format", "TABLE", "FORMATS", "ALL_FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats", "render",
-           "movers_note", "uses_meshes", "require_formats"]
+           "movers_note", "uses_meshes", "require_formats", "unavailable_formats"]
 
 #: Versions the SDF exporter writes: 1.9 for Gazebo Fortress-Harmonic, 1.6 for Gazebo classic.
 SDF_VERSIONS = ("1.9", "1.6")
@@ -131,3 +131,16 @@ def movers_note(params: Mapping[str, Any], written: Iterable[str] = ()) -> dict[
 def uses_meshes(formats: Iterable[str]) -> bool:
     """Whether any of ``formats`` refers to mesh files beside it."""
     return any(TABLE[f].meshes for f in formats)
+
+
+def unavailable_formats(formats: Iterable[str]) -> tuple[str, ...]:
+    """Those of ``formats`` whose optional dependency is not installed (``worldgen check`` leaves them out)."""
+    from worldgen.errors import MissingDependencyError
+
+    missing = []
+    for f in normalise_formats(formats):
+        try:
+            require_formats([f])
+        except MissingDependencyError:
+            missing.append(f)
+    return tuple(missing)
