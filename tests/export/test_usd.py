@@ -421,8 +421,8 @@ def test_check_without_usd_core_reproduces_every_other_file_and_says_what_it_lef
                          capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr[-2000:]
     lines = res.stdout.splitlines()
-    assert lines[0] == (f"OK {good} (world.usda not rendered again: its optional dependency is not installed "
-                        "(its sha256 matches world.json))")
+    assert lines[0] == (f"OK {good} (world.usda not rendered again: the optional dependency is not installed "
+                        "here (sha256 checked against world.json))")
     # the edited SDF with its hash re-recorded: world.json then differs from a fresh export (files.sdf)
     assert lines[1].startswith(f"FAIL {bad_sdf}: reproduce: world.json differs from a fresh export at files.sdf.sha256")
     # the edited usda with its hash re-recorded is not rendered again here: world.json itself is compared,

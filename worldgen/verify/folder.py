@@ -258,8 +258,8 @@ def _reproduce(folder: Path, meta: dict, world, entries) -> str:
     # hash was checked against world.json above, the world it describes was regenerated and re-proved, and
     # every other file is still compared byte for byte. Said in the verdict, never a failure.
     missing = unavailable_formats(formats)
-    note = (f"{', '.join(FILE_NAMES[f] for f in missing)} not rendered again: its optional dependency is not "
-            "installed (its sha256 matches world.json)") if missing else ""
+    note = (f"{', '.join(FILE_NAMES[f] for f in missing)} not rendered again: the optional dependency is not "
+            "installed here (sha256 checked against world.json)") if missing else ""
     formats = [f for f in formats if f not in missing]
     if not formats:
         return note
