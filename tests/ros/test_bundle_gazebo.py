@@ -30,7 +30,6 @@ pytestmark = pytest.mark.gazebo
 
 #: launch's defaults (ExecuteProcess: LaunchConfiguration('sigterm_timeout', default=5), sigkill the same).
 SIGTERM_TIMEOUT = SIGKILL_TIMEOUT = 5.0
-_DART = Path("/usr/lib/x86_64-linux-gnu/ign-physics-5/engine-plugins/libignition-physics5-dartsim-plugin.so.5")
 
 
 @pytest.fixture(scope="module")
@@ -53,10 +52,6 @@ def run_setup(install, tmp_path_factory):
     cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     env = dict(install.env, IGN_PARTITION=f"worldgen-bundle-{os.getpid()}", XDG_CACHE_HOME=cache,
                HOME=str(tmp_path_factory.mktemp("home")))
-    if _DART.exists():  # Debian 12 ships DART's plugin without the unversioned name Gazebo asks for
-        engines = tmp_path_factory.mktemp("engines")
-        (engines / "libignition-physics-dartsim-plugin.so").symlink_to(_DART)
-        env["IGN_GAZEBO_PHYSICS_ENGINE_PATH"] = str(engines)
     env.update(launch.gazebo_env())
     command = launch.gazebo_command(str(folder / launch.SDF), "0")
     robot = folder / "robot_fortress.sdf"

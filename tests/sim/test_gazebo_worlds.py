@@ -18,7 +18,7 @@ from support.gazebo import gazebo_install, pose_errors
 
 import worldgen
 from worldgen.presets import generate_preset, names
-from worldgen.sim.gazebo import GazeboServer
+from worldgen.sim.gazebo import GazeboServer, _physics_args
 
 pytestmark = pytest.mark.gazebo
 
@@ -81,3 +81,11 @@ def test_a_run_leaves_the_users_gazebo_home_as_it_was(install, tmp_path):
         assert gz.step(10) == 10
         assert (Path(gz.env["HOME"]) / ".ignition" / "gazebo").is_dir()  # where Gazebo wrote instead
     assert list(user.iterdir()) == []
+
+
+def test_a_plain_ign_gazebo_finds_the_physics_engine(install):
+    # `ign gazebo WORLD` with no flags, as docs/gazebo.md and users run it, asks for DART by its unversioned
+    # name; Debian 12 ships only the versioned file, and the world then runs with no physics at all.
+    # .ci/run makes the links libignition-physics-dev would bring; the harness needs no --physics-engine.
+    assert _physics_args(install.env) == [], ("Gazebo does not find libignition-physics-dartsim-plugin.so: "
+                                              "run .ci/run, or see docs/gazebo.md")
