@@ -43,7 +43,7 @@ from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
 
 __all__ = ["DEFAULT_NAME", "GZ_RELEASES", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW",
-           "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
+           "Dimensions", "dimensions", "gz_release_of", "robot_sdf", "robot_urdf"]
 
 #: The model's name: the ROS 2 bundle's robot (worldgen.ros.bundle.DEFAULT_ROBOT_NAME).
 DEFAULT_NAME = "robot"
@@ -98,11 +98,12 @@ def dimensions(world) -> Dimensions:
     return Dimensions(float(robot["radius"]), float(robot["height"]), float(lidar["pose"][2]) - float(spawn_z))
 
 
-def _release(gz_release: str) -> tuple[str, str]:
+def gz_release_of(gz_release: str) -> tuple[str, str, str]:
+    """:data:`GZ_RELEASES`'s row for a release name (plugin file prefix, class prefix, message prefix);
+    ParameterError naming the releases for any other name."""
     if gz_release not in GZ_RELEASES:
         raise ParameterError(f"parameter 'gz_release' must be one of {', '.join(GZ_RELEASES)}, got {gz_release!r}")
-    filename, cls, _msgs = GZ_RELEASES[gz_release]
-    return filename, cls
+    return GZ_RELEASES[gz_release]
 
 
 def _inertia_cylinder(m: float, r: float, length: float) -> tuple[float, float, float]:
@@ -231,7 +232,7 @@ def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_ra
 
 
 def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: float) -> None:
-    filename, cls = _release(gz_release)
+    filename, cls, _ = gz_release_of(gz_release)
     drive = sub(model, "plugin", filename=filename.format("diff-drive"), name=cls.format("DiffDrive"))
     for key, value in (("left_joint", "left_wheel_joint"), ("right_joint", "right_wheel_joint"),
                        ("wheel_separation", fmt(d.wheel_separation)), ("wheel_radius", fmt(d.wheel_radius)),
@@ -261,7 +262,7 @@ def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_r
         raise ParameterError(f"parameter 'lidar_noise' must be a finite standard deviation >= 0 m, got {lidar_noise!r}")
     if not (lidar_rate > 0 and odom_rate > 0):
         raise ParameterError(f"rates must be > 0 Hz, got lidar_rate={lidar_rate!r}, odom_rate={odom_rate!r}")
-    _release(gz_release)
+    gz_release_of(gz_release)
     d = dimensions(world)
     root = etree.Element("sdf", version="1.9")
     model = sub(root, "model", name=name)

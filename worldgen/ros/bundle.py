@@ -29,7 +29,7 @@ from typing import Any, Mapping, Optional
 
 from worldgen.errors import ParameterError
 from worldgen.export.robot import DEFAULT_NAME as DEFAULT_ROBOT_NAME
-from worldgen.export.robot import GZ_RELEASES
+from worldgen.export.robot import GZ_RELEASES, gz_release_of
 
 __all__ = ["BUNDLE_DIR", "ROBOT_SDF", "ROBOT_URDF", "GZ_RELEASES", "GZ_SERVERS", "DEFAULT_GZ_RELEASE",
            "DEFAULT_ROBOT_NAME", "TOPICS", "RECORDED_TOPICS", "ros_name", "release_of", "plugins", "with_plugins",
@@ -93,12 +93,6 @@ def ros_name(text: str) -> str:
     return name.rstrip("_")
 
 
-def _release(gz_release: str) -> tuple[str, str, str]:
-    if gz_release not in GZ_RELEASES:
-        raise ParameterError(f"parameter 'gz_release' must be one of {', '.join(GZ_RELEASES)}, got {gz_release!r}")
-    return GZ_RELEASES[gz_release]
-
-
 def release_of(ros) -> str:
     """The Gazebo release a ``ros`` option names: True for the default, else a release's name."""
     if ros is True:
@@ -110,7 +104,7 @@ def release_of(ros) -> str:
 
 def plugins(gz_release: str = DEFAULT_GZ_RELEASE) -> list[tuple[str, str, str]]:
     """``(filename, name, inner XML)`` of every world system the bundle's SDF names, for ``gz_release``."""
-    filename, name, _ = _release(gz_release)
+    filename, name, _ = gz_release_of(gz_release)
     return [(filename.format(f), name.format(n), inner) for f, n, inner in _SYSTEMS]
 
 
@@ -144,7 +138,7 @@ def _topics(robot_name: str) -> dict[str, tuple[str, str, str, str]]:
 
 def bridge_config(robot_name: str = DEFAULT_ROBOT_NAME, gz_release: str = DEFAULT_GZ_RELEASE) -> list[dict[str, Any]]:
     """The ros_gz_bridge YAML config: one mapping per topic with the bridge's documented keys."""
-    prefix = _release(gz_release)[2]
+    prefix = gz_release_of(gz_release)[2]
     return [{"ros_topic_name": ros, "gz_topic_name": gz, "ros_type_name": ros_type,
              "gz_type_name": f"{prefix}.{gz_type}", "direction": direction}
             for ros, (ros_type, gz_type, gz, direction) in _topics(robot_name).items()]
@@ -231,7 +225,7 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
     from worldgen.groundtruth.truth import doors_start_shut, start_occupancy_map
 
     if gz_release is not None:
-        _release(gz_release)
+        gz_release_of(gz_release)
     robot = ros_name(robot_name)
     name = ros_name(world.world_id)
     files: dict[str, bytes] = {

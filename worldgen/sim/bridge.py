@@ -23,7 +23,9 @@ from pathlib import Path
 from lxml import etree
 
 from worldgen.errors import OutputError
-from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate
+from worldgen.export.robot import DEFAULT_NAME
+from worldgen.export.xml import safe_parser
+from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate, user_cache
 
 __all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "GazeboBackend", "world_step"]
 
@@ -34,8 +36,7 @@ _BUILD_HINT = "apt-get install g++ pkg-config libignition-transport-dev libignit
 
 def cache_dir() -> Path:
     """Where built helpers live: ``$XDG_CACHE_HOME/worldgen`` (default ``~/.cache/worldgen``)."""
-    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "worldgen"
+    return user_cache() / "worldgen"
 
 
 def build_bridge(env: dict[str, str] | None = None) -> Path:
@@ -71,8 +72,7 @@ def build_bridge(env: dict[str, str] | None = None) -> Path:
 
 def world_step(sdf_path: Path) -> float:
     """The world's physics step (s): its ``<physics><max_step_size>``, Gazebo's 0.001 s where none is set."""
-    parser = etree.XMLParser(resolve_entities=False, no_network=True)
-    text = etree.parse(str(sdf_path), parser).getroot().findtext("world/physics/max_step_size")
+    text = etree.parse(str(sdf_path), safe_parser()).getroot().findtext("world/physics/max_step_size")
     return float(text) if text else 0.001
 
 
@@ -83,13 +83,11 @@ class GazeboBackend:
     poses come back from the simulator, (t, x, y, yaw) in the world frame.
     """
 
-    name = "gazebo"
-
-    def __init__(self, world_sdf: Path, robot_sdf: str, *, robot_name: str = "robot", first_steps: int = 1):
+    def __init__(self, world_sdf: Path, robot_sdf: str, *, dt: float, first_steps: int = 1):
         self.world_sdf = Path(world_sdf)
         self.first_steps = first_steps  # steps until the first pose: the model's OdometryPublisher's period
-        self.dt = world_step(self.world_sdf)
-        self._robot_sdf, self._robot_name = robot_sdf, robot_name
+        self.dt = dt  # the world's physics step (world_step)
+        self._robot_sdf, self._robot_name = robot_sdf, DEFAULT_NAME  # robot_sdf's model name
         self._server: GazeboServer | None = None
         self._bridge: subprocess.Popen | None = None
         self._model = None

@@ -136,8 +136,9 @@ def _backend(sim: str, folder: Path, meta: dict):
     # time since its last message reaches its period, so a period half a step short of a command's steps
     # lands on every command's end (the first at the end of the first), and no other message wakes the bridge.
     dt = world_step(sdf)
-    robot = robot_sdf(meta, gz_release="fortress", sensors=False, odom_rate=1.0 / ((steps_per_command(dt) - 0.5) * dt))
-    return GazeboBackend(sdf, robot, first_steps=steps_per_command(dt))
+    per = steps_per_command(dt)
+    robot = robot_sdf(meta, gz_release="fortress", sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
+    return GazeboBackend(sdf, robot, dt=dt, first_steps=per)
 
 
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,

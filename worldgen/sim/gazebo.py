@@ -37,7 +37,7 @@ from worldgen.sim.procs import group_members, run_tool, stop_group
 from worldgen.sim.topics import Subscription
 
 __all__ = ["GazeboMissingError", "GazeboError", "GazeboInstall", "GazeboServer", "locate", "SETUP_ENV",
-           "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name"]
+           "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name", "user_cache"]
 
 #: The environment variable naming an install's setup script, and the script used without it.
 SETUP_ENV = "WORLDGEN_GAZEBO_SETUP"
@@ -110,6 +110,11 @@ def locate(setup: str | Path | None = None) -> GazeboInstall:
     return GazeboInstall(setup, env, versions[-1])
 
 
+def user_cache() -> Path:
+    """The user's cache folder: ``$XDG_CACHE_HOME``, else ``~/.cache``."""
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
+
+
 def _physics_args(env: dict[str, str]) -> list[str]:
     """``--physics-engine`` naming Debian's DART plugin when Gazebo's default name exists on none of its paths."""
     dirs = [Path(d) for d in env.get("IGN_GAZEBO_PHYSICS_ENGINE_PATH", "").split(":") if d]
@@ -148,6 +153,11 @@ def problems_in(log: str, actors: int = 0) -> list[str]:
     return out
 
 
+def _accepted(reply: dict) -> bool:
+    """Whether an ``ignition.msgs.Boolean`` reply says yes (protobuf text: ``data: true``)."""
+    return textproto.first(reply, "data") == "true"
+
+
 def _without_harmless(text: str) -> str:
     return "\n".join(x for x in text.splitlines() if not any(k in x for k in HARMLESS))
 
@@ -156,8 +166,9 @@ def world_name(sdf_path: Path) -> tuple[str, int]:
     """The ``<world name>`` of an SDF file and how many ``<actor>``s it holds (parsed without entities or network)."""
     from lxml import etree
 
-    parser = etree.XMLParser(resolve_entities=False, no_network=True)
-    world = etree.parse(str(sdf_path), parser).getroot().find("world")
+    from worldgen.export.xml import safe_parser
+
+    world = etree.parse(str(sdf_path), safe_parser()).getroot().find("world")
     if world is None or not world.get("name"):
         raise GazeboError(f"{sdf_path} holds no <world name=...>")
     return str(world.get("name")), len(world.findall("actor"))
@@ -183,15 +194,13 @@ class GazeboServer:
         # A home of its own: Gazebo writes ~/.ignition/gazebo/6/server.config on its first run (6.18 writes
         # gz::sim plugin names, which a 6.7 install then cannot load: measured) and a log folder per run; a
         # test run must not change the user's Gazebo. The cache stays the user's (Mesa's compiled shaders).
-        cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
         self.env = dict(self.install.env, IGN_PARTITION=f"worldgen-{os.getpid()}-{id(self):x}", HOME=str(home),
-                        XDG_CACHE_HOME=cache)
+                        XDG_CACHE_HOME=str(user_cache()))
         self.world, self.actors = world_name(self.world_sdf)
         self.headless_rendering = headless_rendering
         self.verbosity = verbosity
         self.real_time_factor = real_time_factor
         self.start_timeout = start_timeout
-        self.load_seconds: float | None = None
         self._proc: subprocess.Popen | None = None
         self._iterations = 0
         self._scene: dict | None = None  # the last scene/info reply, until a spawn changes the scene
@@ -215,7 +224,6 @@ class GazeboServer:
         except BaseException:
             self.stop()
             raise
-        self.load_seconds = time.monotonic() - started
         return self
 
     def _wait_up(self, started: float) -> None:
@@ -325,7 +333,7 @@ class GazeboServer:
         target = self._iterations + int(iterations)
         reply = self.service(f"/world/{self.world}/control", "ignition.msgs.WorldControl", "ignition.msgs.Boolean",
                              f"pause: true, multi_step: {int(iterations)}")
-        if textproto.first(reply, "data") is not True and textproto.first(reply, "data") != "true":
+        if not _accepted(reply):
             raise GazeboError(f"world control refused {iterations} steps: {reply}")
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -382,5 +390,5 @@ class GazeboServer:
                f"{{x: {x!r}, y: {y!r}, z: {z!r}}}, orientation: {{z: {math.sin(yaw / 2)!r}, w: {math.cos(yaw / 2)!r}}}}}")
         self._scene = None
         reply = self.service(f"/world/{self.world}/create", "ignition.msgs.EntityFactory", "ignition.msgs.Boolean", req)
-        if textproto.first(reply, "data") is not True and textproto.first(reply, "data") != "true":
+        if not _accepted(reply):
             raise GazeboError(f"Gazebo refused to create {name!r}: {reply}")

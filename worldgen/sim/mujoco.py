@@ -27,8 +27,6 @@ W_MAX = 4.0
 class MujocoBackend:
     """:meth:`start` puts the robot at the spawn; :meth:`step` holds (v, w) for N physics steps."""
 
-    name = "mujoco"
-
     def __init__(self, mjcf: Path, meta: dict):
         root = etree.fromstring(Path(mjcf).read_bytes(), safe_parser())
         robot = meta["robot"]
@@ -66,9 +64,6 @@ class MujocoBackend:
         x, y, yaw = sim.pose()
         # The hinge's angle winds past +-pi; a heading is an angle in (-pi, pi].
         return float(sim.data.time), x, y, math.atan2(math.sin(yaw), math.cos(yaw))
-
-    def problems(self) -> list[str]:
-        return []
 
     def close(self) -> None:
         self._sim = None
