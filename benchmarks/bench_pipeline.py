@@ -100,14 +100,13 @@ def time_world(params: dict, seed: int, out_dir: Path) -> dict[str, float]:
         world._render(fmt, "1.9")  # export_bytes() would return the bytes the pipeline already rendered
         t[fmt] = _now() - t0
     t["floor"] = serialisation_floor(world, files)
-    from worldgen.groundtruth import truth
+    from worldgen.groundtruth import lidar, metrics, occupancy, truth
     truth._DIFFICULTY.pop(world, None)  # world.json's first build computes them: time that, not the remembered ones
     t0 = _now()
     world.metadata_for(files)
     t["metadata"] = _now() - t0
     # Ground truth (worldgen.groundtruth), each part alone and all three as world.json adds them
     # (map made and encoded as PGM + YAML): what issue 4 budgets at 15 ms for 50 obstacles.
-    from worldgen.groundtruth import lidar, metrics, occupancy, truth
     t0 = _now()
     lidar.describe(world.scene, truth.lidar_spec(world))
     t["lidar"] = _now() - t0

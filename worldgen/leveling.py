@@ -212,7 +212,7 @@ def check_request(name: str, level_value: Any, params: Mapping[str, Any]) -> tup
 
 
 def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any],
-                      people_on: Optional[Callable] = None):
+                      people_on: Callable):
     """A world of generator ``name`` at the level ``level_value`` asks for (see the module); ``generate`` is
     :func:`worldgen.generate`, ``people_on(world, params)`` the world with people of the same draw and attempt,
     or None where they refuse it (worldgen.api)."""
@@ -226,6 +226,9 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
     low, high, step = knob.low * scale, knob.high * scale, knob.step * scale
     fixed = {**params, **knob.sets(level)}
     people = bool(params.get("n_people"))
+    # With people the level is judged on the draw without them, and they are added only to a draw that
+    # landed (see the module): the people are walked once per landed draw, not once per draw.
+    drawn = _without_people(fixed) if people else fixed
     draws: list[dict] = []
     refused = 0  # landed draws the people refused: a budget of their own, beside the draws' (see the module)
     for k in range(2 * MAX_DRAWS):
@@ -236,15 +239,13 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         _progress.info("%s at level %d/%d, seed %d: draw %d of at most %d (%s=%s)%s", name, level, LEVELS, seed,
                        len(draws) - refused + 1, MAX_DRAWS, param, n, _last(draws))
         try:
-            # With people the level is judged on the draw without them, and they are added only to a draw that
-            # landed (see the module): the people are walked once per landed draw, not once per draw.
-            world = generate(name, draw_seed, **{**(_without_people(fixed) if people else fixed), param: n})
+            world = generate(name, draw_seed, **{**drawn, param: n})
         except InfeasibleError:  # too crowded to place or drive: ease off
             draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
             value = max(low, value - step)
             continue
         got = score(world)
-        if people and got["difficulty_level"] == level and people_on is not None:
+        if people and got["difficulty_level"] == level:
             _progress.info("%s at level %d/%d, seed %d: draw %d landed; walking %d people", name, level, LEVELS,
                            seed, len(draws) - refused + 1, params["n_people"])
             with_people = people_on(world, {**fixed, param: n})

@@ -91,7 +91,8 @@ def info_command(pack: Path) -> None:
     levels: dict[str, int] = {}
     for w in p:  # the level each world landed in (metrics.difficulty_level); "none" without a path
         level = w.metrics.get("difficulty_level")
-        levels[str(level) if level is not None else "none"] = levels.get(str(level) if level is not None else "none", 0) + 1
+        key = str(level) if level is not None else "none"
+        levels[key] = levels.get(key, 0) + 1
     if levels:
         order = sorted(levels, key=lambda k: (k == "none", int(k) if k != "none" else 0))
         click.echo("difficulty levels: " + ", ".join(f"{k}: {levels[k]}" for k in order))

@@ -47,7 +47,7 @@ from typing import Any, Mapping, Optional, Sequence
 import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
-from worldgen.feasibility.exact import GRAPH_MAX_CIRCLES, GRAPH_ROWS_PER_QUERY, ExactPlanner, exact_planner
+from worldgen.feasibility.exact import GRAPH_MAX_CIRCLES, ExactPlanner, exact_planner
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.floats import round_float
 from worldgen.people.behaviours import widest_tube
@@ -56,7 +56,7 @@ from worldgen.people.places import PERSON_HEIGHT, SLACK, draw_people, people_foo
 from worldgen.people.reach import Pockets
 from worldgen.scene import Mover, Robot, Scene, Task
 
-__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF", "ROADMAP_ROWS_PER_PERSON_S",
+__all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF",
            "ROADMAP_MAX_CIRCLES", "simulate", "walk_people", "walk_plan"]
 
 #: The integration step (s); the trajectories are written at it.
@@ -77,8 +77,7 @@ STUCK = 0.1
 #: A power of two, so that the choice is the one made with the two figures below before (exactly so wherever
 #: people x seconds is exact in floating point).
 QUERIES_PER_PERSON_S = 0.125
-#: The same break-even per person-second, and the largest space the graph is built for.
-ROADMAP_ROWS_PER_PERSON_S = GRAPH_ROWS_PER_QUERY * QUERIES_PER_PERSON_S
+#: The largest space the graph is built for.
 ROADMAP_MAX_CIRCLES = GRAPH_MAX_CIRCLES
 
 

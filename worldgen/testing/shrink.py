@@ -111,8 +111,9 @@ def shrink(world, still_fails: Callable[[object], bool], out_dir, max_calls: int
     search = _Search(world, still_fails, max_calls)
     movers = [m.name for m in world.scene.movers]
     drop_movers = search.reduce(movers, set(), set(), nodes=False) if movers else set()
-    obstacles = [n.name for n in world.scene.nodes
-                 if n.role == "obstacle" and n.parent is None and not world.scene.children(n.name)]
+    from worldgen.verify.edits import removable
+
+    obstacles = [n.name for n in world.scene.nodes if removable(world.scene, n)]
     drop_nodes = search.reduce(obstacles, set(), drop_movers, nodes=True)
     smallest = search.build(drop_nodes, drop_movers) if (drop_nodes or drop_movers) else world
     path = smallest.write(Path(out_dir))

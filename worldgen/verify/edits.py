@@ -10,7 +10,7 @@ An edit changes one thing of a world's scene or tasks:
 ``move_goal``  a task's goal slides by up to :data:`STEP` m (its tolerance and yaw kept; never nearer the
                spawn than the generator's ``min_spawn_goal_distance``).
 
-Two more operators are never drawn, only recorded by :func:`worldgen.shrink` (:data:`REMOVALS`):
+Two more operators are never drawn, only recorded by :func:`worldgen.shrink`:
 ``remove`` of any root obstacle without children (a mesh too), and ``remove_mover`` of a scripted mover.
 
 Only the root nodes whose role is ``obstacle`` and whose shape is a box or a cylinder are edited (walls,
@@ -41,13 +41,12 @@ from worldgen.scene import Box, Cylinder, Material, Node, Pose, Scene, Task
 from worldgen.seeding import edit_rng
 from worldgen.world import World
 
-__all__ = ["EDITS", "REMOVALS", "STEP", "SCALE", "TRIES", "EditedWorld", "edit_world", "apply_edit", "replay_edits",
+__all__ = ["EDITS", "STEP", "SCALE", "TRIES", "EditedWorld", "edit_world", "apply_edit", "replay_edits", "removable",
            "with_edits", "editable"]
 
 #: The edit operators, in the order their names are drawn from.
 EDITS = ("move", "resize", "add", "remove", "move_goal")
 #: What shrinking records: removing an obstacle (any root obstacle without children) or a scripted mover.
-REMOVALS = ("remove", "remove_mover")
 #: Largest slide of an obstacle or a goal (m): an edit is small next to a room of several metres.
 STEP = 0.5
 #: Range of the factor a resize scales a footprint by.
@@ -162,10 +161,7 @@ def apply_edit(scene: Scene, tasks: Sequence[Task], edit: dict) -> tuple[Scene, 
                      Material(*edit["material"]))
         _inside(node, scene.bounds)
         return scene.with_nodes(nodes + [node]), tasks
-    def removable(n: Node) -> bool:  # shrinking removes any root obstacle that holds nothing
-        return n.role == "obstacle" and n.parent is None and not scene.children(n.name)
-
-    target = removable if op == "remove" else _obstacle
+    target = (lambda n: removable(scene, n)) if op == "remove" else _obstacle
     index = next((i for i, n in enumerate(nodes) if n.name == edit["node"] and target(n)), None)
     if index is None:
         raise ParameterError(f"no obstacle named {edit['node']!r}")
@@ -233,6 +229,11 @@ def _slide(rng: np.random.Generator) -> tuple[float, float]:
     """A displacement uniform in the disc of radius :data:`STEP`."""
     r, a = STEP * math.sqrt(rng.random()), rng.uniform(-math.pi, math.pi)
     return r * math.cos(a), r * math.sin(a)
+
+
+def removable(scene, node: Node) -> bool:
+    """Whether shrinking may remove ``node``: a root obstacle that holds nothing (a mesh too)."""
+    return node.role == "obstacle" and node.parent is None and not scene.children(node.name)
 
 
 def _obstacle(node: Node) -> bool:
