@@ -200,7 +200,7 @@ class Specs:
 
     def _mesh(self, parent, name: str, mesh: Mesh, api: list, rigid: bool):
         prim = self.prim(parent, name, "Mesh", api)
-        points = np.round(mesh.vertices, 6) + 0.0  # + 0.0: no negative zero in the text
+        points = np.round(mesh.vertices, DECIMALS) + 0.0  # + 0.0: no negative zero in the text
         self.attr(prim, "points", "Point3fArray", self.Vt.Vec3fArray.FromNumpy(points.astype(np.float32)))
         self.attr(prim, "faceVertexCounts", "IntArray", self.Vt.IntArray([3] * len(mesh.faces)))
         self.attr(prim, "faceVertexIndices", "IntArray", self.Vt.IntArray.FromNumpy(mesh.faces.reshape(-1).astype(np.int32)))
