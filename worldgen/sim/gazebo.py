@@ -9,8 +9,7 @@ The API (stable; the robot-driving loop builds on it)::
         poses = gz.poses()                            # model name -> (x, y, z, qx, qy, qz, qw)
         gz.spawn(robot_sdf_text, name="robot", pose=(1.0, 2.0, 0.0, 0.3))
         gz.echo("/lidar", n=1)                        # parsed messages (worldgen.sim.textproto)
-        with gz.subscribe("/scan") as scans:          # a subscriber that stays while the world steps
-            gz.step(500); scans.messages()
+        with gz.subscribe("/scan") as scans: ...      # a subscriber kept while the world steps (sim/topics)
     gz.problems()                                     # Gazebo's errors and warnings, known harmless ones removed
 
 - :func:`locate` finds an install (``WORLDGEN_GAZEBO_SETUP``, else ``/opt/gz-fortress2/setup.sh``) and reads its
@@ -214,29 +213,38 @@ class GazeboServer:
         return args + _physics_args(self.install.env) + [str(self.world_sdf)]
 
     def start(self) -> GazeboServer:
-        logdir = Path(self._logdir.name)
-        started = time.monotonic()
-        with open(logdir / "stdout", "wb") as out, open(logdir / "stderr", "wb") as err:
-            self._proc = subprocess.Popen(self.command(), env=self.env, stdin=subprocess.DEVNULL, stdout=out,
-                                          stderr=err, start_new_session=True, cwd=str(self.world_sdf.parent))
-        try:
-            self._wait_up(started)
-        except BaseException:
-            self.stop()
-            raise
-        return self
+        """Start the server and wait for its world; one that runs but has not served it within ``start_timeout``
+        is stopped and started once more (docs/gazebo.md, "A server that hangs")."""
+        logdir, attempt = Path(self._logdir.name), 0
+        while True:
+            attempt, started = attempt + 1, time.monotonic()
+            with open(logdir / "stdout", "wb") as out, open(logdir / "stderr", "wb") as err:
+                self._proc = subprocess.Popen(self.command(), env=self.env, stdin=subprocess.DEVNULL, stdout=out,
+                                              stderr=err, start_new_session=True, cwd=str(self.world_sdf.parent))
+            try:
+                self._wait_up(started)
+            except GazeboError as exc:
+                stuck = self._proc.poll() is None
+                self.stop()
+                if attempt == 1 and stuck:
+                    continue
+                raise GazeboError(f"{exc} (attempt {attempt}; the server was {'running' if stuck else 'gone'})") from None
+            except BaseException:
+                self.stop()
+                raise
+            return self
 
     def _wait_up(self, started: float) -> None:
         """Until the world's scene service answers (it is served once the world is loaded)."""
         while time.monotonic() - started < self.start_timeout:
             if self._proc is None or self._proc.poll() is not None:
                 raise GazeboError(f"Gazebo exited while loading {self.world_sdf}: {self.problems()[:5]}")
-            # One long wait rather than short polls: a requester that gives up before a busy server answers
-            # makes the server print "error sending response: Host unreachable".
+            # Long waits, not short polls (a requester that gives up before a busy server answers makes it print
+            # "error sending response: Host unreachable"); half the time at most, to ask again if a reply is lost.
             remaining = self.start_timeout - (time.monotonic() - started)
             try:
                 reply = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty", "ignition.msgs.Scene",
-                                     "", timeout=max(1.0, remaining))
+                                     "", timeout=max(1.0, min(remaining, self.start_timeout / 2)))
             except GazeboError:
                 continue
             if reply:
@@ -282,10 +290,8 @@ class GazeboServer:
 
     def _state(self) -> str:
         """Whether the server still runs, for an error message: a live server that stopped answering is stuck."""
-        if self._proc is None:
-            return "the server was not started"
-        status = self._proc.poll()
-        if status is not None:
+        status = None if self._proc is None else self._proc.poll()
+        if self._proc is None or status is not None:
             return f"Gazebo exited with status {status}; it said: {self.problems()[-3:]}"
         return "Gazebo still runs but its simulation loop stopped answering; docs/gazebo.md, 'A server that hangs'"
 
