@@ -221,7 +221,7 @@ def people_main(out_dir: str, n_worlds: int) -> int:
     import json
 
     from worldgen.groundtruth.ground import Ground
-    from worldgen.testing.proxemics import social_split
+    from worldgen.judge.proxemics import social_split
 
     out = Path(out_dir)
     bags, touched = [], 0

@@ -35,5 +35,5 @@ def test_docstring_examples_run(name, tmp_path, monkeypatch):
 
 
 def test_the_examples_cover_the_public_entry_points():
-    assert {"worldgen", "worldgen.seeding", "worldgen.testing.oracles", "worldgen.testing.stats",
+    assert {"worldgen", "worldgen.seeding", "worldgen.testing.oracles", "worldgen.judge.stats",
             "worldgen.envs"} <= set(_with_examples())

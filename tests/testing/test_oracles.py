@@ -17,7 +17,7 @@ import worldgen
 from worldgen import oracles
 from worldgen.errors import ParameterError
 from worldgen.presets import generate_preset
-from worldgen.testing.evaluate import evaluate, load_criteria
+from worldgen.judge.evaluate import evaluate, load_criteria
 
 GOAL = (2.0, 2.5)
 REF_LENGTH = math.hypot(*GOAL)

@@ -1,6 +1,6 @@
 """``worldgen compare A B``: two report folders of ``worldgen judge`` (say simulation and real runs) compared.
 
-The statistics are :func:`worldgen.testing.stats.compare_runs`; this module reads the two
+The statistics are :func:`worldgen.judge.stats.compare_runs`; this module reads the two
 report.json files, prints the table (or ``--json``), and turns every bad input into one line
 (:class:`~worldgen.errors.ParameterError`, exit status 2).
 """
@@ -36,7 +36,7 @@ def read_runs(path) -> list[dict]:
     runs = data.get("runs") if isinstance(data, dict) else None
     if not isinstance(runs, list) or not all(isinstance(r, dict) for r in runs):
         raise ParameterError(f"report '{file}' has no list of runs ('runs'); is it a report of 'worldgen judge'?")
-    from worldgen.testing.stats import judged_runs
+    from worldgen.judge.stats import judged_runs
 
     if not judged_runs(runs):
         rows = f"{len(runs)} row{'' if len(runs) == 1 else 's'}"
@@ -56,7 +56,7 @@ def _p(x: Optional[float]) -> str:
 
 
 def format_comparison(result: dict, name_a: str, name_b: str) -> str:
-    """The readable table of a :func:`~worldgen.testing.stats.compare_runs` result."""
+    """The readable table of a :func:`~worldgen.judge.stats.compare_runs` result."""
     s = result["success"]
     conf = f"{result['confidence']:.0%}"
     unjudged = result["unjudged"]
@@ -116,7 +116,7 @@ def compare_command(a: Path, b: Path, as_json: bool, confidence: float) -> None:
       worldgen compare reports/sim reports/real
       worldgen compare reports/sim reports/real --json > comparison.json
     """
-    from worldgen.testing.stats import compare_runs
+    from worldgen.judge.stats import compare_runs
 
     runs_a, runs_b = read_runs(a), read_runs(b)
     result = compare_runs(runs_a, runs_b, confidence=confidence)

@@ -23,7 +23,7 @@ open, as the world's truth plans through doors at their open limit: a contact
 with a leaf is no collision; it goes to ``door_contacts`` instead (the same
 ``{time, entity}`` records), and it neither ends the episode nor fails it. One push is one door contact:
 MuJoCo makes and breaks the contact many times while a leaf gives way, so a touch of a leaf that begins
-within :data:`~worldgen.testing.figures.DOOR_DEBOUNCE` (2 s of simulated time) of the last physics step
+within :data:`~worldgen.judge.figures.DOOR_DEBOUNCE` (2 s of simulated time) of the last physics step
 touching that leaf continues the same door contact, as the oracles count them. ``doors_opened`` lists the
 automatic doors the robot triggered (:mod:`worldgen.envs.doors`), ``{time, entity}`` with the leaf's name.
 """
@@ -34,7 +34,7 @@ from typing import Optional
 
 import numpy as np
 
-from worldgen.testing.figures import DOOR_DEBOUNCE, Contact
+from worldgen.judge.figures import DOOR_DEBOUNCE, Contact
 
 __all__ = ["Episode", "spl"]
 
@@ -97,7 +97,7 @@ class Episode:
 
     def figures(self) -> dict:
         """The figures of the run so far, under the oracles' names (see the module's docstring)."""
-        from worldgen.testing import figures as oracles
+        from worldgen.judge import figures as oracles
 
         ground = self._as_walked(self.world.ground())
         traj = self.trajectory
@@ -117,13 +117,13 @@ class Episode:
             max_velocity=float((step[moving] / dt[moving]).max()) if np.any(moving) else 0.0,
             door_contacts=tuple(self.door_contacts))
         limit: Optional[float] = task.get("time_limit")
-        # evaluate's rule (worldgen.testing.evaluate): the goal, within the scenario's max_time, and no collision.
+        # evaluate's rule (worldgen.judge.evaluate): the goal, within the scenario's max_time, and no collision.
         ok = bool(run.reached_goal and not run.collisions and (limit is None or run.time_to_goal <= limit))
         out = run.as_dict()
         out.update(success=ok, spl=spl(ok, ref, length), reference_path_length=ref,
                    doors_opened=[{"time": c.time, "entity": c.entity} for c in self.door_openings])
         if ground.meta.get("people"):
-            from worldgen.testing.proxemics import social_split
+            from worldgen.judge.proxemics import social_split
 
             out["social"] = social_split(traj, ground)
             out["people_clips"] = dict(self.walkers.clips) if self.walkers is not None else {}

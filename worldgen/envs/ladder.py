@@ -49,7 +49,7 @@ def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int]
 
 def ladder_figures(table: Mapping[int, Sequence[bool]]) -> dict:
     """Spearman's rho of per-level success against level, and per level: worlds, successes, rate, Wilson 95 %."""
-    from worldgen.testing.stats import require_scipy, wilson_interval
+    from worldgen.judge.stats import require_scipy, wilson_interval
 
     levels = sorted(table)
     rows = {}

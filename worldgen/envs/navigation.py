@@ -83,8 +83,8 @@ from worldgen.envs.reward import StepOutcome, reward
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.envs.source import PackSource, make_source
 from worldgen.errors import CallOrderError, ParameterError
+from worldgen.judge.figures import Contact
 from worldgen.seeding import check_seed, draw_seed, env_rngs
-from worldgen.testing.figures import Contact
 
 gym = require_gymnasium()
 

@@ -39,7 +39,7 @@ import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError, read_user_text
 from worldgen.files import MANIFEST_NAME, METADATA_NAME
-from worldgen.testing.figures import Ground
+from worldgen.judge.figures import Ground
 
 __all__ = ["Item", "JudgeResult", "judge", "plan", "PLOT_POINTS", "DEFAULT_CRITERIA"]
 
@@ -67,7 +67,7 @@ class _WorldGround(Ground):
     as they are, evaluate reads its scenario.yaml, and one batch builds each world's colliders once."""
 
     def __init__(self, folder: Path):
-        from worldgen.testing.figures import load
+        from worldgen.judge.figures import load
 
         base = load(folder)
         super().__init__(base.meta, read=base._read)
@@ -208,7 +208,7 @@ def _run_name(world_id: str, task: str, index: Optional[str], taken: set[str]) -
 def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, runs=None,
           start: str = "command", read_options: Optional[dict] = None,
           progress: Optional[Callable[[int], None]] = None) -> JudgeResult:
-    """Read every bag, judge the readable runs with :func:`worldgen.testing.evaluate.evaluate`, and return the report.
+    """Read every bag, judge the readable runs with :func:`worldgen.judge.evaluate.evaluate`, and return the report.
 
     ``read_options`` go to :func:`worldgen.ros.reader.read_run` (topic and frame names,
     ``spawn_tolerance``, ``distro``...). ``progress(k)`` is called after each bag. Without
@@ -217,8 +217,8 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     ``failure`` (judged, and it failed: a run that started far from its spawn or names another world
     too) or ``unjudged`` (the bag could not be read, or its world not found: no verdict at all).
     """
+    from worldgen.judge.evaluate import evaluate, load_criteria
     from worldgen.ros.reader import RunMismatchError, peek_metadata, read_run
-    from worldgen.testing.evaluate import evaluate, load_criteria
 
     if criteria is None:
         criteria = DEFAULT_CRITERIA

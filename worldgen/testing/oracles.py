@@ -14,16 +14,16 @@
     >>> report.passed
     True
 
-The public face of two modules: :mod:`worldgen.testing.figures` (each figure of
+The public face of two modules: :mod:`worldgen.judge.figures` (each figure of
 one run: trajectories, worlds and tasks as accepted there) and
-:mod:`worldgen.testing.evaluate` (many runs judged against acceptance criteria).
+:mod:`worldgen.judge.evaluate` (many runs judged against acceptance criteria).
 """
 
 from __future__ import annotations
 
 from worldgen.groundtruth.ground import Ground, as_trajectory, load
-from worldgen.testing.evaluate import evaluate
-from worldgen.testing.figures import (
+from worldgen.judge.evaluate import evaluate
+from worldgen.judge.figures import (
     DOOR_DEBOUNCE,
     Contact,
     Run,
@@ -38,8 +38,8 @@ from worldgen.testing.figures import (
     run,
     time_to_goal,
 )
-from worldgen.testing.proxemics import ZONES, social_split
-from worldgen.testing.social import PERSONAL_SPACE, min_person_distance, min_time_to_collision, personal_space_time
+from worldgen.judge.proxemics import ZONES, social_split
+from worldgen.judge.social import PERSONAL_SPACE, min_person_distance, min_time_to_collision, personal_space_time
 
 __all__ = [
     "Ground", "Contact", "Run", "load", "as_trajectory",

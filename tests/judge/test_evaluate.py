@@ -14,9 +14,9 @@ import pytest
 
 import worldgen
 from worldgen.errors import ParameterError
+from worldgen.judge.evaluate import evaluate, load_criteria
+from worldgen.judge.figures import barn_score
 from worldgen.presets import generate_preset
-from worldgen.testing.evaluate import evaluate, load_criteria
-from worldgen.testing.figures import barn_score
 
 REF = math.hypot(2.0, 2.5)
 

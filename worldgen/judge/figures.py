@@ -25,8 +25,8 @@ import numpy as np
 
 from worldgen.errors import ParameterError
 from worldgen.groundtruth.ground import Ground, as_trajectory, leaves_of, load
-from worldgen.testing.proxemics import social_split
-from worldgen.testing.social import disc_gaps, discs, social_figures, timed_samples
+from worldgen.judge.proxemics import social_split
+from worldgen.judge.social import disc_gaps, discs, social_figures, timed_samples
 
 __all__ = [
     "Contact", "Run",
@@ -197,7 +197,7 @@ def min_separation(trajectory, world) -> Optional[float]:
 
 @dataclass(frozen=True)
 class Run:
-    """Every figure of one run in one world, as :func:`worldgen.testing.evaluate.evaluate` tabulates them."""
+    """Every figure of one run in one world, as :func:`worldgen.judge.evaluate.evaluate` tabulates them."""
 
     world_id: str
     task: str
@@ -214,13 +214,13 @@ class Run:
     reference_length: Optional[float] = None
     #: Contacts with door leaves (pushed open: not collisions).
     door_contacts: tuple[Contact, ...] = ()
-    #: With people (worldgen.testing.social): the smallest gap to one (m), the seconds spent in a
+    #: With people (worldgen.judge.social): the smallest gap to one (m), the seconds spent in a
     #: person's personal space, the smallest time to collision with one (s; None: never on course).
     min_person_distance: Optional[float] = None
     personal_space_time: Optional[float] = None
     min_time_to_collision: Optional[float] = None
     #: With people: the figures users compare across tools, split by behaviour
-    #: (:func:`worldgen.testing.proxemics.social_split`); left out of :meth:`as_dict` without people.
+    #: (:func:`worldgen.judge.proxemics.social_split`); left out of :meth:`as_dict` without people.
     social: Optional[dict] = None
 
     def as_dict(self) -> dict[str, Any]:

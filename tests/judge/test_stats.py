@@ -1,4 +1,4 @@
-"""worldgen.testing.stats against reference values: known binomial bounds, scipy on fixed samples, and an
+"""worldgen.judge.stats against reference values: known binomial bounds, scipy on fixed samples, and an
 independent computation from first principles (binomial and hypergeometric sums with math.comb) where cheap."""
 
 import math
@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from worldgen.errors import MissingDependencyError, ParameterError
-from worldgen.testing import stats
+from worldgen.judge import stats
 
 
 def binomial_tail_at_least(k, n, p):

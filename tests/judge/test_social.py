@@ -1,4 +1,4 @@
-"""The social-navigation figures (worldgen.testing.social) against hand-checked cases, and the oracles
+"""The social-navigation figures (worldgen.judge.social) against hand-checked cases, and the oracles
 in worlds with movers and people together."""
 
 from __future__ import annotations
@@ -9,7 +9,7 @@ import pytest
 import worldgen
 from worldgen import oracles
 from worldgen.groundtruth.ground import Ground
-from worldgen.testing import social
+from worldgen.judge import social
 
 #: A person of radius 0.25 walking from (5, 0) to (0, 0) at 1 m/s, then waiting there; robot radius 0.2.
 META = {"robot": {"radius": 0.2, "height": 0.4, "clearance": 0.05},

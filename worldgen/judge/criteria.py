@@ -7,7 +7,7 @@
                  from movers), collision_tolerance (<=, total contacts), max_velocity (<=, m/s)
     performance: max_time (<=, s, slowest successful run), avg_time_to_goal (<=, s, mean over
                  successes), barn_score (>=, mean BARN Challenge score over all runs, failures 0)
-    social:      with people (worldgen.testing.social): min_person_distance (>=, m, smallest gap over
+    social:      with people (worldgen.judge.social): min_person_distance (>=, m, smallest gap over
                  all runs), personal_space_time (<=, s, the longest of a run), min_time_to_collision
                  (>=, s, smallest over all runs); each holds in a world without people
     scoring:     settings, not criteria: barn_k (the BARN score's lower clip, optimal times) and
@@ -24,7 +24,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 from worldgen.errors import ParameterError
-from worldgen.testing.figures import BARN_K, BARN_REFERENCE_SPEED
+from worldgen.judge.figures import BARN_K, BARN_REFERENCE_SPEED
 
 __all__ = ["CRITERIA", "SCORING", "DEFAULT_CONFIDENCE", "load_criteria"]
 

@@ -7,12 +7,12 @@ Usage (an example that runs is in :mod:`worldgen.testing.oracles`)::
     report.passed, report.failures
     report.write_csv("report.csv"); report.write_json("report.json")
 
-The criteria file's sections and keys are in :mod:`worldgen.testing.criteria`.
+The criteria file's sections and keys are in :mod:`worldgen.judge.criteria`.
 What is averaged over what, so that a crash cannot flatter a figure:
 
 - success rate: every run; in its confidence form (``success_rate: {min: 0.95, confidence: 0.95}``)
   the one-sided Clopper-Pearson lower bound must reach ``min``, and the report says how many more
-  clean runs would get it there (:mod:`worldgen.testing.stats`);
+  clean runs would get it there (:mod:`worldgen.judge.stats`);
 - path efficiency and time to goal: successful runs only, as BARN and Arena average them (a run
   that crashed at 65 % of the path is short, not efficient);
 - BARN score: every run, failures scoring 0; clearance, contacts, speed: every run.
@@ -37,9 +37,9 @@ from typing import Any, Iterable, Mapping, Optional, Union
 from worldgen.errors import ParameterError
 from worldgen.files import SCENARIO_NAME
 from worldgen.groundtruth.ground import load
-from worldgen.testing.criteria import CRITERIA, SCORING, load_criteria
-from worldgen.testing.figures import Run, barn_score
-from worldgen.testing.figures import run as run_figures
+from worldgen.judge.criteria import CRITERIA, SCORING, load_criteria
+from worldgen.judge.figures import Run, barn_score
+from worldgen.judge.figures import run as run_figures
 
 __all__ = ["CRITERIA", "AVERAGED_OVER", "Criterion", "Report", "load_criteria", "evaluate", "scenario_of"]
 
@@ -337,7 +337,7 @@ def evaluate(runs: Iterable, criteria, *, barn_k: Optional[float] = None,
 
 
 def _bound_verdict(section: str, key: str, op: str, need: dict, k: int, n: int) -> Criterion:
-    from worldgen.testing.stats import success_bound
+    from worldgen.judge.stats import success_bound
 
     b = success_bound(k, n, need["min"], need["confidence"])
     return Criterion(section, key, op, need["min"], b["lower_bound"], b["passed"], b["lower_bound"] - need["min"],

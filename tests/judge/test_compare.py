@@ -9,8 +9,8 @@ import scipy.stats
 from support.cli import run
 
 import worldgen
+from worldgen.judge.evaluate import evaluate
 from worldgen.presets import generate_preset
-from worldgen.testing.evaluate import evaluate
 
 NOTE = ("A large p-value means these runs cannot tell A and B apart, not that A and B are the same; "
         "a small one means a difference this large would be rare if they were.")
