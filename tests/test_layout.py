@@ -283,3 +283,42 @@ def test_random_streams_are_made_only_in_seeding_py():
              for i, line in enumerate(path.read_text().splitlines(), 1) if made.search(line)]
     assert not found, "random streams made outside seeding.py:\n" + "\n".join(found)
 
+
+# -- judging in the judge's room --------------------------------------------------------------------------
+
+#: The judging: one run's figures, the criteria, many runs evaluated, the statistics. They live in judge/;
+#: testing/ (the test author's face) only imports them.
+JUDGING = ("criteria", "evaluate", "figures", "proxemics", "social", "stats")
+
+
+def test_the_judging_lives_in_the_judges_room():
+    for name in JUDGING:
+        assert (PACKAGE / "judge" / f"{name}.py").is_file(), f"worldgen/judge/{name}.py is missing"
+        assert not (PACKAGE / "testing" / f"{name}.py").exists(), \
+            f"worldgen/testing/{name}.py: the judging lives in judge/ (the old name imports through testing/__init__)"
+
+
+def test_judging_is_taken_from_the_judge_never_from_testing():
+    """testing/ comes after judge/ and imports it; the rooms that use a run's figures, the criteria or the
+    statistics to do their own work (the judge itself, the environment, the simulators) take them from judge/."""
+    found = [f"{a} -> {b}" for a, targets in sorted(import_graph().items()) for b in sorted(targets)
+             if room_of(a) in {"judge", "envs", "sim"} and room_of(b) == "testing"]
+    assert not found, "take the judging from worldgen.judge, not worldgen.testing:\n" + "\n".join(found)
+    assert rank("judge") < rank("testing")
+
+
+def test_the_package_never_imports_the_judgings_old_names():
+    """worldgen.testing.stats and its kind still import for users, with a DeprecationWarning; the package itself
+    uses the new names, or every run would warn."""
+    old = {f"worldgen.testing.{name}" for name in JUDGING}
+    found = []
+    for name, path in sorted(modules().items()):
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.Import):
+                named = {alias.name for alias in node.names}
+            elif isinstance(node, ast.ImportFrom) and not node.level:
+                named = {node.module or ""} | {f"{node.module}.{alias.name}" for alias in node.names}
+            else:
+                continue
+            found += [f"{path.relative_to(PACKAGE.parent)}:{node.lineno} {n}" for n in sorted(named & old)]
+    assert not found, "import these from worldgen.judge:\n" + "\n".join(found)
