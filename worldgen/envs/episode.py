@@ -1,11 +1,11 @@
 """One episode's record, and its figures under the oracles' names once it ends.
 
-The record is the run as :mod:`worldgen.testing.oracles` takes it: ``t, x, y, yaw``
+The record is the run as the judge takes it (:mod:`worldgen.judge.figures`): ``t, x, y, yaw``
 rows, one at the reset and one after every env step, plus every MuJoCo contact
-of the robot (one :class:`~worldgen.testing.oracles.Contact` per contact that begins,
-naming the entity touched, as :func:`worldgen.testing.oracles.collisions` reports them).
+of the robot (one :class:`~worldgen.judge.figures.Contact` per contact that begins,
+naming the entity touched, as :func:`worldgen.judge.figures.collisions` reports them).
 
-:meth:`Episode.figures` gives the keys of :class:`worldgen.testing.oracles.Run`
+:meth:`Episode.figures` gives the keys of :class:`worldgen.judge.figures.Run`
 (``world_id``, ``task``, ``reached_goal``, ``time_to_goal``, ``duration``,
 ``path_length``, ``path_efficiency``, ``min_clearance``, ``collisions``,
 ``min_separation``, ``max_velocity``; ``collisions`` as ``Run.as_dict`` writes

@@ -3,7 +3,7 @@
 A source hands the environment one :class:`EpisodeWorld` per episode: the
 world's MJCF as an lxml element (the env adds its robot to it), the footprint,
 the task as world.json describes it, the movers, and lazy access to the
-oracles' :class:`~worldgen.testing.oracles.Ground` and to world.json (for drawing).
+oracles' :class:`~worldgen.groundtruth.ground.Ground` and to world.json (for drawing).
 
 - :class:`GeneratorSource`: ``worldgen.generate(generator, seed, **params)`` in
   memory, a new seed per episode; nothing touches the disk. A preset is a
