@@ -16,8 +16,8 @@ import yaml
 import worldgen
 from worldgen import oracles
 from worldgen.errors import ParameterError
-from worldgen.presets import generate_preset
 from worldgen.judge.evaluate import evaluate, load_criteria
+from worldgen.presets import generate_preset
 
 GOAL = (2.0, 2.5)
 REF_LENGTH = math.hypot(*GOAL)
