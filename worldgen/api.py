@@ -13,7 +13,6 @@ from typing import Any
 
 from worldgen.errors import ParameterError
 from worldgen.generators import get
-from worldgen.leveling import generate_at_level
 from worldgen.pipeline import first_feasible, prepare
 from worldgen.seeding import check_seed
 from worldgen.world import World
@@ -37,5 +36,9 @@ def generate(name: str, seed: int = 0, *, allow_infeasible: bool = False, diffic
     if difficulty is not None:
         if allow_infeasible:
             raise ParameterError("parameter 'difficulty' asks for a drivable world; it excludes allow_infeasible")
+        # Imported here, on the first level request: its scoring pulls in the ground truth, which a plain
+        # request does not need before its world is written.
+        from worldgen.leveling import generate_at_level
+
         return generate_at_level(spec, seed, difficulty, params)
     return first_feasible(prepare(spec, seed, params, allow_infeasible=allow_infeasible))
