@@ -5,7 +5,8 @@
 For every level 1..10 and seeds 0..N-1 (default 10: 100 requests), ``worldgen.generate("cluttered", seed,
 difficulty="k/10", size=[X, Y])`` (default 20 x 20 m, the issue's target room), timed with
 time.perf_counter (draws that missed included). Each request is timed twice, interleaved so both see the
-same machine load: with the shipped calibration (``leveling.START``) and with :data:`PREVIOUS_START`, the
+same machine load: with the shipped calibration (the cluttered spec's knob, ``worldgen.generators.cluttered.KNOB``)
+and with :data:`PREVIOUS_START`, the
 calibration before it, so a change of calibration is measured in one run. Targets (issue 19): at least
 95 % of requests land, at a median of at most 5 draws; a world at a level in at most 50 ms median. The
 table goes to stdout, the figures to benchmarks/results/leveling.json.
@@ -26,14 +27,14 @@ RESULTS = Path(__file__).resolve().parent / "results" / "leveling.json"
 PREVIOUS_START = (0.0, 10.0, 20.0, 30.0, 35.0, 40.0, 45.0, 55.0, 65.0, 75.0)
 
 
-def _request(level: int, seed: int, size) -> dict:
-    import worldgen
+def _request(spec, level: int, seed: int, size) -> dict:
     from worldgen.errors import InfeasibleError
-    from worldgen.leveling import LEVELS, MAX_DRAWS
+    from worldgen.leveling import LEVELS, MAX_DRAWS, generate_at_level
 
     t0 = time.perf_counter()
     try:
-        world = worldgen.generate("cluttered", seed, difficulty=f"{level}/{LEVELS}", size=list(size))
+        # The request worldgen.generate makes for difficulty=, with the calibration under test in its spec.
+        world = generate_at_level(spec, seed, f"{level}/{LEVELS}", {"size": list(size)})
         landed, draws = True, len(world.difficulty_request["draws"])
     except InfeasibleError:
         landed, draws = False, MAX_DRAWS
@@ -49,25 +50,24 @@ def _summary(rows: list[dict]) -> dict:
 
 def main(argv=None) -> int:
     from worldgen import leveling
+    from worldgen.generators import get
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--size", type=float, nargs=2, default=[20.0, 20.0], metavar=("X", "Y"))
     args = ap.parse_args(argv)
-    shipped = leveling.KNOBS["cluttered"]
-    calibrations = {"current": shipped, "previous": dataclasses.replace(shipped, start=PREVIOUS_START)}
+    shipped = get("cluttered")
+    assert shipped.knob is not None
+    calibrations = {"current": shipped,
+                    "previous": dataclasses.replace(shipped, knob=dataclasses.replace(shipped.knob, start=PREVIOUS_START))}
     rows: dict[str, list] = {name: [] for name in calibrations}
     print(f"cluttered {args.size[0]:g} x {args.size[1]:g} m; per calibration: landed, median draws, median ms")
     print("level  " + "  ".join(f"{name:>24s}" for name in calibrations))
     for level in range(1, leveling.LEVELS + 1):
         cells = []
         for seed in range(args.seeds):
-            for name, knob in calibrations.items():  # interleaved: both see the same load
-                leveling.KNOBS["cluttered"] = knob
-                try:
-                    rows[name].append(_request(level, seed, args.size))
-                finally:
-                    leveling.KNOBS["cluttered"] = shipped
+            for name, spec in calibrations.items():  # interleaved: both see the same load
+                rows[name].append(_request(spec, level, seed, args.size))
         for name in calibrations:
             runs = [r for r in rows[name] if r["level"] == level]
             s = _summary(runs)

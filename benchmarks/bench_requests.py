@@ -135,7 +135,7 @@ def _value(p, rng: random.Random):
 
 def _request(rng: random.Random, specs, presets) -> tuple[str, dict, dict]:
     """(label, generate's keyword arguments, the parameters drawn) of one random request."""
-    from worldgen.leveling import KNOBS, reachable
+    from worldgen.leveling import reachable
 
     if rng.random() < 0.2 and presets:
         preset = rng.choice(presets)
@@ -154,9 +154,9 @@ def _request(rng: random.Random, specs, presets) -> tuple[str, dict, dict]:
     if rng.random() < 0.25:
         drawn["n_people"] = rng.randint(1, 20)
     kwargs = {**params, **drawn}
-    if name in KNOBS and rng.random() < 1 / 3:
+    if spec.knob is not None and rng.random() < 1 / 3:
         kwargs["difficulty"] = f"{rng.choice(reachable(name))}/10"
-        for owned in KNOBS[name].owned():
+        for owned in spec.knob.owned():
             kwargs.pop(owned, None)
     return label, {"name": name, **kwargs}, drawn
 

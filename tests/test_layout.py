@@ -137,7 +137,7 @@ def test_tests_mirror_the_package_and_share_helpers_only_through_support():
 #: Top-level modules are rooms of their own. Rooms on one rank may not import each other.
 FLOW = [
     {"errors"}, {"floats", "files", "seeding", "schema"}, {"params"}, {"scene"}, {"generators"}, {"feasibility"},
-    {"groundtruth"}, {"people"}, {"export"}, {"ros"}, {"world"}, {"leveling"}, {"api"}, {"presets"},
+    {"groundtruth"}, {"people"}, {"export"}, {"ros"}, {"world"}, {"pipeline"}, {"leveling"}, {"api"}, {"presets"},
     {"verify"}, {"pack"}, {"judge"}, {"testing"}, {"envs"}, {"sim"}, {"cli"}, {"__main__"},
 ]
 MAX_TOP_LEVEL = 10
@@ -322,3 +322,72 @@ def test_the_package_never_imports_the_judgings_old_names():
                 continue
             found += [f"{path.relative_to(PACKAGE.parent)}:{node.lineno} {n}" for n in sorted(named & old)]
     assert not found, "import these from worldgen.judge:\n" + "\n".join(found)
+
+
+# -- the level request as a visible call (issue 35, item 4) --------------------------------------------
+
+#: leveling answers the names it held before the knobs moved into the generators' specs through a module
+#: ``__getattr__`` (with a DeprecationWarning), whose protocol is an AttributeError for any other name.
+BUILTIN_RAISES_ALLOWED[("leveling.py", "AttributeError")] = "a module's __getattr__ protocol (moved names, deprecated)"
+
+
+def _functions_passed_as_arguments(text: str, where: str) -> list[str]:
+    """Calls in module source ``text`` that hand over one of the module's own functions as an argument."""
+    tree = ast.parse(text)
+    own = {n.name for n in tree.body if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))}
+    return [f"{where}:{node.lineno} passes {arg.id}"
+            for node in ast.walk(tree) if isinstance(node, ast.Call)
+            for arg in [*node.args, *(k.value for k in node.keywords)] if isinstance(arg, ast.Name) and arg.id in own]
+
+
+def _callable_parameters(text: str, where: str) -> list[str]:
+    """Parameters of the functions in module source ``text`` annotated as callables (a callback coming in)."""
+    out = []
+    for node in ast.walk(ast.parse(text)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            for arg in [*node.args.posonlyargs, *node.args.args, *node.args.kwonlyargs]:
+                if arg.annotation is not None and "Callable" in ast.unparse(arg.annotation):
+                    out.append(f"{where}:{node.lineno} {node.name}({arg.arg})")
+    return out
+
+
+def test_a_level_request_calls_the_pipeline_itself():
+    """A level request draws each world through worldgen.pipeline, which it imports: the edge is in the import
+    graph. generate hands nothing to it to be called back, and it takes no callable."""
+    graph = import_graph()
+    assert any(t == "worldgen.pipeline" or t.startswith("worldgen.pipeline.") for t in graph["worldgen.leveling"])
+    assert "worldgen.leveling" in graph["worldgen.api"]
+    found = _functions_passed_as_arguments((PACKAGE / "api.py").read_text(), "worldgen/api.py") + \
+        _callable_parameters((PACKAGE / "leveling.py").read_text(), "worldgen/leveling.py")
+    assert not found, "a callback between api and leveling (call the pipeline instead):\n" + "\n".join(found)
+
+
+def test_the_callback_finders_find_a_callback():
+    text = "from typing import Callable\ndef f(x): pass\ndef g(cb: Callable, n: int):\n    g(f, 1)\n    g(cb=f, n=2)\n"
+    assert _functions_passed_as_arguments(text, "m.py") == ["m.py:4 passes f", "m.py:5 passes f"]
+    assert _callable_parameters(text, "m.py") == ["m.py:3 g(cb)"]
+    assert _functions_passed_as_arguments("def f(): pass\nprint(len([]))\n", "m.py") == []
+
+
+def test_every_generator_declares_its_difficulty_knob_beside_its_parameters():
+    """Each built-in generator's spec says how a level request turns it (``knob=``) or why it cannot
+    (``no_levels=``), in its own module; no other module makes a Knob, so there is no table to keep in step."""
+    from worldgen.generators import all_specs
+
+    undeclared, elsewhere = [], []
+    for name, path in sorted(modules().items()):
+        tree = ast.parse(path.read_text())
+        in_generators = name.startswith("worldgen.generators.")
+        for node in ast.walk(tree):
+            if not isinstance(node, ast.Call):
+                continue
+            called = node.func.id if isinstance(node.func, ast.Name) else getattr(node.func, "attr", None)
+            if called == "Knob" and not in_generators:
+                elsewhere.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno}")
+            if called == "GeneratorSpec" and in_generators and \
+                    not {k.arg for k in node.keywords} & {"knob", "no_levels"}:
+                undeclared.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno}")
+    assert not undeclared, "generator specs without knob= or no_levels=:\n" + "\n".join(undeclared)
+    assert not elsewhere, "knobs made outside the generators they turn:\n" + "\n".join(elsewhere)
+    for spec in all_specs():
+        assert (spec.knob is None) == bool(spec.no_levels), spec.name

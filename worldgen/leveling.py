@@ -5,20 +5,24 @@ of :mod:`worldgen.groundtruth.difficulty`). A request draws worlds until one
 lands in the level, each draw a whole world of its own:
 
 - draw ``k``'s seed is :func:`worldgen.seeding.level_seed` ``(seed, k)``;
-- its knob (:data:`KNOBS`: a parameter per generator, e.g. the cluttered
-  generator's ``n_obstacles`` scaled by the floor area, the corridor's
-  ``n_obstacles`` with its ``shape`` set by level, the door world's ``n_doors``
-  with its doors' ``state`` set by level) starts at the level's calibrated
-  value and moves after every draw by the knob's step times the levels it
-  missed by (up for too easy, down for too hard), within the knob's bounds;
+- its knob (the ``knob`` the generator's spec declares beside its parameters,
+  :class:`worldgen.generators.Knob`: e.g. the cluttered generator's
+  ``n_obstacles`` scaled by the floor area, the corridor's ``n_obstacles`` with
+  its ``shape`` set by level, the door world's ``n_doors`` with its doors'
+  ``state`` set by level) starts at the level's calibrated value and moves
+  after every draw by the knob's step times the levels it missed by (up for
+  too easy, down for too hard), within the knob's bounds;
+- each draw is one request of :mod:`worldgen.pipeline` (attempts until one is
+  kept), called from here, as ``worldgen.generate`` calls it;
 - the first draw whose level is the one asked for is the world; after
   :data:`MAX_DRAWS` misses the request is an InfeasibleError naming the levels
   reached. A level a generator cannot reach (:func:`reachable`; ``worldgen list
-GENERATOR`` prints it) and a generator without a knob (:data:`NO_LEVELS`) are
-refused up front in one line.
+GENERATOR`` prints it) and a generator without a knob (its spec's ``no_levels``
+says why) are refused up front in one line.
 
 With people (``n_people``) a draw is judged on its world without them (``n_people=0``; the level never
-reads the people) and the people are walked only on a draw that landed, on the attempt it landed on; where
+reads the people) and the people are walked only on a draw that landed, on the attempt it landed on
+(:func:`worldgen.pipeline.attempt` of that number, with the people's parameters); where
 they refuse it (no timed path) the draw is recorded with no level and the next draw keeps the knob. Such
 refusals have their own budget of :data:`MAX_DRAWS` beside the misses' (docs/metrics.md). Walking them on
 every attempt of every draw made a 10-draw request 133 s of CPU.
@@ -34,109 +38,50 @@ from __future__ import annotations
 
 import logging
 import re
-from dataclasses import dataclass
-from typing import Any, Callable, Mapping, Optional
+import warnings
+from typing import Any, Mapping
 
 from worldgen.errors import InfeasibleError, ParameterError, quoted
+from worldgen.export.tasks import leaves_on_path
 from worldgen.floats import finite_or_none
+from worldgen.generators import LEVELS, GeneratorSpec, Knob, all_specs, get
 from worldgen.groundtruth import difficulty, truth
+from worldgen.pipeline import attempt, first_feasible, prepare
 from worldgen.seeding import level_seed
+from worldgen.world import World
 
 #: Where a long request says what it is doing (worldgen.cli.progress shows it on a terminal; nothing else does).
 _progress = logging.getLogger("worldgen.progress")
 
-__all__ = ["LEVELS", "MAX_DRAWS", "STEP", "START", "MAX_KNOB", "Knob", "KNOBS", "NO_LEVELS", "reachable",
-           "describe_levels", "parse_level", "check_request", "score", "generate_at_level"]
+__all__ = ["LEVELS", "MAX_DRAWS", "reachable", "describe_levels", "parse_level", "check_request", "score",
+           "generate_at_level"]
 
-#: Levels of world.json's ``difficulty_level``.
-LEVELS = 10
 #: Draws a request may make before it gives up.
 MAX_DRAWS = 40
-#: Obstacles (per 100 m^2) the cluttered knob moves per level missed.
-STEP = 4.0
-#: Most obstacles per 100 m^2 a cluttered draw may ask for.
-MAX_KNOB = 120.0
-#: Obstacles per 100 m^2 of floor the first cluttered draw for each level asks for (levels 1..10). Calibrated on
-#: default 10 x 10 m cluttered rooms: about the median obstacle count of the worlds that landed in each level
-#: (requests with seeds 100-111; the first calibration, 0, 10, 20, 30, 35, 40, 45, 55, 65, 75, left level 9
-#: at a median of 77 obstacles, above level 10's 75).
-START = (0.0, 8.0, 17.0, 23.0, 31.0, 36.0, 41.0, 50.0, 70.0, 78.0)
 
 
-@dataclass(frozen=True)
-class Knob:
-    """How one generator is turned towards a level: the parameter a request sets draw by draw.
-
-    ``start[level - 1]`` is the first draw's value for that level, None where the generator cannot reach the
-    level (a request for it is refused up front). After a draw that misses, the value moves by ``step`` per
-    level missed (up for a world too easy), within [``low``, ``high``]; a draw the generator cannot build
-    (InfeasibleError: too crowded) moves it ``step`` down. ``per_area``: ``start``, ``step`` and ``high`` are
-    per 100 m^2 of the request's ``size``. ``fixed`` sets further parameters by level: (first level, last
-    level, {parameter: value}). The request sets the knob, every ``fixed`` parameter and ``excludes``; the
-    caller leaves them out.
-    """
-
-    param: str
-    start: tuple[Optional[float], ...]
-    step: float
-    high: float
-    low: float = 0.0
-    per_area: bool = False
-    fixed: tuple[tuple[int, int, Mapping[str, Any]], ...] = ()
-    excludes: tuple[str, ...] = ()
-    integer: bool = True
-
-    def value(self, x: float):
-        """The parameter's value for the knob's position ``x``: a whole number for an integer knob."""
-        return int(round(x)) if self.integer else round(float(x), 6)
-
-    def sets(self, level: int) -> dict:
-        """The parameters besides the knob a request for ``level`` sets."""
-        return {k: v for lo, hi, values in self.fixed if lo <= level <= hi for k, v in values.items()}
-
-    def owned(self) -> tuple[str, ...]:
-        """Every parameter a request sets (the caller must leave them out)."""
-        names = [self.param, *(k for _, _, values in self.fixed for k in values), *self.excludes]
-        return tuple(dict.fromkeys(names))
-
-
-#: The generators that can be asked for a level, and how each is turned. Calibrations (``start``): the
-#: value whose worlds' median level is the level, measured with seeds the tests do not use (docs/metrics.md).
-#: Every registered generator is a row here or in :data:`NO_LEVELS` (tests/test_leveling.py holds it).
-KNOBS: dict[str, Knob] = {
-    "cluttered": Knob("n_obstacles", START, STEP, MAX_KNOB, per_area=True, excludes=("density",)),
-    # Straight corridors with more and more obstacles, then an L, then a U bend (two turns).
-    "corridor": Knob("n_obstacles", (0, 3, 4, 5, 6, 0, 1, 4, 0, 2), 1.0, 6.0,
-                     fixed=((1, 5, {"shape": "straight"}), (6, 8, {"shape": "L"}), (9, 10, {"shape": "U"}))),
-    # Open doors (rooms in a row) up to level 5, closed leaves to push from level 6.
-    "door": Knob("n_doors", (None, 1, 1, 1, 1, 1, 1, 1, 2, 4), 1.0, 5.0, low=1.0,
-                 fixed=((1, 5, {"state": "open"}), (6, 10, {"state": "closed"}))),
-    # BARN's cellular-automaton fields, fuller and fuller (the field's size is the request's, not scaled:
-    # a fill fraction is already per cell). Medians of seeds 0-19: level 1 at 0.1, 5 at 0.2, 8 at 0.3. No
-    # higher than 0.325: at 0.35 most fields cannot be crossed, and a draw refused 400 times costs 0.6 s
-    # (six level-10 requests: 38 s with 0.35 as the top, 21 s with 0.325).
-    "barn": Knob("fill_fraction", (0.1, 0.15, 0.175, 0.19, 0.2, 0.225, 0.275, 0.3, 0.325, 0.325), 0.025, 0.325,
-                 integer=False),
-}
-#: Generators without a level, and why (a request for one is refused in one line saying so).
-NO_LEVELS: dict[str, str] = {
-    "minimal": "it has no random draws: one target at an exact distance for a sensor test",
-}
+def _knob(spec: GeneratorSpec) -> Knob:
+    """The knob ``spec`` declares; a one-line ParameterError saying why for a generator without one."""
+    if spec.knob is None:
+        offered = ", ".join(s.name for s in all_specs() if s.knob is not None)
+        why = f" ({spec.no_levels})" if spec.no_levels else ""
+        raise ParameterError(f"parameter 'difficulty' is offered by the generators {offered}, not by {spec.name!r}{why}")
+    return spec.knob
 
 
 def reachable(name: str) -> tuple[int, ...]:
     """The levels generator ``name`` can be asked for (none for a generator without a knob)."""
-    knob = KNOBS.get(name)
-    return () if knob is None else tuple(i + 1 for i, v in enumerate(knob.start) if v is not None)
+    knob = get(name).knob
+    return () if knob is None else knob.reachable()
 
 
 def describe_levels(name: str) -> str:
     """One line on the levels generator ``name`` can be asked for (``worldgen list GENERATOR`` prints it)."""
-    levels = reachable(name)
-    if not levels:
-        why = NO_LEVELS.get(name, "no knob is calibrated for it")
-        return f"difficulty: no levels ({why})"
-    knob = KNOBS[name]
+    spec = get(name)
+    knob = spec.knob
+    if knob is None or not knob.reachable():
+        return f"difficulty: no levels ({spec.no_levels or 'no knob is calibrated for it'})"
+    levels = knob.reachable()
     also = sorted({k for k in knob.owned() if k != knob.param})
     sets = f"; sets {', '.join(also)} by level" if knob.fixed else ""
     return f"difficulty: levels {_ranges(levels)} of {LEVELS} (--difficulty K/{LEVELS} turns {knob.param}{sets})"
@@ -176,30 +121,29 @@ def parse_level(value: Any) -> int:
 
 def score(world) -> dict:
     """``difficulty``, ``difficulty_level`` and ``difficulty_model`` of ``world`` as its world.json will have
-    them, from its paths and path-local figures alone (no file rendered)."""
-    from worldgen.export.tasks import task_entry
-
+    them, from the figures the model reads (:func:`worldgen.groundtruth.difficulty.features_from`): the five
+    exact figures along its paths, its narrowest passage, the robot's radius, each task's reference path and
+    whether that path needs a door leaf moved. No file is rendered and no world.json is built."""
     report = world.feasibility
-    paths = list(report.paths) + [None] * max(0, len(world.tasks) - len(report.paths))
-    meta = {
-        "metrics": {"narrowest_passage": finite_or_none(report.narrowest_passage), **truth.difficulty(world)},
-        "robot": {"radius": world.robot.radius},
-        "tasks": [task_entry(world, task, path) for task, path in zip(world.tasks, paths)],
-    }
-    return difficulty.assess(meta)
+    paths = [report.paths[i] if i < len(report.paths) else None for i in range(len(world.tasks))]
+    f = difficulty.features_from(truth.difficulty(world), finite_or_none(report.narrowest_passage), world.robot.radius,
+                                 [(p.waypoints, float(p.length)) for p in paths if p is not None],
+                                 [bool(leaves_on_path(world, p)) for p in paths])
+    return difficulty.rating(f)
 
 
 def check_request(name: str, level_value: Any, params: Mapping[str, Any]) -> tuple[int, str]:
     """(level, knob parameter) of a request for ``level_value`` from generator ``name`` with ``params``; one-line
     ParameterError for a bad level, a generator without levels or without that level, or a parameter the
     request sets that the caller also set."""
+    return _check(get(name), level_value, params)
+
+
+def _check(spec: GeneratorSpec, level_value: Any, params: Mapping[str, Any]) -> tuple[int, str]:
+    """:func:`check_request` of ``spec`` itself."""
     level = parse_level(level_value)
-    knob = KNOBS.get(name)
-    if knob is None:
-        why = f" ({NO_LEVELS[name]})" if name in NO_LEVELS else ""
-        raise ParameterError(f"parameter 'difficulty' is offered by the generators {', '.join(sorted(KNOBS))}, "
-                             f"not by {name!r}{why}")
-    levels = reachable(name)
+    knob, name = _knob(spec), spec.name
+    levels = knob.reachable()
     if level not in levels:
         raise ParameterError(f"parameter 'difficulty' {level}/{LEVELS} is out of reach of {name!r}: it reaches "
                              f"levels {_ranges(levels)}")
@@ -211,17 +155,12 @@ def check_request(name: str, level_value: Any, params: Mapping[str, Any]) -> tup
     return level, knob.param
 
 
-def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any, params: Mapping[str, Any],
-                      people_on: Callable):
-    """A world of generator ``name`` at the level ``level_value`` asks for (see the module); ``generate`` is
-    :func:`worldgen.generate`, ``people_on(world, params)`` the world with people of the same draw and attempt,
-    or None where they refuse it (worldgen.api)."""
-    level, param = check_request(name, level_value, params)
-    knob = KNOBS[name]
-    scale = 1.0
-    if knob.per_area:
-        size = params.get("size", (10.0, 10.0))
-        scale = float(size[0]) * float(size[1]) / 100.0 if isinstance(size, (list, tuple)) and len(size) == 2 else 1.0
+def generate_at_level(spec: GeneratorSpec, seed: int, level_value: Any, params: Mapping[str, Any]) -> World:
+    """A world of generator ``spec`` at the level ``level_value`` asks for (see the module), drawn with
+    ``seed`` and the caller's ``params`` (which leave out what the knob sets)."""
+    level, param = _check(spec, level_value, params)
+    knob, name = _knob(spec), spec.name
+    scale = _scale(knob, params)
     value = float(knob.start[level - 1] or 0.0) * scale
     low, high, step = knob.low * scale, knob.high * scale, knob.step * scale
     fixed = {**params, **knob.sets(level)}
@@ -239,7 +178,7 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         _progress.info("%s at level %d/%d, seed %d: draw %d of at most %d (%s=%s)%s", name, level, LEVELS, seed,
                        len(draws) - refused + 1, MAX_DRAWS, param, n, _last(draws))
         try:
-            world = generate(name, draw_seed, **{**drawn, param: n})
+            world = first_feasible(prepare(spec, draw_seed, {**drawn, param: n}))
         except InfeasibleError:  # too crowded to place or drive: ease off
             draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
             value = max(low, value - step)
@@ -248,12 +187,14 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
         if people and got["difficulty_level"] == level:
             _progress.info("%s at level %d/%d, seed %d: draw %d landed; walking %d people", name, level, LEVELS,
                            seed, len(draws) - refused + 1, params["n_people"])
-            with_people = people_on(world, {**fixed, param: n})
-            if with_people is None:  # no timed path among them on the landed attempt: same knob, next draw
+            # The same draw's attempt with its people: every earlier attempt failed static checks that never
+            # read the people, so this is the world the draw's seed and params, people included, regenerate.
+            with_people = attempt(prepare(spec, draw_seed, {**fixed, param: n}), world.attempts - 1, proven=world)
+            if not with_people.kept or with_people.world is None:  # no timed path among them: same knob, next draw
                 draws.append({"seed": draw_seed, param: n, "difficulty": None, "level": None})
                 refused += 1
                 continue
-            world = with_people
+            world = with_people.world
         draws.append({"seed": draw_seed, param: n, "difficulty": got["difficulty"], "level": got["difficulty_level"]})
         if got["difficulty_level"] == level:
             return world.set_provenance(difficulty_request={"level": f"{level}/{LEVELS}", "seed": seed, "knob": param,
@@ -265,6 +206,14 @@ def generate_at_level(generate: Callable, name: str, seed: int, level_value: Any
     raise InfeasibleError(f"no '{name}' world at level {level}/{LEVELS} for seed {seed} within {MAX_DRAWS} draws{also} "
                           f"(levels reached: {', '.join(map(str, reached)) or 'none'}); try another seed or a "
                           f"level nearer {_nearest(reached, level)}", {"difficulty_level": MAX_DRAWS})
+
+
+def _scale(knob: Knob, params: Mapping[str, Any]) -> float:
+    """What a per-area knob's values are multiplied by: the request's floor in units of 100 m^2 (1 otherwise)."""
+    if not knob.per_area:
+        return 1.0
+    size = params.get("size", (10.0, 10.0))
+    return float(size[0]) * float(size[1]) / 100.0 if isinstance(size, (list, tuple)) and len(size) == 2 else 1.0
 
 
 def _without_people(params: Mapping[str, Any]) -> dict:
@@ -283,3 +232,28 @@ def _last(draws: list) -> str:
 
 def _nearest(reached: list, level: int) -> str:
     return str(min(reached, key=lambda v: (abs(v - level), v))) if reached else "the middle"
+
+
+#: Names this module held before each generator declared its own knob: where each is now (``Knob``, which
+#: this module uses, is still importable from here, as worldgen.generators.Knob itself).
+_MOVED = {
+    "KNOBS": "each generator's spec: worldgen.generators.get(name).knob",
+    "NO_LEVELS": "each generator's spec: worldgen.generators.get(name).no_levels",
+    "START": "worldgen.generators.cluttered.KNOB.start",
+    "STEP": "worldgen.generators.cluttered.KNOB.step",
+    "MAX_KNOB": "worldgen.generators.cluttered.KNOB.high",
+}
+
+
+def __getattr__(name: str) -> Any:
+    """The names of :data:`_MOVED`, still answered with a DeprecationWarning (the tables are read off the specs)."""
+    if name not in _MOVED:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    warnings.warn(f"worldgen.leveling.{name} is deprecated: use {_MOVED[name]}", DeprecationWarning, stacklevel=2)
+    if name in ("KNOBS", "NO_LEVELS"):
+        specs = all_specs()
+        return {s.name: s.knob for s in specs if s.knob is not None} if name == "KNOBS" else \
+            {s.name: s.no_levels for s in specs if s.knob is None}
+    from worldgen.generators.cluttered import KNOB
+    return {"START": KNOB.start, "STEP": KNOB.step, "MAX_KNOB": KNOB.high}[name]
+

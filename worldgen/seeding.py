@@ -6,7 +6,7 @@ what the stream is for, so adding a kind of random thing never reshuffles anothe
 ==============================  ============================  =====================================
 stream                          key                           used by
 ==============================  ============================  =====================================
-draw ``k`` of a world           ``(k,)``                      ``api.generate``, every generator
+draw ``k`` of a world           ``(k,)``                      ``pipeline.attempt``, every generator
 its movers                      ``(k, MOVER_STREAM)``         ``generators.movers``
 its people                      ``(k, PEOPLE_STREAM)``        ``people.places``
 an environment's worlds         ``(WORLD_STREAM,)``           ``envs.navigation`` (reset's seed)

@@ -16,7 +16,7 @@ in the order the data flows through them:
 - ``verify``: the FCL proof of a path, on the volume the footprint sweeps along it;
 - ``check``: running it all and assembling the report;
 - ``crowd``: people walked by the social force model round the exact geometry (docs/people.md);
-- ``timed``: the timed path among them, the certificate ``api.generate`` adds with people.
+- ``timed``: the timed path among them, the certificate ``pipeline.attempt`` adds with people.
 """
 
 from worldgen.feasibility.check import check

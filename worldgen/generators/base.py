@@ -1,4 +1,4 @@
-"""What a generator is: a name, its parameters, and a pure build function."""
+"""What a generator is: a name, its parameters, its difficulty knob, and a pure build function."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from typing import Any, Callable, Mapping, Optional
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.generators.knob import Knob
 from worldgen.params import COMMON_PARAMS, Param, validate_params
 from worldgen.scene import Robot, Scene, Task
 
@@ -35,7 +36,9 @@ class GeneratorSpec:
 
     ``build(params, rng)`` must be a pure function of the validated parameters and
     the ``numpy.random.Generator``; ``check(params)`` may reject combinations of
-    parameters (raising :class:`~worldgen.errors.ParameterError`).
+    parameters (raising :class:`~worldgen.errors.ParameterError`). ``knob`` is the
+    parameter a request for a difficulty level turns (:class:`~worldgen.generators.Knob`,
+    worldgen.leveling); a generator without one says why in ``no_levels``.
     """
 
     name: str
@@ -44,11 +47,23 @@ class GeneratorSpec:
     build: Callable[[Mapping[str, Any], np.random.Generator], Draft]
     check: Optional[Callable[[Mapping[str, Any]], None]] = None
     examples: tuple[str, ...] = field(default=())
+    knob: Optional[Knob] = None
+    no_levels: str = ""
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         # The name becomes part of every world_id, and so of folder names: keep it plain.
         if not re.fullmatch(r"[a-z][a-z0-9_]{0,31}", self.name):
             raise ParameterError(f"generator name {self.name!r} must be 1-32 of a-z, 0-9, _ (starting with a letter)")
+        if self.knob is not None and self.no_levels:
+            raise ParameterError(f"generator {self.name!r} declares a knob and says it has no levels; give one of them")
+        if self.knob is not None:
+            # Declared beside the parameters it turns, and checked against them: a renamed parameter
+            # fails here, when the generator is defined, not at the first request for a level.
+            known = {p.name for p in self.all_params}
+            unknown = [name for name in self.knob.owned() if name not in known]
+            if unknown:
+                raise ParameterError(f"generator {self.name!r}: its knob sets {', '.join(map(repr, unknown))}, "
+                                     f"which it has no parameter for")
 
     @property
     def all_params(self) -> tuple[Param, ...]:

@@ -35,6 +35,7 @@ from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.corridor_layout import Layout, layout
+from worldgen.generators.knob import Knob
 from worldgen.generators.room import FLOOR_RGBA, FLOOR_THICKNESS, WALL_RGBA
 from worldgen.params import Param
 from worldgen.scene import Box, Material, Node, Physics, Pose, Scene, Task
@@ -318,6 +319,10 @@ SPEC = GeneratorSpec(
         "worldgen generate corridor --set shape=zigzag --set segments=4,3,4 --set turns=left,right --out worlds",
         "worldgen generate corridor --set shape=L --set n_obstacles=4 --set side_openings=2 --out worlds",
     ),
+    # Levels: straight corridors with more and more obstacles, then an L, then a U bend (two turns); the
+    # starts are the counts whose worlds' median level is the level (seeds 100-109, docs/metrics.md).
+    knob=Knob("n_obstacles", (0, 3, 4, 5, 6, 0, 1, 4, 0, 2), step=1.0, high=6.0,
+              fixed=((1, 5, {"shape": "straight"}), (6, 8, {"shape": "L"}), (9, 10, {"shape": "U"}))),
 )
 
 

@@ -35,6 +35,7 @@ import numpy as np
 from worldgen.errors import ParameterError
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
+from worldgen.generators.knob import Knob
 from worldgen.generators.room import WALL_RGBA, floor_node, wall_nodes
 from worldgen.generators.tasks import free_points
 from worldgen.params import Param
@@ -317,4 +318,8 @@ SPEC = GeneratorSpec(
         "worldgen generate door --seed 1 --set n_doors=2 --set state=closed --out worlds",
         "worldgen generate door --set size=14,4 --set door_x=3 --set door_y=0 --set spawn=0,0,0 --set goal=6,0 --out worlds",
     ),
+    # Levels: open doors (rooms in a row) up to level 5, closed leaves to push from level 6. Level 1 is out
+    # of reach: no request with seeds 100-109 landed there (docs/metrics.md).
+    knob=Knob("n_doors", (None, 1, 1, 1, 1, 1, 1, 1, 2, 4), step=1.0, high=5.0, low=1.0,
+              fixed=((1, 5, {"state": "open"}), (6, 10, {"state": "closed"}))),
 )

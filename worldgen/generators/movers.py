@@ -2,7 +2,7 @@
 
 Any generator gets them through the common parameters ``n_movers``,
 ``mover_radius``, ``mover_height``, ``mover_speed`` and ``mover_waypoints``:
-the pipeline (:func:`worldgen.api.generate`) calls :func:`place_movers` on each
+the pipeline (:func:`worldgen.pipeline.attempt`) calls :func:`place_movers` on each
 draft with its own RNG stream (:func:`worldgen.seeding.mover_rng`), so adding or changing movers
 never moves an obstacle or a task.
 

@@ -5,7 +5,8 @@ reference probes of the navigation environment (``worldgen.envs.probes``: the
 lidar-only reactive policy and the corner-cutting tracker, default settings)
 expected to fail in the world: one logistic model per probe, ``difficulty`` the
 mean of their two failure chances. Its inputs are figures world.json already
-holds or that follow from it (:func:`features`):
+holds or that follow from it (:func:`features` reads them from a world.json dict, :func:`features_from`
+from the figures themselves, as a level request scores a world before any world.json is built):
 
 - the five BARN-style figures along the reference paths (docs/metrics.md);
 - ``turning``: the reference path's total turning (rad, the sum of the
@@ -32,12 +33,12 @@ purpose) has no score (None).
 from __future__ import annotations
 
 import math
-from typing import Mapping, Optional
+from typing import Any, Mapping, Optional, Sequence
 
 import numpy as np
 
-__all__ = ["MODEL_ID", "MODEL", "FEATURES", "SLACK_CAP", "BEND_WINDOW", "features", "path_turning", "sharpest_bend",
-           "probe_chance", "score", "level_of", "assess"]
+__all__ = ["MODEL_ID", "MODEL", "FEATURES", "SLACK_CAP", "BEND_WINDOW", "features", "features_from", "path_turning",
+           "sharpest_bend", "probe_chance", "score", "level_of", "rating", "assess"]
 
 #: The name and version of the frozen model, written as world.json ``metrics.difficulty_model``.
 MODEL_ID = "worldgen.difficulty/1"
@@ -112,21 +113,32 @@ def sharpest_bend(waypoints, window: float = BEND_WINDOW) -> float:
 def features(meta: Mapping) -> Optional[dict[str, float]]:
     """The model's inputs from a world.json dict (its ``metrics``, ``robot`` and ``tasks``); None without a path."""
     metrics, tasks = meta["metrics"], meta["tasks"]
-    paths = [t["path"] for t in tasks if t.get("path")]
-    if not paths or metrics.get("tortuosity") is None:
+    return features_from(metrics, metrics.get("narrowest_passage"), float(meta["robot"]["radius"]),
+                         [(t["path"]["waypoints"], t["path"]["length"]) for t in tasks if t.get("path")],
+                         [bool(t.get("requires_door_open")) for t in tasks])
+
+
+def features_from(figures: Mapping[str, Any], narrowest: Optional[float], radius: float,
+                  paths: Sequence[tuple[Any, float]], doors: Sequence[bool]) -> Optional[dict[str, float]]:
+    """The model's inputs from the figures themselves; None without a path.
+
+    ``figures``: the five exact figures along the reference paths (:func:`worldgen.groundtruth.metrics.difficulty`,
+    world.json ``metrics``); ``narrowest``: the narrowest passage (m, None for none); ``radius``: the robot's;
+    ``paths``: (waypoints (n, 2), length m) of each task's reference path, tasks without one left out;
+    ``doors``: per task, whether its path needs a door leaf moved.
+    """
+    if not paths or figures.get("tortuosity") is None:
         return None
-    radius = float(meta["robot"]["radius"])
-    narrowest = metrics.get("narrowest_passage")
     slack = SLACK_CAP if narrowest is None else min(float(narrowest) - 2.0 * radius, SLACK_CAP)
-    out = {name: float(metrics[name]) for name in ("closest_obstacle_distance_mean", "average_visibility",
+    out = {name: float(figures[name]) for name in ("closest_obstacle_distance_mean", "average_visibility",
                                                     "dispersion", "characteristic_dimension", "tortuosity")}
     out.update(
-        turning=float(np.mean([path_turning(p["waypoints"]) for p in paths])),
-        sharpest_bend=sharpest_bend(paths[0]["waypoints"]),
+        turning=float(np.mean([path_turning(waypoints) for waypoints, _ in paths])),
+        sharpest_bend=sharpest_bend(paths[0][0]),
         passage_slack=max(slack, 0.0),
         clearance_slack=max(out["closest_obstacle_distance_mean"] - radius, 0.0),
-        path_length=float(paths[0]["length"]),
-        doors=float(np.mean([bool(t.get("requires_door_open")) for t in tasks])),
+        path_length=float(paths[0][1]),
+        doors=float(np.mean([bool(d) for d in doors])),
     )
     return out
 
@@ -155,7 +167,12 @@ def level_of(difficulty: float) -> int:
 
 def assess(meta: Mapping) -> dict:
     """world.json's ``metrics.difficulty``, ``difficulty_level`` and ``difficulty_model`` of a world.json dict."""
-    f = features(meta)
+    return rating(features(meta))
+
+
+def rating(f: Optional[Mapping[str, float]]) -> dict:
+    """world.json's ``metrics.difficulty``, ``difficulty_level`` and ``difficulty_model`` of features ``f``
+    (:func:`features`, :func:`features_from`; None: no score)."""
     if f is None:
         return {"difficulty": None, "difficulty_level": None, "difficulty_model": MODEL_ID}
     d = round(score(f), 6)  # rounded as world.json writes it, so the level is the written figure's
