@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Union
 
 import numpy as np
 from lxml import etree
@@ -25,10 +26,12 @@ W_MAX = 4.0
 
 
 class MujocoBackend:
-    """:meth:`start` puts the robot at the spawn; :meth:`step` holds (v, w) for N physics steps."""
+    """:meth:`start` puts the robot at the spawn; :meth:`step` holds (v, w) for N physics steps.
 
-    def __init__(self, mjcf: Path, meta: dict):
-        root = etree.fromstring(Path(mjcf).read_bytes(), safe_parser())
+    ``mjcf`` is the world's MJCF, its bytes (a world need not be on disk: a World, a pack archive's) or its path."""
+
+    def __init__(self, mjcf: Union[bytes, Path], meta: dict):
+        root = etree.fromstring(mjcf if isinstance(mjcf, bytes) else Path(mjcf).read_bytes(), safe_parser())
         robot = meta["robot"]
         add_robot(root, float(robot["radius"]), float(robot["height"]), V_RANGE, W_MAX)
         self._root = root
