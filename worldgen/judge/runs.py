@@ -31,7 +31,7 @@ import csv
 import math
 import tempfile
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Iterator, Optional, Sequence
 
@@ -98,9 +98,9 @@ def plan(bags: Sequence, *, world=None, pack=None, runs=None) -> list[Item]:
     if world is not None:
         opened = open_world(world, "--world")
         folder = opened.path if isinstance(world, (str, Path)) else world
-        if opened.path is None and getattr(world, "feasibility", None) is None:  # not a World: no scenario to build
-            raise ParameterError(f"--world: {opened.label} has no folder on disk to read its scenario.yaml from; "
-                                 "write it, or extract its pack, first")
+        if opened.path is None and getattr(world, "feasibility", None) is None and not _archived(world):
+            raise ParameterError(f"--world: {opened.label} has no folder on disk to read its scenario.yaml from, "
+                                 "nor a World's scenario to build; write it first")
     elif pack is None:
         raise ParameterError("say where the worlds are: --world DIR, --pack DIR (worlds named in the bags' metadata) "
                              "or --runs TABLE")
@@ -222,6 +222,10 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     extra: list[dict] = []        # per bag: the judge's columns (judged ones also get evaluate's)
     plots: list[Optional[dict]] = []
     scratch = tempfile.TemporaryDirectory(prefix="worldgen-judge-")
+    if items and _archived(items[0].world):  # evaluate reads scenario.yaml from a folder: the world's, extracted
+        archived = items[0].world
+        folder = archived.pack.source.extract_folder(archived.folder, Path(scratch.name) / "world")
+        items = [replace(item, world=folder) for item in items]
     names: set[str] = set()
 
     def ground(world) -> Ground:
@@ -289,6 +293,11 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
             yield from runs_iter
         report = evaluate(chained(), criteria).to_dict()
     return JudgeResult(_assemble(report, extra), plots, scratch)
+
+
+def _archived(world) -> bool:
+    """Whether ``world`` is a world inside a pack archive (a PackWorld with no folder on disk)."""
+    return bool(getattr(getattr(world, "pack", None), "archive", False))
 
 
 def _same_world(bag: Path, metadata: dict, world_id: str) -> None:
