@@ -116,3 +116,14 @@ def test_a_world_json_naming_a_file_outside_its_folder_is_refused(three, tmp_pat
 
 def test_a_folder_is_opened_by_its_world_json_too(three):
     assert open_world(three["folder"] / "world.json").path == three["folder"]
+
+
+def test_a_folder_reader_pickles_and_a_world_is_not_rendered_to_be_recognised(three):
+    import pickle
+
+    again = pickle.loads(pickle.dumps(open_world(three["folder"])))
+    assert again.metadata == open_world(three["folder"]).metadata and again.file("sdf").is_file()
+    fresh = worldgen.generate("minimal", seed=0)
+    opened = open_world(fresh)
+    assert "metadata" not in vars(fresh)  # nothing rendered until the metadata is asked for
+    assert opened.world_id == fresh.world_id and "metadata" in vars(fresh)

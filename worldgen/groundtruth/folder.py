@@ -22,7 +22,7 @@ own ``files`` table, which the writer keys by that table, so no writer is import
 from __future__ import annotations
 
 import json
-from functools import cached_property
+from functools import cached_property, partial
 from pathlib import Path, PurePosixPath
 from typing import Any, Callable, Mapping, Optional
 
@@ -84,7 +84,7 @@ class WorldFolder:
             path = path.parent
         if not is_world_folder(path):
             raise ParameterError(f"{what} '{folder}' is not a world folder (no {METADATA_NAME})")
-        world = cls(lambda name: (path / _inside(name)).read_bytes(), path, label=f"{what} '{folder}'")
+        world = cls(partial(_read_in, path), path, label=f"{what} '{folder}'")
         world.metadata  # noqa: B018 -- read at once: a broken world.json is the caller's mistake, found here
         return world
 
@@ -173,6 +173,11 @@ class WorldFolder:
         return self.read(self.file_name(fmt))
 
 
+def _read_in(folder: Path, name: str) -> bytes:
+    """The bytes of ``folder/name`` (a module-level function, not a closure, so a reader pickles)."""
+    return (folder / _inside(name)).read_bytes()
+
+
 def _inside(rel: str) -> str:
     """``rel`` when it names a file inside the world's folder; a ParameterError otherwise (a world.json that
     names ``../x`` must not make a reader open a file outside)."""
@@ -192,7 +197,8 @@ def open_world(world, what: str = "parameter 'world'") -> WorldFolder:
     own = getattr(world, "reader", None)
     if isinstance(own, WorldFolder):  # a PackWorld reads itself through one
         return own
-    if hasattr(world, "metadata") and hasattr(world, "read") and hasattr(world, "world_id"):  # a World
+    kind = type(world)  # asked of the class: a World's metadata is rendered on first use, not to be looked at
+    if hasattr(kind, "metadata") and hasattr(kind, "read") and hasattr(world, "world_id"):  # a World
         return WorldFolder(world.read, getattr(world, "path", None), label=f"world {world.world_id}",
                            metadata=lambda: world.metadata, scene=getattr(world, "scene", None))
     raise ParameterError(f"{what} must be a World, a PackWorld or a world folder, got {type(world).__name__}")
