@@ -17,6 +17,7 @@ from lxml import etree
 from worldgen.envs.movers import MoverScript
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.export.xml import safe_parser
+from worldgen.groundtruth.folder import robot_of
 
 __all__ = ["MujocoBackend", "V_RANGE", "W_MAX"]
 
@@ -32,8 +33,8 @@ class MujocoBackend:
 
     def __init__(self, mjcf: Union[bytes, Path], meta: dict):
         root = etree.fromstring(mjcf if isinstance(mjcf, bytes) else Path(mjcf).read_bytes(), safe_parser())
-        robot = meta["robot"]
-        add_robot(root, float(robot["radius"]), float(robot["height"]), V_RANGE, W_MAX)
+        robot = robot_of(meta)
+        add_robot(root, robot.radius, robot.height, V_RANGE, W_MAX)
         self._root = root
         self._floor = sorted(e["name"] for e in meta["entities"] if e["role"] == "floor")
         self._movers = [m["name"] for m in meta.get("dynamic_obstacles", [])]
