@@ -311,6 +311,8 @@ def test_a_world_or_a_pack_world_is_judged_as_its_folder(setup, tmp_path):
             assert [r["min_clearance"] for r in result.report["runs"]] == \
                 pytest.approx([r["min_clearance"] for r in expected["runs"]], abs=1e-6), kind
             assert result.passed is False and result.report["summary"]["runs"] == 2, kind
+            folder = None if kind != "pack" else str(pack[0].path)  # no folder of its own: None, not a scratch copy
+            assert [r["world_folder"] for r in result.report["runs"]] == [folder, folder], kind
             write_report(result, tmp_path / f"report-{kind}")
             assert all((tmp_path / f"report-{kind}" / r["picture"]).is_file() for r in result.report["runs"])
     finally:

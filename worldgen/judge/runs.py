@@ -251,7 +251,8 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
                 g = ground(folder)
                 world_id, task_id = str(g.meta.get("world_id")), g.task(task)["id"]
                 row["run"] = _run_name(world_id, task_id, item.run or named.get("worldgen.run"), names)
-                row["world_folder"] = None if g.path is None else str(g.path)
+                # None where the world has no folder of its own: an unwritten World, an archive's world extracted
+                row["world_folder"] = None if g.path is None or Path(scratch.name) in g.path.parents else str(g.path)
                 try:
                     _same_world(item.bag, named, world_id)
                     got = read_run(item.bag, g, task=task, start=start, **options)
