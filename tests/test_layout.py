@@ -391,3 +391,67 @@ def test_every_generator_declares_its_difficulty_knob_beside_its_parameters():
     assert not elsewhere, "knobs made outside the generators they turn:\n" + "\n".join(elsewhere)
     for spec in all_specs():
         assert (spec.knob is None) == bool(spec.no_levels), spec.name
+
+
+# -- one reader of a world folder --
+
+#: Modules that may name world.json (``METADATA_NAME``, or a path ending in it), each with its reason; everything
+#: else reads a world through worldgen.groundtruth.folder (``open_world``, ``WorldFolder``, ``is_world_folder``).
+WORLD_JSON_NAMED = {
+    "groundtruth/folder.py": "the reader",
+    "files.py": "defines the name; refuse_other_world reads the content_hash a folder records before a write "
+                "replaces it (the writer's guard, in a room below every room the reader could live in)",
+    "world.py": "the writer: world.json among a folder's files, and read()/file('json') of the in-memory World",
+    "pack/render.py": "a pack build, the writer: the figures its manifest copies come from the world.json just rendered",
+    "pack/manifest.py": "finds a world's folder by the path its world.json is listed under in a manifest; opens nothing",
+    "pack/verify.py": "checks that a pack's manifest lists world.json with its sha256; parses it through the reader",
+    "verify/folder.py": "checks a received folder's raw bytes: a missing or broken world.json is the verdict of its "
+                        "`metadata` check, not a usage error, and a fresh export's world.json is compared with it",
+}
+
+
+def world_json_named(sources: dict[str, str]) -> list[str]:
+    """``rel:line`` of every naming of world.json in ``sources`` (relative path -> text) outside WORLD_JSON_NAMED:
+    the name ``METADATA_NAME``, or a string that is, or ends in, ``/world.json`` (docstrings aside)."""
+    import re
+
+    path_like = re.compile(r"(.*[/*])?world\.json")
+    found = []
+    for rel, text in sorted(sources.items()):
+        if rel in WORLD_JSON_NAMED:
+            continue
+        tree = ast.parse(text)
+        docstrings = {id(n.body[0].value) for n in ast.walk(tree)
+                      if isinstance(n, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef))
+                      and n.body and isinstance(n.body[0], ast.Expr) and isinstance(n.body[0].value, ast.Constant)}
+        for node in ast.walk(tree):
+            named = (isinstance(node, ast.Name) and node.id == "METADATA_NAME") or \
+                (isinstance(node, ast.Attribute) and node.attr == "METADATA_NAME") or \
+                (isinstance(node, ast.alias) and node.name == "METADATA_NAME") or \
+                (isinstance(node, ast.Constant) and isinstance(node.value, str) and id(node) not in docstrings
+                 and path_like.fullmatch(node.value) is not None)
+            if named:
+                found.append(f"worldgen/{rel}:{getattr(node, 'lineno', '?')}")
+    return found
+
+
+def test_world_json_is_read_only_through_the_reader():
+    sources = {path.relative_to(PACKAGE).as_posix(): path.read_text() for path in modules().values()}
+    found = world_json_named(sources)
+    assert not found, ("world.json named outside its reader (read the world with worldgen.groundtruth.folder."
+                       "open_world, or add the module to WORLD_JSON_NAMED with its reason):\n" + "\n".join(found))
+    assert set(WORLD_JSON_NAMED) <= set(sources), sorted(set(WORLD_JSON_NAMED) - set(sources))
+
+
+def test_the_world_json_rule_finds_a_hand_rolled_read():
+    hand_rolled = [
+        "from worldgen.files import METADATA_NAME\nmeta = json.loads((folder / METADATA_NAME).read_text())\n",
+        "import worldgen.files as f\nmeta = json.loads((folder / f.METADATA_NAME).read_text())\n",
+        "metas = sorted(root.glob('*/world.json'))\n",
+        "meta = src.read(f'{folder}/world.json')\n",
+    ]
+    for k, text in enumerate(hand_rolled):
+        assert world_json_named({f"sim/m{k}.py": text}), text
+    clean = '"""Reads world.json through the reader."""\nraise ParameterError("x is not a world folder (no world.json)")\n'
+    assert world_json_named({"sim/ok.py": clean}) == []
+    assert world_json_named({"world.py": hand_rolled[0]}) == []

@@ -196,7 +196,7 @@ def test_cli_preview_redraws_the_same_picture_and_leaves_world_json_alone(folder
 def test_cli_preview_mistakes_are_one_line_and_status_2(tmp_path, capsys):
     assert main(["preview", str(tmp_path)]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error: argument WORLD_DIR") and "has no world.json" in err and err.count("\n") == 1
+    assert err.startswith("error: argument WORLD_DIR") and "is not a world folder (no world.json)" in err and err.count("\n") == 1
     (tmp_path / "world.json").write_text("{not json")
     assert main(["preview", str(tmp_path)]) == 2
     assert "cannot be read as JSON" in capsys.readouterr().err

@@ -283,3 +283,38 @@ def test_a_run_among_people_is_drawn_with_the_people_where_they_were_at_the_cont
         u, v = lay.px(x + 0.6 * radius, y)  # inside the person's disc, off the crossed-out robot at its centre
         assert rgb.getpixel((round(u), round(v) + _HEADER)) == PERSON_COLOURS[0]
         assert {c for _, c in rgb.getcolors(1 << 20)} >= {PERSON_COLOURS[0], (200, 30, 30)}
+
+
+def test_a_world_or_a_pack_world_is_judged_as_its_folder(setup, tmp_path):
+    """judge(world=...) takes a World (unwritten), a pack's world (folder or archive) or a folder, each read through
+    worldgen.groundtruth.folder: the same rows, and the report draws every run's picture."""
+    import worldgen
+    from worldgen.judge import judge, write_report
+    from worldgen.pack import Pack, build_pack, parse_recipe
+    from worldgen.pack.archive import write_archive
+
+    bags = [setup["clean"], setup["crash"]]
+    build_pack(parse_recipe("name: one\nseeds: 1\nworlds:\n  - generator: cluttered\n"
+                            "    params: {size: [8, 8], n_obstacles: 6}\n"), tmp_path / "pack")
+    pack, archived = Pack.open(tmp_path / "pack"), Pack.open(write_archive(tmp_path / "pack"))
+    try:
+        assert pack[0].world_id == oracles.load(setup["world"]).meta["world_id"]
+        worlds = {"world": worldgen.generate("cluttered", seed=0, size=[8, 8], n_obstacles=6), "pack": pack[0],
+                  "archive": archived[0]}
+        expected = judge(bags, CRITERIA, world=setup["world"]).report
+        for kind, world in worlds.items():
+            result = judge(bags, CRITERIA, world=world)
+            # A World's colliders are its scene's; a folder's are rebuilt from world.json's 6 decimals.
+            drop = {"bag", "world_folder", "picture", "min_clearance"}
+            assert [{k: v for k, v in r.items() if k not in drop} for r in result.report["runs"]] == \
+                [{k: v for k, v in r.items() if k not in drop} for r in expected["runs"]], kind
+            assert [r["min_clearance"] for r in result.report["runs"]] == \
+                pytest.approx([r["min_clearance"] for r in expected["runs"]], abs=1e-6), kind
+            assert result.passed is False and result.report["summary"]["runs"] == 2, kind
+            folder = None if kind != "pack" else str(pack[0].path)  # no folder of its own: None, not a scratch copy
+            assert [r["world_folder"] for r in result.report["runs"]] == [folder, folder], kind
+            write_report(result, tmp_path / f"report-{kind}")
+            assert all((tmp_path / f"report-{kind}" / r["picture"]).is_file() for r in result.report["runs"])
+    finally:
+        pack.close()
+        archived.close()

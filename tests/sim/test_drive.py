@@ -160,3 +160,33 @@ def test_movers_follow_their_scripts_in_mujoco(tmp_path):
     placed = backend._sim.data.mocap_pos[backend._sim.mocap, :2]
     assert placed == pytest.approx(expected, abs=1e-9)
     assert not np.allclose(expected, script.positions(np.zeros(1))[0])  # they did move
+
+
+def test_a_world_and_a_pack_world_drive_as_their_folder_does(worlds, tmp_path):
+    """drive() reads its world through worldgen.groundtruth.folder: an unwritten World and a pack's world (in a
+    folder or an archive) drive in MuJoCo to the same run as the written folder, and are judged the same."""
+    from worldgen.pack import Pack, build_pack, parse_recipe
+    from worldgen.pack.archive import write_archive
+
+    build_pack(parse_recipe("name: one\nseeds: {start: 1, count: 1}\nworlds:\n  - generator: minimal\n"),
+               tmp_path / "pack")
+    pack, archived = Pack.open(tmp_path / "pack"), Pack.open(write_archive(tmp_path / "pack"))
+    sources = {"folder": worlds["minimal"], "world": worldgen.generate("minimal", seed=1), "pack": pack[0],
+               "archive": archived[0]}
+    try:
+        outcomes = {kind: drive(world, tmp_path / kind, sim="mujoco") for kind, world in sources.items()}
+    finally:
+        pack.close()
+        archived.close()
+    runs = {kind: read_run(o.bag, worlds["minimal"]).trajectory for kind, o in outcomes.items()}
+    for kind, outcome in outcomes.items():
+        assert outcome.passed and outcome.ended == "goal", (kind, outcome.verdict)
+        assert outcome.bag.name == outcomes["folder"].bag.name
+        assert np.array_equal(runs[kind], runs["folder"]), kind
+        # A World's colliders are its scene's; a folder's are rebuilt from world.json's 6 decimals.
+        drop = ("bag", "world_folder", "min_clearance")
+        assert {k: v for k, v in outcome.run.items() if k not in drop} == \
+            {k: v for k, v in outcomes["folder"].run.items() if k not in drop}, kind
+        assert outcome.run["min_clearance"] == pytest.approx(outcomes["folder"].run["min_clearance"], abs=1e-6)
+    with pytest.raises(worldgen.errors.ParameterError, match="has no folder on disk"):
+        drive(worldgen.generate("minimal", seed=1), tmp_path / "gz", sim="gazebo")

@@ -251,14 +251,14 @@ def check_command(world_dirs: Sequence[Path]) -> None:
     Prints "OK DIR" or "FAIL DIR: CHECK: DETAIL" per folder; exit status 1 if any failed.
     """
     from worldgen.cli.progress import shown
-    from worldgen.files import METADATA_NAME
+    from worldgen.groundtruth.folder import is_world_folder
     from worldgen.verify import check_folder
 
     for folder in world_dirs:  # a usage mistake, before any check: a folder of worlds is not a world folder
-        inner = sorted(p.parent.name for p in folder.glob(f"*/{METADATA_NAME}"))
-        if inner and not (folder / METADATA_NAME).exists():
+        inner = [p for p in folder.iterdir() if is_world_folder(p)]
+        if inner and not is_world_folder(folder):
             raise ParameterError(f"'{folder}' is a folder of {len(inner)} world folders, not a world folder "
-                                 f"(no {METADATA_NAME}); give them: worldgen check {folder}/*")
+                                 f"(no world.json); give them: worldgen check {folder}/*")
     failed = 0
     with shown() as echo:
         for folder in world_dirs:

@@ -228,19 +228,17 @@ class PackSource:
 
         from worldgen.export.xml import safe_parser
         from worldgen.groundtruth.ground import load as ground_of
-        from worldgen.scene import Robot as _Robot
 
         pw = self.pack[index]
         meta = pw.metadata
-        task = _checked_task(pw.world_id, meta["tasks"][0])
+        task = _checked_task(pw.world_id, pw.task())
         if "mjcf" in meta.get("files", {}):
-            root = etree.fromstring(pw.read(meta["files"]["mjcf"]["path"]), safe_parser())
+            root = etree.fromstring(pw.reader.file_bytes("mjcf"), safe_parser())
         else:
             root = self._regenerated_mjcf(pw, meta)
-        r = meta["robot"]
         params = dict(meta.get("params", {}))
         return EpisodeWorld(
-            world_id=pw.world_id, mjcf=root, robot=_Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
+            world_id=pw.world_id, mjcf=root, robot=pw.robot,
             task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
             floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
             lidar_height=float(params.get("lidar_height", 0.3)), params=params,

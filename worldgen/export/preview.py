@@ -25,7 +25,6 @@ every coordinate comes from the rounded metadata.
 from __future__ import annotations
 
 import io
-import json
 import math
 from pathlib import Path
 from typing import Any, Mapping
@@ -50,7 +49,8 @@ from worldgen.export.preview_frame import (
     title,
 )
 from worldgen.export.topdown import Pen, draw_movers, draw_people, text_font
-from worldgen.files import METADATA_NAME, PREVIEW_NAME, write_atomically
+from worldgen.files import PREVIEW_NAME, write_atomically
+from worldgen.groundtruth.folder import WorldFolder
 from worldgen.scene.pose import rpy_matrix
 
 __all__ = ["DEFAULT_WIDTH", "MIN_WIDTH", "MAX_WIDTH", "COLOURS", "NOGO_ALPHA",
@@ -272,13 +272,8 @@ def write_preview(folder, width: int = DEFAULT_WIDTH) -> Path:
     reader never sees half a picture. world.json is only read.
     """
     folder = Path(folder)
-    source = folder / METADATA_NAME
-    try:
-        meta = json.loads(source.read_bytes())
-    except FileNotFoundError:
-        raise ParameterError(f"argument WORLD_DIR '{folder}' has no world.json") from None
-    except (OSError, ValueError) as exc:
-        raise ParameterError(f"argument WORLD_DIR '{folder}': world.json cannot be read as JSON ({exc})") from None
+    opened = WorldFolder.open(folder, "argument WORLD_DIR")
+    meta = opened.metadata
     try:
         png = render(meta, width)
     except (KeyError, TypeError, ValueError, IndexError) as exc:
@@ -286,7 +281,7 @@ def write_preview(folder, width: int = DEFAULT_WIDTH) -> Path:
             raise
         raise ParameterError(f"argument WORLD_DIR '{folder}': world.json cannot be drawn "
                              f"({type(exc).__name__}: {exc})") from None
-    target = folder / PREVIEW_NAME
+    target = opened.file("json").parent / PREVIEW_NAME
     try:
         write_atomically(target, png)
     except OSError as exc:

@@ -2,48 +2,44 @@
 recorded trajectory, checked (:func:`as_trajectory`).
 
 A world is a :class:`~worldgen.World` (its scene is used), a world of a built pack
-(:class:`~worldgen.PackWorld`, folder or archive) or a written world folder; without a scene the
-colliders are rebuilt from world.json's entities, exactly as the feasibility check places them.
+(:class:`~worldgen.PackWorld`, folder or archive) or a written world folder, each read through
+:func:`worldgen.groundtruth.folder.open_world`; without a scene the colliders are rebuilt from
+world.json's entities, exactly as the feasibility check places them.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Callable, Optional
 
 import numpy as np
 
 from worldgen.errors import ParameterError
-from worldgen.files import METADATA_NAME
+from worldgen.groundtruth.folder import open_world, robot_of, task_of
 
 __all__ = ["Ground", "load", "leaves_of", "as_trajectory"]
 
 
 class Ground:
-    """What the oracles need of one world: world.json, and FCL colliders built once (on first use)."""
+    """What the oracles need of one world: world.json, and FCL colliders built once (on first use).
 
-    def __init__(self, meta: dict, scene=None, read: Optional[Callable[[str], bytes]] = None):
+    ``path`` is the world's folder on disk where it has one (the judge reads its scenario.yaml there)."""
+
+    def __init__(self, meta: dict, scene=None, read: Optional[Callable[[str], bytes]] = None,
+                 path: Optional[Path] = None):
         self.meta = meta
         self._scene = scene
         self._read = read  # a file of the world by its relative path (meshes), where there is no scene
+        self.path = path
         self._colliders = None
         self._fixed_colliders = None
 
     @property
     def robot(self):
-        from worldgen.scene import Robot
-        r = self.meta["robot"]
-        return Robot(float(r["radius"]), float(r["height"]), float(r["clearance"]))
+        return robot_of(self.meta)
 
     def task(self, task: Optional[str] = None) -> dict:
-        tasks = self.meta["tasks"]
-        if task is None:
-            return tasks[0]
-        for t in tasks:
-            if t["id"] == task:
-                return t
-        raise ParameterError(f"parameter 'task' must be one of {', '.join(t['id'] for t in tasks)}, got {task!r}")
+        return task_of(self.meta, task)
 
     @property
     def colliders(self):
@@ -77,21 +73,8 @@ def load(world) -> Ground:
     """A :class:`Ground` for a World, a PackWorld, a world folder (str/Path) or a Ground (returned as is)."""
     if isinstance(world, Ground):
         return world
-    scene = getattr(world, "scene", None)
-    if scene is not None and hasattr(world, "metadata"):
-        return Ground(world.metadata, scene=scene)
-    if hasattr(world, "metadata") and hasattr(world, "read"):  # a PackWorld, in a folder or an archive
-        return Ground(world.metadata, read=world.read)
-    if isinstance(world, (str, Path)):
-        folder = Path(world)
-        path = folder / METADATA_NAME if folder.is_dir() else folder
-        try:
-            meta = json.loads(path.read_text())
-        except (OSError, ValueError) as exc:
-            raise ParameterError(f"parameter 'world' must be a World or a world folder with world.json, "
-                                 f"got {str(world)!r} ({exc})") from None
-        return Ground(meta, read=lambda rel: (path.parent / rel).read_bytes())
-    raise ParameterError(f"parameter 'world' must be a World, a PackWorld or a world folder, got {type(world).__name__}")
+    opened = open_world(world)
+    return Ground(opened.metadata, scene=opened.scene, read=opened.read, path=opened.path)
 
 
 def leaves_of(ground: Ground) -> frozenset:

@@ -114,11 +114,12 @@ _HEADER = 54
 _WORLDS_KEPT = 4
 
 
-def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict, worlds: Optional[dict] = None):
+def draw_run(world, task: Optional[str], trajectory: np.ndarray, row: dict, worlds: Optional[dict] = None):
     """The run's picture (a Pillow image): the world as preview.png draws it from world.json (walls, obstacles,
     no-go zone, reference path, spawn and goal, movers' and people's tracks), the run over it, and at each
     contact who was where, all with :mod:`worldgen.export.topdown`; a header with the run and its verdict.
-    ``worlds`` keeps each world's picture between runs (it costs tens of ms to draw)."""
+    ``world`` is a world folder, a World or a pack's world; ``worlds`` keeps each world's picture between runs
+    (it costs tens of ms to draw)."""
     from PIL import Image, ImageDraw
 
     from worldgen.export.preview import draw, layout
@@ -127,7 +128,7 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
     from worldgen.groundtruth.ground import load
 
     worlds = {} if worlds is None else worlds
-    key = str(Path(world).resolve())
+    key = str(Path(world).resolve()) if isinstance(world, (str, Path)) else id(world)
     if key not in worlds:
         ground = load(world)
         worlds[key] = (ground, layout(ground.meta, _WIDTH), draw(ground.meta, _WIDTH))

@@ -10,7 +10,7 @@ Which world a bag ran in, in order of precedence:
 
 - ``runs``: a CSV table with columns ``bag`` and ``world`` (a world id of ``pack``, or a world
   folder), optional ``task`` and ``run``; relative paths are relative to the table's folder;
-- ``world``: one world folder for every bag;
+- ``world``: one world for every bag: a world folder, a :class:`~worldgen.World` or a pack's world;
 - ``pack``: the world whose id the bag names in its metadata (``custom_data``
   ``worldgen.world_id``, which :func:`worldgen.ros.write_run` and the ROS 2 bundle's
   launch file record).
@@ -31,15 +31,16 @@ import csv
 import math
 import tempfile
 from collections import OrderedDict
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Callable, Iterator, Optional, Sequence
 
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError, read_user_text
-from worldgen.files import MANIFEST_NAME, METADATA_NAME
-from worldgen.judge.figures import Ground
+from worldgen.files import MANIFEST_NAME
+from worldgen.groundtruth.folder import is_world_folder, open_world
+from worldgen.groundtruth.ground import Ground, load
 
 __all__ = ["Item", "JudgeResult", "judge", "plan", "PLOT_POINTS", "DEFAULT_CRITERIA"]
 
@@ -54,24 +55,13 @@ _CACHE = 8
 
 @dataclass(frozen=True)
 class Item:
-    """One bag to judge: the bag, its world folder (None: from the bag's metadata), task and run id."""
+    """One bag to judge: the bag, its world (a folder, or a World or pack world; None: from the bag's metadata),
+    task and run id."""
 
     bag: Path
-    world: Optional[Path]
+    world: Any
     task: Optional[str]
     run: Optional[str]
-
-
-class _WorldGround(Ground):
-    """A world folder's ground truth that also reads as a folder (``path``): the oracles use its colliders
-    as they are, evaluate reads its scenario.yaml, and one batch builds each world's colliders once."""
-
-    def __init__(self, folder: Path):
-        from worldgen.judge.figures import load
-
-        base = load(folder)
-        super().__init__(base.meta, read=base._read)
-        self.path = folder
 
 
 @dataclass
@@ -83,7 +73,7 @@ class JudgeResult:
     """
 
     report: dict
-    plots: list[Optional[dict]]   # per row: world folder, task, the .npy of its (m, 3) t, x, y; None when unreadable
+    plots: list[Optional[dict]]   # per row: world (folder or World), task, the .npy of its (m, 3) t, x, y; None when unreadable
     scratch: Any = field(default=None, repr=False)  # the TemporaryDirectory holding the .npy files
 
     def trajectory(self, k: int) -> Optional[np.ndarray]:
@@ -106,9 +96,11 @@ def plan(bags: Sequence, *, world=None, pack=None, runs=None) -> list[Item]:
         raise ParameterError("give at least one BAG (a rosbag2 folder, .mcap, .db3 or .bag), or --runs TABLE")
     folder = None
     if world is not None:
-        folder = Path(world)
-        if not (folder / METADATA_NAME).is_file():
-            raise ParameterError(f"--world '{folder}' is not a world folder (no world.json)")
+        opened = open_world(world, "--world")
+        folder = opened.path if isinstance(world, (str, Path)) else world
+        if opened.path is None and getattr(world, "feasibility", None) is None and not _archived(world):
+            raise ParameterError(f"--world: {opened.label} has no folder on disk to read its scenario.yaml from, "
+                                 "nor a World's scenario to build; write it first")
     elif pack is None:
         raise ParameterError("say where the worlds are: --world DIR, --pack DIR (worlds named in the bags' metadata) "
                              "or --runs TABLE")
@@ -117,8 +109,6 @@ def plan(bags: Sequence, *, world=None, pack=None, runs=None) -> list[Item]:
 
 def _index(pack) -> dict[str, Path]:
     """world id -> world folder of a built pack, or of a folder of world folders (``worldgen generate --out``)."""
-    import json
-
     root = Path(pack)
     if not root.is_dir() and not root.is_file():
         raise ParameterError(f"--pack '{root}' does not exist")
@@ -133,11 +123,11 @@ def _index(pack) -> dict[str, Path]:
         finally:
             opened.close()
     found = {}
-    for meta in sorted(root.glob("*/world.json")):
+    for sub in sorted(p for p in root.iterdir() if is_world_folder(p)):
         try:
-            found[str(json.loads(meta.read_text())["world_id"])] = meta.parent
-        except (OSError, ValueError, KeyError, TypeError):
-            continue  # not a world folder: the lookup reports the id as missing
+            found[open_world(sub).world_id] = sub
+        except ParameterError:
+            continue  # not a readable world folder: the lookup reports the id as missing
     if not found:
         raise ParameterError(f"--pack '{root}' is neither a pack (no manifest.json) nor a folder of world folders")
     return found
@@ -166,7 +156,7 @@ def _table(table: Path, pack) -> list[Item]:
         if not bag or not world:
             raise ParameterError(f"runs table '{table}' line {i}: bag and world must not be empty")
         candidate = table.parent / world
-        if (candidate / METADATA_NAME).is_file():
+        if is_world_folder(candidate):
             folder = candidate
         elif pack is not None:
             folder = _pack_world(pack, world, packs)
@@ -228,16 +218,20 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     if pack is not None:  # a pack that is missing or holds no world is a usage mistake, not 20 unjudged bags
         packs[str(pack)] = _index(pack)
     options = dict(read_options or {})
-    grounds: OrderedDict[Path, _WorldGround] = OrderedDict()
+    grounds: OrderedDict[Any, Ground] = OrderedDict()
     extra: list[dict] = []        # per bag: the judge's columns (judged ones also get evaluate's)
     plots: list[Optional[dict]] = []
     scratch = tempfile.TemporaryDirectory(prefix="worldgen-judge-")
+    if items and _archived(items[0].world):  # evaluate reads scenario.yaml from a folder: the world's, extracted
+        archived = items[0].world
+        folder = archived.pack.source.extract_folder(archived.folder, Path(scratch.name) / "world")
+        items = [replace(item, world=folder) for item in items]
     names: set[str] = set()
 
-    def ground(folder: Path) -> _WorldGround:
-        key = folder.resolve()
+    def ground(world) -> Ground:
+        key = world.resolve() if isinstance(world, Path) else id(world)  # a World or pack world: the object itself
         if key not in grounds:
-            grounds[key] = _WorldGround(folder)
+            grounds[key] = load(world)
             if len(grounds) > _CACHE:
                 grounds.popitem(last=False)
         grounds.move_to_end(key)
@@ -257,7 +251,8 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
                 g = ground(folder)
                 world_id, task_id = str(g.meta.get("world_id")), g.task(task)["id"]
                 row["run"] = _run_name(world_id, task_id, item.run or named.get("worldgen.run"), names)
-                row["world_folder"] = str(folder)
+                # None where the world has no folder of its own: an unwritten World, an archive's world extracted
+                row["world_folder"] = None if g.path is None or Path(scratch.name) in g.path.parents else str(g.path)
                 try:
                     _same_world(item.bag, named, world_id)
                     got = read_run(item.bag, g, task=task, start=start, **options)
@@ -276,7 +271,8 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
                 points = Path(scratch.name) / f"{len(plots)}.npy"
                 np.save(points, _decimate(got.trajectory))
                 plots.append({"world": folder, "task": task, "points": points})
-                yield got.trajectory, g, task
+                # evaluate reads the run's scenario from the world's folder, or builds it from an unwritten World
+                yield got.trajectory, g if g.path is not None else folder, task
             except WorldgenError as exc:
                 row.update(run=row["run"] or _unique(_stem(item.bag), names), readable=False, outcome="unjudged",
                            reason=str(exc), success=None, world_id=None, task=item.task)
@@ -298,6 +294,11 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
             yield from runs_iter
         report = evaluate(chained(), criteria).to_dict()
     return JudgeResult(_assemble(report, extra), plots, scratch)
+
+
+def _archived(world) -> bool:
+    """Whether ``world`` is a world inside a pack archive (a PackWorld with no folder on disk)."""
+    return bool(getattr(getattr(world, "pack", None), "archive", False))
 
 
 def _same_world(bag: Path, metadata: dict, world_id: str) -> None:

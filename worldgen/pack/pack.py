@@ -17,7 +17,8 @@ from pathlib import Path, PurePosixPath
 from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 from worldgen.errors import ParameterError
-from worldgen.files import BUILD_STATE_DIR, MANIFEST_NAME, METADATA_NAME
+from worldgen.files import BUILD_STATE_DIR, MANIFEST_NAME
+from worldgen.groundtruth.folder import WorldFolder
 from worldgen.pack.archive import ArchiveReader, is_archive
 from worldgen.pack.manifest import METRICS, SCHEMA_ID, world_folder
 from worldgen.pack.where import parse_where
@@ -73,8 +74,10 @@ class PackWorld:
     """One world of a pack, as its manifest records it.
 
     It reads as a :class:`~worldgen.World` does where both make sense: ``world_id``,
-    ``metadata`` (world.json as a dict), ``read(name)`` (a file's bytes) and
-    ``path`` (None inside an archive), so the oracles take either.
+    ``metadata`` (world.json as a dict), ``read(name)`` (a file's bytes), ``path`` (None inside an
+    archive), ``robot`` and ``file(fmt)``, and adds ``task(id)``: all of it through ``reader``, the
+    :class:`~worldgen.groundtruth.folder.WorldFolder` every world folder is read with, so the oracles,
+    ``worldgen drive`` and the judge take either.
     """
 
     index: int
@@ -100,9 +103,27 @@ class PackWorld:
         return self.pack.source.read(f"{self.folder}/{name}")
 
     @cached_property
+    def reader(self) -> WorldFolder:
+        """This world read as a world folder (world.json, tasks, robot, files by format key)."""
+        return WorldFolder(self.read, self.path, label=f"world {self.world_id} of pack '{self.pack.path}'")
+
+    @property
     def metadata(self) -> dict:
         """world.json as a dict."""
-        return json.loads(self.read(METADATA_NAME))
+        return self.reader.metadata
+
+    @property
+    def robot(self):
+        """The footprint (world.json ``robot``) as a :class:`~worldgen.scene.Robot`."""
+        return self.reader.robot
+
+    def task(self, task: Optional[str] = None) -> dict:
+        """world.json's ``tasks[]`` entry of id ``task`` (the first without one)."""
+        return self.reader.task(task)
+
+    def file(self, fmt: str) -> Path:
+        """Path on disk of this world's file of format key ``fmt`` (a pack folder's, not an archive's)."""
+        return self.reader.file(fmt)
 
 
 class Pack:

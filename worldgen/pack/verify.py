@@ -11,12 +11,11 @@ from an archive, on a temporary copy of the folder).
 from __future__ import annotations
 
 import hashlib
-import json
 import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from worldgen.files import INDEX_NAME, WORLDS_DIR
+from worldgen.files import INDEX_NAME, METADATA_NAME, WORLDS_DIR
 from worldgen.pack.manifest import index_bytes
 from worldgen.pack.pack import Pack
 
@@ -44,9 +43,8 @@ def verify_pack(path, regenerate: bool = False) -> Iterator[tuple[bool, str]]:
 
 def _world(pack: Pack, world, validate, regenerate: bool) -> tuple[bool, str]:
     src = pack.source
-    meta_rel = f"{world.folder}/world.json"
-    if meta_rel not in world.files:
-        return False, f"FAIL {world.world_id}: files: world.json is not listed in the manifest"
+    if f"{world.folder}/{METADATA_NAME}" not in world.files:
+        return False, f"FAIL {world.world_id}: files: {METADATA_NAME} is not listed in the manifest"
     for rel, digest in sorted(world.files.items()):
         if not rel.startswith(world.folder + "/"):
             return False, f"FAIL {world.world_id}: paths: {rel} is outside the world's folder"
@@ -55,12 +53,12 @@ def _world(pack: Pack, world, validate, regenerate: bool) -> tuple[bool, str]:
         if hashlib.sha256(src.read(rel)).hexdigest() != digest:
             return False, f"FAIL {world.world_id}: files: {rel} does not match its sha256"
     try:
-        meta = json.loads(src.read(meta_rel))
+        meta = world.metadata  # its bytes were checked against the manifest's sha256 above
         validate(meta)
     except Exception as exc:  # a bad world.json is a verdict, not a crash
         return False, f"FAIL {world.world_id}: schema: {' '.join(str(exc).split())[:200]}"
     if (meta.get("world_id"), meta.get("generator"), meta.get("seed")) != (world.world_id, world.generator, world.seed):
-        return False, f"FAIL {world.world_id}: metadata: world.json names another world"
+        return False, f"FAIL {world.world_id}: metadata: {METADATA_NAME} names another world"
     if regenerate:
         from worldgen.verify import check_folder
 

@@ -35,6 +35,7 @@ import numpy as np
 
 from worldgen.envs.policies import PathFollower
 from worldgen.errors import OutputError, ParameterError
+from worldgen.groundtruth.folder import WorldFolder, open_world
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "Outcome",
            "drive", "run_loop", "steps_per_command"]
@@ -96,42 +97,16 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED) 
     return np.array(rows), np.array(commands), ended
 
 
-def _load(folder: Path) -> dict:
-    from worldgen.files import METADATA_NAME
-
-    path = folder / METADATA_NAME
-    if not path.is_file():
-        raise ParameterError(f"argument WORLD must be a world folder holding {METADATA_NAME}; '{folder}' has none")
-    return json.loads(path.read_text(encoding="utf-8"))
-
-
-def _task(meta: dict, task_id: Optional[str]) -> dict:
-    tasks = meta["tasks"]
-    if task_id is None:
-        return tasks[0]
-    for task in tasks:
-        if task["id"] == task_id:
-            return task
-    raise ParameterError(f"option '--task' must name one of the world's tasks ({', '.join(t['id'] for t in tasks)}), "
-                         f"got {task_id!r}")
-
-
-def _file(folder: Path, meta: dict, key: str) -> Path:
-    entry = meta["files"].get(key)
-    if entry is None or not (folder / entry["path"]).is_file():
-        raise ParameterError(f"world folder '{folder}' has no {key} file; write the world with that format to drive it")
-    return folder / entry["path"]
-
-
-def _backend(sim: str, folder: Path, meta: dict):
+def _backend(sim: str, world: WorldFolder):
+    meta = world.metadata
     if sim == "mujoco":
         from worldgen.sim.mujoco import MujocoBackend
 
-        return MujocoBackend(_file(folder, meta, "mjcf"), meta)
+        return MujocoBackend(world.file_bytes("mjcf"), meta)
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.bridge import GazeboBackend, world_step
 
-    sdf = _file(folder, meta, "sdf")
+    sdf = world.file("sdf")
     # The ground truth is published once a command, at its last step: OdometryPublisher publishes when the
     # time since its last message reaches its period, so a period half a step short of a command's steps
     # lands on every command's end (the first at the end of the first), and no other message wakes the bridge.
@@ -143,16 +118,20 @@ def _backend(sim: str, folder: Path, meta: dict):
 
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,
           speed: float = SPEED) -> Outcome:
-    """Drive ``world`` (a world folder) in ``sim``, write the bag into the new folder ``out``/<bag name>, judge it."""
+    """Drive ``world`` in ``sim``, write the bag into the new folder ``out``/<bag name>, judge it.
+
+    ``world`` is a world folder, a :class:`~worldgen.World` or a pack's world (read through
+    :func:`worldgen.groundtruth.folder.open_world`); Gazebo loads world.sdf from disk, so there it must
+    be written (a World) or in a pack folder (not an archive)."""
     from worldgen.judge import judge
 
     if sim not in SIMS:
         raise ParameterError(f"option '--sim' must be one of {', '.join(SIMS)}, got {sim!r}")
     if not (0 < speed <= 2.0):
         raise ParameterError(f"option '--speed' must be in (0, 2] m/s, got {speed!r}")
-    folder = Path(world)
-    meta = _load(folder)
-    chosen = _task(meta, task)
+    opened = open_world(world, "argument WORLD")
+    meta = opened.metadata
+    chosen = opened.task(task, "option '--task'")
     bag = Path(out) / f"{meta['world_id']}-{chosen['id']}-{sim}{'-straight' if straight else ''}"
     if bag.exists():
         raise ParameterError(f"option '--out': '{bag}' exists already; a run is written into a new folder")
@@ -160,7 +139,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
         raise OutputError(f"output folder '{out}' is not a folder")
     wall = {}
     started = time.perf_counter()
-    backend = _backend(sim, folder, meta)
+    backend = _backend(sim, opened)
     try:
         trajectory, commands, ended = run_loop(backend, chosen, straight, speed)
     finally:
@@ -168,7 +147,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     wall["drive"] = time.perf_counter() - started
     _write_bag(bag, trajectory, commands, meta, chosen)
     wall["record"] = time.perf_counter() - started - wall["drive"]
-    result = judge([bag], world=folder)
+    result = judge([bag], world=world)
     wall["judge"] = time.perf_counter() - started - wall["drive"] - wall["record"]
     run = result.report["runs"][0]
     return Outcome(bag, ended, bool(result.passed), _verdict(run, ended), run,

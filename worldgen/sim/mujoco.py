@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Union
 
 import numpy as np
 from lxml import etree
@@ -16,6 +17,7 @@ from lxml import etree
 from worldgen.envs.movers import MoverScript
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.export.xml import safe_parser
+from worldgen.groundtruth.folder import robot_of
 
 __all__ = ["MujocoBackend", "V_RANGE", "W_MAX"]
 
@@ -25,12 +27,14 @@ W_MAX = 4.0
 
 
 class MujocoBackend:
-    """:meth:`start` puts the robot at the spawn; :meth:`step` holds (v, w) for N physics steps."""
+    """:meth:`start` puts the robot at the spawn; :meth:`step` holds (v, w) for N physics steps.
 
-    def __init__(self, mjcf: Path, meta: dict):
-        root = etree.fromstring(Path(mjcf).read_bytes(), safe_parser())
-        robot = meta["robot"]
-        add_robot(root, float(robot["radius"]), float(robot["height"]), V_RANGE, W_MAX)
+    ``mjcf`` is the world's MJCF, its bytes (a world need not be on disk: a World, a pack archive's) or its path."""
+
+    def __init__(self, mjcf: Union[bytes, Path], meta: dict):
+        root = etree.fromstring(mjcf if isinstance(mjcf, bytes) else Path(mjcf).read_bytes(), safe_parser())
+        robot = robot_of(meta)
+        add_robot(root, robot.radius, robot.height, V_RANGE, W_MAX)
         self._root = root
         self._floor = sorted(e["name"] for e in meta["entities"] if e["role"] == "floor")
         self._movers = [m["name"] for m in meta.get("dynamic_obstacles", [])]

@@ -13,13 +13,12 @@ resolution and its sub-pixel sampling put the ray on either side of the jump.
 
 from __future__ import annotations
 
-import json
 import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from worldgen.files import METADATA_NAME
+from worldgen.groundtruth.folder import open_world
 from worldgen.sim.gazebo import GazeboError, GazeboServer, locate
 
 __all__ = ["gazebo_scan", "read_scan", "edge_rays", "EDGE_JUMP"]
@@ -28,10 +27,10 @@ __all__ = ["gazebo_scan", "read_scan", "edge_rays", "EDGE_JUMP"]
 EDGE_JUMP = 0.1
 
 
-def _world_with_sensors(folder: Path, sdf_name: str) -> str:
+def _world_with_sensors(folder: Path, sdf: Path) -> str:
     from worldgen.ros.bundle import with_plugins
 
-    text = (folder / sdf_name).read_text(encoding="utf-8")
+    text = sdf.read_text(encoding="utf-8")
     return with_plugins(text, "fortress", str(folder.resolve()) + "/").decode()
 
 
@@ -42,16 +41,18 @@ def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> np
 
 def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> tuple[np.ndarray, str]:
     """(ranges, m; the message's header ``frame_id``) of the first scan the robot's gpu_lidar publishes at the
-    first task's spawn in ``world`` (a folder). The frame is what a ROS 2 bridge passes on."""
+    first task's spawn in ``world`` (a world folder, a written World or a pack folder's world: Gazebo loads
+    its world.sdf from disk). The frame is what a ROS 2 bridge passes on."""
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.textproto import first
 
-    folder = Path(world)
-    meta = json.loads((folder / METADATA_NAME).read_text(encoding="utf-8"))
-    spawn = meta["tasks"][0]["spawn"]
+    opened = open_world(world)
+    meta = opened.metadata
+    spawn = opened.task()["spawn"]
+    source = opened.file("sdf")
     with tempfile.TemporaryDirectory(prefix="worldgen-scan-") as tmp:
-        sdf = Path(tmp) / "world.sdf"  # the world folder is left untouched; its meshes are named absolutely
-        sdf.write_text(_world_with_sensors(folder, meta["files"]["sdf"]["path"]), encoding="utf-8")
+        sdf = Path(tmp) / source.name  # the world folder is left untouched; its meshes are named absolutely
+        sdf.write_text(_world_with_sensors(opened.file("json").parent, source), encoding="utf-8")
         with GazeboServer(sdf, install=locate(), headless_rendering=True) as gz:
             gz.spawn(robot_sdf(meta, gz_release="fortress", lidar_noise=lidar_noise), name="robot",
                      pose=(spawn[0], spawn[1], spawn[2], spawn[5]))
