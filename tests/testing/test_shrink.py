@@ -186,7 +186,10 @@ def test_every_candidate_handed_over_holds_its_certificate_as_check_reads_it(cro
 
 def test_a_world_folder_in_a_folder_out(crowds, tmp_path):
     """What a campaign's worker calls: the path of a written world in, the shrunk world written, plain data back."""
+    from worldgen.verify import load_world
+
     folder = crowds["random"].write(tmp_path / "in")
+    assert load_world(folder).content_hash == crowds["random"].content_hash
     result = worldgen.shrink(str(folder), lambda w: "person_5" in people(w), tmp_path / "out")
     record = result.record()
     assert json.loads(json.dumps(record)) == record and record["counts"]["people"] == 5
