@@ -10,8 +10,10 @@ An edit changes one thing of a world's scene or tasks:
 ``move_goal``  a task's goal slides by up to :data:`STEP` m (its tolerance and yaw kept; never nearer the
                spawn than the generator's ``min_spawn_goal_distance``).
 
-Two more operators are never drawn, only recorded by :func:`worldgen.shrink`:
-``remove`` of any root obstacle without children (a mesh too), and ``remove_mover`` of a scripted mover.
+Three more operators are never drawn, only recorded by :func:`worldgen.shrink`: ``remove`` of any root
+obstacle without children (a mesh too), ``remove_mover`` of a scripted mover and ``remove_person`` of a
+person. In a world with people every edit is followed by the people's walk made again and certified anew
+(:mod:`worldgen.verify.rewalk`): a world whose people cannot be certified after it is not kept.
 
 Only the root nodes whose role is ``obstacle`` and whose shape is a box or a cylinder are edited (walls,
 doors, frames and floors never); an edited obstacle stays inside the scene's bounds. Worlds with movers
@@ -19,9 +21,9 @@ or people are not edited (their timed proofs follow the obstacles): :func:`edit_
 
 Every edited scene goes through :func:`worldgen.feasibility.check`, the same exact checker a generated
 world passes, and is kept only when feasible: an :class:`EditedWorld` always carries a certificate and a
-reference path per task. An edit is recorded as plain data (its operator, target and new values), so
-:func:`replay_edits` rebuilds the same world from (generator, params, seed, edits), re-proving it.
-Randomness comes from :func:`worldgen.seeding.edit_rng` of a seed the caller draws.
+reference path per task (among people, a timed path per task too). An edit is recorded as plain data (its
+operator, target and new values), so :func:`replay_edits` rebuilds the same world from (generator, params,
+seed, edits), re-proving it. Randomness comes from :func:`worldgen.seeding.edit_rng` of a seed the caller draws.
 """
 
 from __future__ import annotations
@@ -39,6 +41,7 @@ from worldgen.errors import ParameterError
 from worldgen.floats import round_float
 from worldgen.scene import Box, Cylinder, Material, Node, Pose, Scene, Task
 from worldgen.seeding import edit_rng
+from worldgen.verify.rewalk import people_plan, settle
 from worldgen.world import World
 
 __all__ = ["EDITS", "STEP", "SCALE", "TRIES", "EditedWorld", "edit_world", "apply_edit", "replay_edits", "removable",
@@ -65,11 +68,15 @@ class EditedWorld(World):
     scene alone: two levels are the same only when their generator, parameters, seed and edits are.
     """
 
-    def __init__(self, parent: World, scene: Scene, tasks: Sequence[Task], report, edits: Sequence[dict]):
+    def __init__(self, parent: World, scene: Scene, tasks: Sequence[Task], report, edits: Sequence[dict],
+                 plan=None):
         super().__init__(parent.generator, parent.seed, parent.params, scene, tasks, parent.robot, report,
                          parent.attempts, parent.allow_infeasible)
         self.set_provenance(preset=parent.preset)
         self.edits: tuple[dict, ...] = tuple(edits)
+        #: The plan the generator drew for the people (:mod:`worldgen.verify.rewalk`): a later edit walks them
+        #: from it again. None in a world generated without people.
+        self.people_plan = plan if plan is not None else getattr(parent, "people_plan", None)
 
     @cached_property
     def content_hash(self) -> str:
@@ -109,12 +116,15 @@ def edit_world(world: World, seed: int, ops: Sequence[str] = EDITS, tries: int =
 
 def replay_edits(world: World, edits: Sequence[dict]) -> EditedWorld:
     """``world`` with the recorded ``edits`` applied in order, each re-proved; ParameterError when one no
-    longer applies or no longer passes (a record from another worldgen version)."""
+    longer applies or no longer passes (a record from another worldgen version). Among people, each edit is
+    proved on the static scene and the people are walked and certified once, after the last (the settled
+    world does not depend on the order: :mod:`worldgen.verify.rewalk`)."""
     out: World = world
-    for edit in edits:
-        edited = _proven(out, [dict(edit)])
+    for k, edit in enumerate(edits):
+        edited = _proven(out, [dict(edit)], walk=k == len(edits) - 1)
         if edited is None:
-            raise ParameterError(f"edit {edit!r} of world {world.world_id} does not give a feasible world")
+            among = " among its people re-walked" if people_plan(out) is not None else ""
+            raise ParameterError(f"edit {edit!r} of world {world.world_id} does not give a feasible world{among}")
         out = edited
     if not isinstance(out, EditedWorld):
         raise ParameterError("parameter 'edits' must hold at least one edit")
@@ -127,18 +137,25 @@ def with_edits(world: World, edits: Sequence[dict]) -> Optional[EditedWorld]:
     return _proven(world, [dict(e) for e in edits])
 
 
-def _proven(world: World, edits: list[dict]) -> Optional[EditedWorld]:
+def _proven(world: World, edits: list[dict], walk: bool = True) -> Optional[EditedWorld]:
+    """``world`` with ``edits``, proven; among people, walked again and certified unless ``walk`` is False
+    (an edit of a replay before its last, whose people the last one walks)."""
     scene, tasks = world.scene, world.tasks
     try:
         for edit in edits:
             scene, tasks = apply_edit(scene, tasks, edit)
     except (KeyError, ValueError, IndexError, TypeError):  # a record that names nothing here, or a bad value
         return None
-    report = feasibility.check(scene, tasks, world.robot)
+    report = feasibility.check(scene, tasks, world.robot)  # static: it never reads the people
     if not report.feasible or any(p is None for p in report.paths):
         return None
+    plan = people_plan(world)
+    if plan is not None and walk:
+        scene, report = settle(world, plan, scene, tasks, report)
+        if not report.feasible:  # the people left no way through: not a world to keep
+            return None
     before = world.edits if isinstance(world, EditedWorld) else ()
-    return EditedWorld(world, scene, tasks, report, before + tuple(edits))
+    return EditedWorld(world, scene, tasks, report, before + tuple(edits), plan)
 
 
 def apply_edit(scene: Scene, tasks: Sequence[Task], edit: dict) -> tuple[Scene, tuple[Task, ...]]:
@@ -151,10 +168,11 @@ def apply_edit(scene: Scene, tasks: Sequence[Task], edit: dict) -> tuple[Scene, 
         t = tasks[k]
         goal = Pose(float(edit["x"]), float(edit["y"]), t.goal.z, t.goal.roll, t.goal.pitch, t.goal.yaw)
         return scene, tasks[:k] + (Task(t.id, t.spawn, goal, t.goal_tolerance),) + tasks[k + 1:]
-    if op == "remove_mover":
-        if not any(m.name == edit["mover"] for m in scene.movers):
-            raise ParameterError(f"no mover named {edit['mover']!r}")
-        return scene.with_movers(m for m in scene.movers if m.name != edit["mover"]), tasks
+    if op in ("remove_mover", "remove_person"):
+        person, name = op == "remove_person", edit["person" if op == "remove_person" else "mover"]
+        if not any(m.name == name and m.person == person for m in scene.movers):
+            raise ParameterError(f"no {'person' if person else 'scripted mover'} named {name!r}")
+        return scene.with_movers(m for m in scene.movers if m.name != name), tasks
     nodes = list(scene.nodes)
     if op == "add":
         node = _node(edit["name"], edit["shape"], float(edit["x"]), float(edit["y"]), float(edit["yaw"]),

@@ -49,7 +49,7 @@ import numpy as np
 
 from worldgen.files import METADATA_NAME
 
-__all__ = ["CHECKS", "Outcome", "check_folder", "LENGTH_TOLERANCE"]
+__all__ = ["CHECKS", "Outcome", "check_folder", "load_world", "LENGTH_TOLERANCE"]
 
 CHECKS = ("metadata", "paths", "files", "schema", "regenerate", "feasibility", "timed", "reproduce")
 #: Recorded and re-run path lengths may differ by this much (m): the 1e-6 of the
@@ -102,6 +102,21 @@ def check_folder(folder) -> Outcome:
     except _Fail as f:
         return Outcome(folder, False, f.check, f.detail)
     return Outcome(folder, True, note=note)
+
+
+def load_world(folder):
+    """The World a world folder holds, rebuilt from its world.json (generator, seed, params, then its
+    ``edits``) and proven the one recorded (the same ``content_hash``); the files themselves are not read.
+    A folder that holds no such world is one :class:`~worldgen.errors.ParameterError` line."""
+    from worldgen.errors import ParameterError
+
+    folder = Path(folder)
+    try:
+        meta = _metadata(folder)
+        _schema(meta)
+        return _regenerate(meta)
+    except _Fail as f:
+        raise ParameterError(f"'{folder}' holds no world worldgen can rebuild: {f.check}: {f.detail}") from None
 
 
 # -- the checks ----------------------------------------------------------------
