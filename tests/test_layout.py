@@ -238,7 +238,7 @@ BUILTIN_RAISES_ALLOWED = {
     ("export/metadata.py", "TypeError"): "the JSON encoder's protocol: a value world.json cannot hold is a bug in the caller",
     ("params.py", "ValueError"): "raised and caught a line later, inside parsing; never leaves the function",
     ("ros/cdr.py", "ValueError"): "the fast decoder's own signal; the reader catches it and falls back to rosbags",
-    ("ros/bundle.py", "AssertionError"): "an invariant of the shipped templates, not of anything a user gives",
+    ("export/ros2.py", "AssertionError"): "an invariant of the shipped templates, not of anything a user gives",
     ("pack/archive.py", "FileNotFoundError"): "the archive's file reader answers as open() does",
     ("feasibility/report.py", "KeyError"): "the report's mapping protocol (report['check_name'])",
     ("pack/pack.py", "KeyError"): "the pack's mapping protocol (pack['world_id'])",

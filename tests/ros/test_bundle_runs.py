@@ -19,7 +19,7 @@ import pytest
 import yaml
 from support.bundle import load_script as load
 
-from worldgen.ros import bundle as ros2
+from worldgen.export import ros2
 
 # -- stand-ins of ROS's launch API ------------------------------------------------
 

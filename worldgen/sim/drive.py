@@ -128,6 +128,7 @@ def _backend(sim: str, folder: Path, meta: dict):
         from worldgen.sim.mujoco import MujocoBackend
 
         return MujocoBackend(_file(folder, meta, "mjcf"), meta)
+    from worldgen.export.contract import SIM_GZ_RELEASE
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.bridge import GazeboBackend, world_step
 
@@ -137,7 +138,7 @@ def _backend(sim: str, folder: Path, meta: dict):
     # lands on every command's end (the first at the end of the first), and no other message wakes the bridge.
     dt = world_step(sdf)
     per = steps_per_command(dt)
-    robot = robot_sdf(meta, gz_release="fortress", sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
+    robot = robot_sdf(meta, gz_release=SIM_GZ_RELEASE, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
     return GazeboBackend(sdf, robot, dt=dt, first_steps=per)
 
 
