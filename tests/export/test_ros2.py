@@ -4,8 +4,8 @@ ROS 2 cannot be installed on the machines these tests run on (Debian 12), so the
 checked for structure and against lists pinned from the ROS packages' documentation and sources (each
 list says where it comes from); the goal sender runs against a stand-in keeping BasicNavigator's
 initial-pose behaviour. The SDF with plugins goes through libsdformat. The launch description and the
-loop at run time are in test_bundle_runs.py, the map and robot in test_bundle_world.py, the real Gazebo
-server's shutdown in test_bundle_gazebo.py; docs/ros2.md says what was verified where.
+loop at run time are in test_ros2_runs.py, the map and robot in test_ros2_world.py, the real Gazebo
+server's shutdown in test_ros2_gazebo.py; docs/ros2.md says what was verified where.
 """
 
 from __future__ import annotations
