@@ -170,7 +170,7 @@ def dumps(data: Any) -> bytes:
 
 def _template(name: str) -> str:
     """``templates/ros2/<name>.in``: .in, so that no tool takes the scripts for modules of worldgen."""
-    return resources.files("worldgen.templates").joinpath("ros2", name + ".in").read_text(encoding="utf-8")
+    return resources.files("worldgen.templates").joinpath("ros2").joinpath(name + ".in").read_text(encoding="utf-8")
 
 
 def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_GZ_RELEASE,
