@@ -197,6 +197,7 @@ class _Messages:
 
     def __init__(self, types: Mapping[str, Any], base_frame: str):
         self.T, self.base_frame = types, base_frame
+        self.zero6 = np.zeros(36)  # covariances: the same unknown for every message
 
     def stamp(self, t: float):
         ns = int(round(t * 1e9))
@@ -225,7 +226,7 @@ class _Messages:
         return self.T[TF.ros_type](transforms=transforms)
 
     def odometry(self, t: float, frame: str, p, v: float, w: float):
-        T, zero6 = self.T, np.zeros(36)
+        T, zero6 = self.T, self.zero6
         return T[ODOM.ros_type](
             header=self.header(t, frame), child_frame_id=self.base_frame,
             pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=self.pose(p), covariance=zero6),
@@ -302,15 +303,15 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
         gt_, gx, gy, gyaw = (float(v) for v in goal)
         out.append((gt_, GOAL_POSE.name, m.T[GOAL_POSE.ros_type](header=m.header(gt_, "map"), pose=m.pose((gx, gy, gyaw)))))
     # Messages go out in receive-time order, as a recorder writes them (a stable sort: ties keep their order).
-    out.sort(key=lambda item: _receive_ns(item[0]))
+    timed = sorted(((_receive_ns(t) + RECEIVE_LATENCY_NS, name, msg) for t, name, msg in out), key=lambda item: item[0])
     static = "tf" in topics and not drift and map_odom
     types = {CMD_VEL.name: CMD_VEL_STAMPED_TYPE if stamped_cmd else CMD_VEL.ros_type}
     with bag:
         conns = {name: bag.add_connection(name, types.get(name))
-                 for name in sorted({item[1] for item in out} | ({TF_STATIC.name} if static else set()))}
+                 for name in sorted({item[1] for item in timed} | ({TF_STATIC.name} if static else set()))}
         if static:
             t0 = float(traj[0, 0])
             bag.write(conns[TF_STATIC.name], _receive_ns(t0), m.tf_message([m.tf(t0, "map", "odom", spawn3)]))
-        for t, name, msg in out:
-            bag.write(conns[name], _receive_ns(t) + RECEIVE_LATENCY_NS, msg)
+        for when, name, msg in timed:
+            bag.write(conns[name], when, msg)
     return bag.path
