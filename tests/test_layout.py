@@ -320,6 +320,17 @@ def test_gazebo_releases_and_topics_are_spelled_only_in_the_contract():
     assert not found, "spell these through worldgen.export.contract:\n" + "\n".join(found)
 
 
+def test_the_contract_check_finds_a_planted_spelling_and_not_prose(tmp_path):
+    (tmp_path / "export").mkdir()
+    (tmp_path / "sim").mkdir()
+    (tmp_path / "export" / "contract.py").write_text('RELEASE = "fortress"\n')
+    (tmp_path / "sim" / "drive.py").write_text('"""Drives in fortress, reads /ground_truth."""\n'
+                                               'robot = robot_sdf(meta, gz_release="fortress")\n'
+                                               'topic = f"{ns}/ground_truth"\n')  # a piece of an f-string counts
+    assert sorted(spelled_outside_the_contract(tmp_path, contract_spellings())) == \
+        [f"{tmp_path.name}/sim/drive.py:2 'fortress' (a Gazebo release)", f"{tmp_path.name}/sim/drive.py:3 '/ground_truth' (a topic)"]
+
+
 def is_deprecation_shim(tree: ast.Module) -> bool:
     """A module kept only so an old import path works: no function or class of its own, and it warns."""
     warns = any(isinstance(n, ast.Expr) and isinstance(n.value, ast.Call) and "DeprecationWarning" in ast.dump(n.value)
