@@ -7,7 +7,7 @@
     >>> GROUND_TRUTH.name, GROUND_TRUTH.ros_type, GROUND_TRUTH.gz_topic
     ('/ground_truth', 'nav_msgs/msg/Odometry', '/ground_truth/odom')
 
-Everything that names a release's plugins, its command-line tool or its message package, and every
+Everything that names a release's plugins, its server command or its message package, and every
 module that spells a topic of a run (the robot's SDF, the ROS 2 bundle's bridge and recorder, the bag
 writer, the bag reader's defaults, the Gazebo drive, ``worldgen judge``'s options) reads them here, so
 a topic or a release is renamed in one place (tests/test_layout.py holds that no other module spells
