@@ -238,7 +238,7 @@ BUILTIN_RAISES_ALLOWED = {
     ("export/metadata.py", "TypeError"): "the JSON encoder's protocol: a value world.json cannot hold is a bug in the caller",
     ("params.py", "ValueError"): "raised and caught a line later, inside parsing; never leaves the function",
     ("ros/cdr.py", "ValueError"): "the fast decoder's own signal; the reader catches it and falls back to rosbags",
-    ("ros/bundle.py", "AssertionError"): "an invariant of the shipped templates, not of anything a user gives",
+    ("export/ros2.py", "AssertionError"): "an invariant of the shipped templates, not of anything a user gives",
     ("pack/archive.py", "FileNotFoundError"): "the archive's file reader answers as open() does",
     ("feasibility/report.py", "KeyError"): "the report's mapping protocol (report['check_name'])",
     ("pack/pack.py", "KeyError"): "the pack's mapping protocol (pack['world_id'])",
@@ -455,3 +455,88 @@ def test_the_world_json_rule_finds_a_hand_rolled_read():
     clean = '"""Reads world.json through the reader."""\nraise ParameterError("x is not a world folder (no world.json)")\n'
     assert world_json_named({"sim/ok.py": clean}) == []
     assert world_json_named({"world.py": hand_rolled[0]}) == []
+
+
+# -- the ROS/Gazebo contract --------------------------------------------------------------------------
+
+CONTRACT = PACKAGE / "export" / "contract.py"
+
+
+def contract_spellings() -> dict[str, str]:
+    """Each string the contract owns -> what it is: every Gazebo release's name, every topic's ROS name and
+    its Gazebo topic (read from the module itself, so a row added there is held here too)."""
+    from worldgen.export import contract
+
+    out = {name: "a Gazebo release" for name in contract.GZ_RELEASES}
+    out.update({t.gz_topic: "a Gazebo topic" for t in contract.TOPICS if t.gz_topic is not None})
+    out.update({t.name: "a topic" for t in contract.TOPICS})
+    return out
+
+
+def spelled_outside_the_contract(package: Path, spellings: dict[str, str]) -> list[str]:
+    found = []
+    for path in sorted(package.rglob("*.py")):
+        if path == package / "export" / "contract.py" or "templates" in path.relative_to(package).parts:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value in spellings:
+                found.append(f"{path.relative_to(package.parent)}:{node.lineno} {node.value!r} ({spellings[node.value]})")
+    return found
+
+
+def test_gazebo_releases_and_topics_are_spelled_only_in_the_contract():
+    """The robot, the bundle, the bag writer and reader, sim/ and the CLI read releases and topics from
+    worldgen/export/contract.py: a literal elsewhere is a second home that a rename would miss (issue 35
+    found /ground_truth with two types and two default releases that way)."""
+    spellings = contract_spellings()
+    assert {"fortress", "harmonic", "/ground_truth", "/cmd_vel"} <= set(spellings)
+    found = spelled_outside_the_contract(PACKAGE, spellings)
+    assert not found, "spell these through worldgen.export.contract:\n" + "\n".join(found)
+
+
+def test_the_contract_check_finds_a_planted_spelling_and_not_prose(tmp_path):
+    (tmp_path / "export").mkdir()
+    (tmp_path / "sim").mkdir()
+    (tmp_path / "export" / "contract.py").write_text('RELEASE = "fortress"\n')
+    (tmp_path / "sim" / "drive.py").write_text('"""Drives in fortress, reads /ground_truth."""\n'
+                                               'robot = robot_sdf(meta, gz_release="fortress")\n'
+                                               'topic = f"{ns}/ground_truth"\n')  # a piece of an f-string counts
+    assert sorted(spelled_outside_the_contract(tmp_path, contract_spellings())) == \
+        [f"{tmp_path.name}/sim/drive.py:2 'fortress' (a Gazebo release)", f"{tmp_path.name}/sim/drive.py:3 '/ground_truth' (a topic)"]
+
+
+def is_deprecation_shim(tree: ast.Module) -> bool:
+    """A module kept only so an old import path works: no function or class of its own, and it warns."""
+    warns = any(isinstance(n, ast.Expr) and isinstance(n.value, ast.Call) and "DeprecationWarning" in ast.dump(n.value)
+                for n in tree.body)
+    return warns and not any(isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)) for n in ast.walk(tree))
+
+
+def ros_room_writers(graph: dict[str, set[str]], paths: dict[str, Path]) -> list[str]:
+    """Modules of ros/ that reach for a world folder's files: worldgen.files (names, atomic writes) or an
+    exporter other than the contract's tables (the package export/ itself holds nothing)."""
+    out = []
+    for name in sorted(m for m in graph if room_of(m) == "ros"):
+        reached = sorted(t for t in graph[name] if t == "worldgen.files" or
+                         (room_of(t) == "export" and t not in ("worldgen.export", "worldgen.export.contract")))
+        if reached and not is_deprecation_shim(ast.parse(paths[name].read_text())):
+            out.append(f"{name} -> {', '.join(reached)}")
+    return out
+
+
+def test_the_ros_room_keeps_bags_only():
+    """ros/ reads and writes bags; what a world folder holds (the ROS 2 bundle among it) is export/'s."""
+    found = ros_room_writers(import_graph(), modules())
+    assert not found, "ros/ writes no world-folder file; move this to export/:\n" + "\n".join(found)
+
+
+def test_the_ros_room_check_finds_a_bundle_and_lets_a_shim_be():
+    graph = {"worldgen.ros.bundle": {"worldgen.files", "worldgen.export.robot", "worldgen.export.contract"},
+             "worldgen.ros.writer": {"worldgen.export.contract"}}
+    writer = Path(__file__)  # any module with functions of its own
+    assert ros_room_writers(graph, {"worldgen.ros.bundle": writer, "worldgen.ros.writer": writer}) == \
+        ["worldgen.ros.bundle -> worldgen.export.robot, worldgen.files"]
+    shim = ast.parse('"""Moved."""\nimport warnings\nfrom worldgen.export.ros2 import bundle\n__all__ = ["bundle"]\n'
+                     'warnings.warn("moved", DeprecationWarning, stacklevel=2)\n')
+    assert is_deprecation_shim(shim)
+    assert not is_deprecation_shim(ast.parse("def bundle():\n    warnings.warn('x', DeprecationWarning)\n"))

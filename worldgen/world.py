@@ -209,7 +209,7 @@ class World:
         The folder appears complete or not at all: files are written into a
         temporary folder beside it, which is then renamed into place.
         ``preview`` adds preview.png, a top-down picture (worldgen.export.preview).
-        ``ros`` adds the ROS 2 bundle in ``ros2/`` (worldgen.ros.bundle): True for the default
+        ``ros`` adds the ROS 2 bundle in ``ros2/`` (worldgen.export.ros2): True for the default
         Gazebo release, or a release's name (``fortress``, ``harmonic``, ...).
         A folder of the same name that holds another world (another
         ``content_hash``, or no readable world.json) is an :class:`OutputError`
@@ -237,7 +237,7 @@ class World:
             blobs[PREVIEW_NAME] = render(meta)
         blobs[METADATA_NAME] = metadata.dumps(meta).encode()
         if ros:  # derived from the world like preview.png, so not listed in world.json's `files` either
-            from worldgen.ros.bundle import bundle, release_of
+            from worldgen.export.ros2 import bundle, release_of
             blobs.update(bundle(self, sdf_version, release_of(ros)))
         return blobs
 

@@ -18,8 +18,9 @@ from support.reftools_urdf import check_urdf
 import worldgen
 from worldgen.errors import ParameterError
 from worldgen.export import robot as robot_export
+from worldgen.export.contract import GZ_RELEASES
+from worldgen.export.ros2 import DEFAULT_ROBOT_NAME
 from worldgen.export.xml import parse_bytes
-from worldgen.ros.bundle import DEFAULT_ROBOT_NAME
 
 
 def _world(**params):
@@ -48,7 +49,7 @@ def _check_files(tmp_path, world, **kw):
 
 
 def test_sdf_and_urdf_pass_the_reference_tools(tmp_path, world):
-    for release in robot_export.GZ_RELEASES:
+    for release in GZ_RELEASES:
         _check_files(tmp_path, world, gz_release=release, lidar_noise=0.01)
     _check_files(tmp_path, world, sensors=False)
     model, data = load_and_step(tmp_path / "robot.urdf", steps=200)

@@ -60,7 +60,11 @@ def test_the_pursuit_reaches_the_goal_without_contact(worlds, tmp_path, generato
     run = read_run(outcome.bag, worlds[generator])
     assert run.source == "ground_truth" and set(run.topics) >= {"/clock", "/odom", "/tf", "/cmd_vel", "/ground_truth"}
     # The bag's trajectory ends within the goal's tolerance (the loop stops inside half of it).
-    task = json.loads((worlds[generator] / "world.json").read_text())["tasks"][0]
+    meta = json.loads((worlds[generator] / "world.json").read_text())
+    task = meta["tasks"][0]
+    # The run is named <world_id>__<task>__<run> by the judge and by its folder, the world named once.
+    assert outcome.bag.name == outcome.run["run"] == f"{meta['world_id']}__{task['id']}__mujoco"
+    assert run.metadata["worldgen.run"] == "mujoco" and outcome.run["run"].count(meta["world_id"]) == 1
     end = run.trajectory[-1]
     assert math.hypot(end[1] - task["goal"][0], end[2] - task["goal"][1]) < task["goal_tolerance"]
 
@@ -69,6 +73,8 @@ def test_a_straight_drive_collides_with_the_obstacle_in_the_way(blocked, tmp_pat
     outcome = drive(blocked, tmp_path, sim="mujoco", straight=True)
     assert not outcome.passed and outcome.run["collisions"], outcome.verdict
     assert outcome.run["collisions"][0]["entity"] == first_in_the_way(blocked)
+    world_id = json.loads((blocked / "world.json").read_text())["world_id"]
+    assert outcome.bag.name == outcome.run["run"] == f"{world_id}__task_0__mujoco-straight"
 
 
 def test_the_drive_controller_follows_a_corner_and_turns_on_the_spot_when_facing_away():

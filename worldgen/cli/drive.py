@@ -25,7 +25,7 @@ Examples:
 @click.option("--sim", type=click.Choice(["gazebo", "mujoco"]), default="mujoco", show_default=True,
               help="The simulator: Gazebo Fortress headless, or MuJoCo (docs/drive.md).")
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
-              help="Where the run's bag folder is written (DIR/<world id>-<task>-<sim>).")
+              help="Where the run's bag folder is written (DIR/<world id>__<task>__<sim>).")
 @click.option("--task", metavar="ID", help="The task to drive [default: the world's first].")
 @click.option("--speed", type=click.FloatRange(0, 2, min_open=True), default=0.5, show_default=True,
               help="Forward speed, m/s.")

@@ -14,6 +14,7 @@ from typing import Optional, Sequence
 import click
 
 from worldgen.cli.context import CONTEXT as _CONTEXT
+from worldgen.export.contract import CMD_VEL, GROUND_TRUTH, ODOM
 
 __all__ = ["judge_command", "bag_lines", "BAG_LINES"]
 
@@ -58,9 +59,9 @@ Examples:
               help="The report folder (created; an earlier report there is replaced).")
 @click.option("--start", type=click.Choice(["command", "goal", "motion", "bag"]), default="command", show_default=True,
               help="Where a run starts: first non-zero /cmd_vel, goal sent, first 0.1 m of motion (BARN), bag start.")
-@click.option("--pose-topic", default="/ground_truth", show_default=True, help="The simulator's ground-truth pose topic.")
-@click.option("--odom-topic", default="/odom", show_default=True)
-@click.option("--cmd-topic", default="/cmd_vel", show_default=True)
+@click.option("--pose-topic", default=GROUND_TRUTH.name, show_default=True, help="The simulator's ground-truth pose topic.")
+@click.option("--odom-topic", default=ODOM.name, show_default=True)
+@click.option("--cmd-topic", default=CMD_VEL.name, show_default=True)
 @click.option("--base-frame", "base_frames", multiple=True, metavar="FRAME",
               help="Robot base frame(s) in /tf, in order of preference [default: base_footprint, base_link].")
 @click.option("--spawn-tolerance", type=click.FloatRange(0, None), default=0.25, show_default=True,

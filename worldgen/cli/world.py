@@ -18,10 +18,10 @@ import click
 import worldgen
 from worldgen.cli.context import CONTEXT as _CONTEXT
 from worldgen.errors import InfeasibleError, OutputError, ParameterError, WorldgenError, did_you_mean
+from worldgen.export.contract import DEFAULT_GZ_RELEASE, GZ_RELEASES
 from worldgen.export.formats import ALL_FORMATS, FORMATS, SDF_VERSIONS, normalise_formats, require_formats
 from worldgen.generators import all_specs, get
 from worldgen.params import Param, describe_range, parse_value
-from worldgen.ros.bundle import DEFAULT_GZ_RELEASE, GZ_RELEASES
 from worldgen.seeding import MAX_SEED
 
 __all__ = ["list_command", "generate_command", "preview_command", "check_command", "presets_command",

@@ -21,8 +21,9 @@ Gazebo systems on the model (its own topics, as nav2 expects them, not gz-sim's
 ``/model/<name>/...`` defaults): DiffDrive takes ``cmd_vel`` and publishes ``odom`` and ``tf``
 (``odom`` -> ``base_footprint``, starting at zero at the spawn); OdometryPublisher publishes the
 ground truth, the model's pose in the world frame (= the map frame), on ``ground_truth/odom``
-(``map`` -> ``base_footprint``) and its ``tf_topic`` on ``/model/<name>/pose``, the topic the
-ROS 2 bundle bridges as ``/ground_truth``. Sensors: a ``gpu_lidar`` on ``scan`` whose rays are
+(``map`` -> ``base_footprint``), the topic the ROS 2 bundle bridges as ``/ground_truth``, and the
+same pose on its ``tf_topic``, ``/model/<name>/pose``. Every topic name and the release's plugin
+names come from :mod:`worldgen.export.contract`. Sensors: a ``gpu_lidar`` on ``scan`` whose rays are
 world.json's ``sensors.lidar`` (samples, angles, range_min, range_max, height) with optional
 Gaussian noise, and an IMU on ``imu``. The lidar sits inside the footprint cylinder, as world.json
 puts it; the chassis' visual leaves a window around its plane so the lidar never sees the robot.
@@ -39,21 +40,15 @@ from typing import Mapping
 from lxml import etree
 
 from worldgen.errors import ParameterError
+from worldgen.export.contract import CMD_VEL, DEFAULT_GZ_RELEASE, GROUND_TRUTH, IMU, JOINT_STATES, ODOM, SCAN, TF, release
 from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
 
-__all__ = ["DEFAULT_NAME", "GZ_RELEASES", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW",
-           "Dimensions", "dimensions", "gz_release_of", "robot_sdf", "robot_urdf"]
+__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "Dimensions", "dimensions", "robot_sdf",
+           "robot_urdf"]
 
-#: The model's name: the ROS 2 bundle's robot (worldgen.ros.bundle.DEFAULT_ROBOT_NAME).
+#: The model's name: the ROS 2 bundle's robot (worldgen.export.ros2.DEFAULT_ROBOT_NAME).
 DEFAULT_NAME = "robot"
-#: How each Gazebo release names a system's plugin (file, class) and its message package: Fortress (ROS 2
-#: Humble) keeps the ignition names, Garden and later the gz-sim ones (gz-sim's include/gz/sim/server.config
-#: and include/ignition/gazebo/server.config). The ROS 2 bundle reads this table too.
-GZ_RELEASES = {"fortress": ("ignition-gazebo-{}-system", "ignition::gazebo::systems::{}", "ignition.msgs"),
-               "garden": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
-               "harmonic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs"),
-               "ionic": ("gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs")}
 #: The element Gazebo's sensors take their message frame from. Without it a scan's frame is the scoped
 #: sensor name (``robot::base_scan::lidar``, measured in Fortress 6.18), a frame no URDF has, and AMCL and
 #: the costmaps drop the scans. ``gz_frame_id`` is read by Fortress 6.18's ign-sensors and by gz-sensors 8
@@ -96,14 +91,6 @@ def dimensions(world) -> Dimensions:
     lidar, robot = meta["sensors"]["lidar"], meta["robot"]
     spawn_z = meta["tasks"][0]["spawn"][2]
     return Dimensions(float(robot["radius"]), float(robot["height"]), float(lidar["pose"][2]) - float(spawn_z))
-
-
-def gz_release_of(gz_release: str) -> tuple[str, str, str]:
-    """:data:`GZ_RELEASES`'s row for a release name (plugin file prefix, class prefix, message prefix);
-    ParameterError naming the releases for any other name."""
-    if gz_release not in GZ_RELEASES:
-        raise ParameterError(f"parameter 'gz_release' must be one of {', '.join(GZ_RELEASES)}, got {gz_release!r}")
-    return GZ_RELEASES[gz_release]
 
 
 def _inertia_cylinder(m: float, r: float, length: float) -> tuple[float, float, float]:
@@ -201,7 +188,7 @@ def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_ra
     sub(sensor, "always_on", "true")
     sub(sensor, "update_rate", fmt(lidar_rate))
     sub(sensor, "visualize", "false")
-    sub(sensor, "topic", "scan")
+    sub(sensor, "topic", SCAN.gz_name)
     sub(sensor, SENSOR_FRAME_ELEMENT, "base_scan")
     ray = sub(sensor, "lidar")
     horizontal = sub(sub(ray, "scan"), "horizontal")
@@ -227,29 +214,31 @@ def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_ra
     imu = sub(imu_link, "sensor", name="imu", type="imu")
     sub(imu, "always_on", "true")
     sub(imu, "update_rate", "50")
-    sub(imu, "topic", "imu")
+    sub(imu, "topic", IMU.gz_name)
     sub(imu, SENSOR_FRAME_ELEMENT, "imu_link")
 
 
 def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: float) -> None:
-    filename, cls, _ = gz_release_of(gz_release)
-    drive = sub(model, "plugin", filename=filename.format("diff-drive"), name=cls.format("DiffDrive"))
+    row = release(gz_release)
+    filename, cls = row.plugin("diff-drive", "DiffDrive")
+    drive = sub(model, "plugin", filename=filename, name=cls)
     for key, value in (("left_joint", "left_wheel_joint"), ("right_joint", "right_wheel_joint"),
                        ("wheel_separation", fmt(d.wheel_separation)), ("wheel_radius", fmt(d.wheel_radius)),
-                       ("odom_publish_frequency", fmt(odom_rate)), ("topic", "cmd_vel"), ("odom_topic", "odom"),
-                       ("tf_topic", "tf"), ("frame_id", "odom"), ("child_frame_id", "base_footprint")):
+                       ("odom_publish_frequency", fmt(odom_rate)), ("topic", CMD_VEL.gz_name), ("odom_topic", ODOM.gz_name),
+                       ("tf_topic", TF.gz_name), ("frame_id", "odom"), ("child_frame_id", "base_footprint")):
         sub(drive, key, value)
-    truth = sub(model, "plugin", filename=filename.format("odometry-publisher"), name=cls.format("OdometryPublisher"))
+    filename, cls = row.plugin("odometry-publisher", "OdometryPublisher")
+    truth = sub(model, "plugin", filename=filename, name=cls)
     for key, value in (("odom_frame", "map"), ("robot_base_frame", "base_footprint"),
-                       ("odom_publish_frequency", fmt(odom_rate)), ("odom_topic", "ground_truth/odom"),
+                       ("odom_publish_frequency", fmt(odom_rate)), ("odom_topic", GROUND_TRUTH.gz_name),
                        ("tf_topic", f"/model/{name}/pose"), ("dimensions", "2")):
         sub(truth, key, value)
-    states = sub(model, "plugin", filename=filename.format("joint-state-publisher"),
-                 name=cls.format("JointStatePublisher"))
-    sub(states, "topic", "joint_states")
+    filename, cls = row.plugin("joint-state-publisher", "JointStatePublisher")
+    states = sub(model, "plugin", filename=filename, name=cls)
+    sub(states, "topic", JOINT_STATES.gz_name)
 
 
-def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_release: str = "harmonic",
+def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_release: str = DEFAULT_GZ_RELEASE,
               sensors: bool = True, lidar_rate: float = 10.0, odom_rate: float = 50.0) -> str:
     """``robot.sdf`` (SDFormat 1.9, one ``<model>``) of the robot for ``world`` (a World or world.json's content).
 
@@ -262,7 +251,7 @@ def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_r
         raise ParameterError(f"parameter 'lidar_noise' must be a finite standard deviation >= 0 m, got {lidar_noise!r}")
     if not (lidar_rate > 0 and odom_rate > 0):
         raise ParameterError(f"rates must be > 0 Hz, got lidar_rate={lidar_rate!r}, odom_rate={odom_rate!r}")
-    gz_release_of(gz_release)
+    release(gz_release)
     d = dimensions(world)
     root = etree.Element("sdf", version="1.9")
     model = sub(root, "model", name=name)

@@ -154,7 +154,8 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
             r.fail(top["preview"], "preview", f"must be true or false, got {quoted(preview)}")
     ros: Any = False
     if "ros" in top:
-        from worldgen.ros.bundle import GZ_RELEASES, release_of
+        from worldgen.export.contract import GZ_RELEASES
+        from worldgen.export.ros2 import release_of
 
         value = r.value(top["ros"])
         try:

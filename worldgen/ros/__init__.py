@@ -19,16 +19,18 @@
     >>> write_report(result, "report").name
     'report'
 
-The room of ROS 2: bags in (:mod:`worldgen.ros.reader`, with :mod:`~worldgen.ros.bagio` and the fast
-field decoder :mod:`~worldgen.ros.cdr`), bags out (:mod:`worldgen.ros.writer`), the optional rosbags
-(:mod:`~worldgen.ros.deps`) and the bundle a world carries for a ROS 2 run (:mod:`~worldgen.ros.bundle`).
-Reader and writer import rosbags only when called, and say in one line what to install when it is
-missing. Judging runs against worlds is :mod:`worldgen.judge`'s (docs/judge.md).
+The room of ROS 2 bags: bags in (:mod:`worldgen.ros.reader`, with :mod:`~worldgen.ros.bagio` and the fast
+field decoder :mod:`~worldgen.ros.cdr`), bags out (:mod:`worldgen.ros.writer`: :class:`BagWriter`, and
+:func:`write_run` over it) and the optional rosbags (:mod:`~worldgen.ros.deps`). The bundle a world
+carries for a ROS 2 run is an exporter, :mod:`worldgen.export.ros2`, and the topics and Gazebo releases
+both sides agree on are :mod:`worldgen.export.contract`'s. Reader and writer import rosbags only when
+called, and say in one line what to install when it is missing. Judging runs against worlds is
+:mod:`worldgen.judge`'s (docs/judge.md).
 """
 
 from __future__ import annotations
 
 from worldgen.ros.reader import START_RULES, BagRun, RunMismatchError, read_run
-from worldgen.ros.writer import DISTROS, STORAGES, write_run
+from worldgen.ros.writer import DISTROS, STORAGES, BagWriter, write_run
 
-__all__ = ["read_run", "write_run", "BagRun", "RunMismatchError", "START_RULES", "STORAGES", "DISTROS"]
+__all__ = ["read_run", "write_run", "BagWriter", "BagRun", "RunMismatchError", "START_RULES", "STORAGES", "DISTROS"]

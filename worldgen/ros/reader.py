@@ -45,6 +45,7 @@ from typing import Any, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import ParameterError, WorldgenError
+from worldgen.export.contract import CLOCK, CMD_VEL, GOAL_POSE, GROUND_TRUTH, NAV_FEEDBACK, NAV_STATUS, ODOM, TF, TF_STATIC
 from worldgen.ros.bagio import (
     RunMismatchError,
     bag_metadata,
@@ -63,7 +64,7 @@ __all__ = ["BagRun", "RunMismatchError", "read_run", "bag_metadata", "peek_metad
 
 START_RULES = ("command", "goal", "motion", "bag")
 #: Where a goal shows: RViz's and nav2's goal topic, and the navigate_to_pose action's topics as recorded.
-GOAL_TOPICS = ("/goal_pose", "/navigate_to_pose/_action/feedback", "/navigate_to_pose/_action/status")
+GOAL_TOPICS = (GOAL_POSE.name, NAV_FEEDBACK.name, NAV_STATUS.name)
 #: The BARN Challenge starts its clock once the robot has moved this far (m) from where it stood.
 MOTION_START = 0.1
 _POSE_TYPES = ("nav_msgs/msg/Odometry", "geometry_msgs/msg/PoseStamped", "geometry_msgs/msg/PoseWithCovarianceStamped",
@@ -145,8 +146,8 @@ def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "command",
-             pose_topic: str = "/ground_truth", model: Optional[str] = None,
-             odom_topic: str = "/odom", cmd_topic: str = "/cmd_vel", goal_topics: Sequence[str] = GOAL_TOPICS,
+             pose_topic: str = GROUND_TRUTH.name, model: Optional[str] = None,
+             odom_topic: str = ODOM.name, cmd_topic: str = CMD_VEL.name, goal_topics: Sequence[str] = GOAL_TOPICS,
              map_frame: str = "map", odom_frame: str = "odom", base_frames: Sequence[str] = ("base_footprint", "base_link"),
              spawn_tolerance: float = 0.25, distro: Optional[str] = None, min_dt: float = 0.02) -> BagRun:
     """Read ``bag`` (folder, .mcap, .db3, .bag) into a :class:`BagRun`; ``world`` gives the spawn (any form the
@@ -205,7 +206,7 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
 
 def _pose_topics(topics: dict[str, str], pose_topic: str, odom_topic: str) -> bool:
     """Whether the bag has a topic any pose source could come from (its connections, before any message)."""
-    return (topics.get(pose_topic) in _POSE_TYPES or "/tf" in topics or "/tf_static" in topics
+    return (topics.get(pose_topic) in _POSE_TYPES or TF.name in topics or TF_STATIC.name in topics
             or odom_topic in topics)
 
 
@@ -219,8 +220,8 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
     if gt:
         wanted.add(pose_topic)
     else:
-        wanted |= {"/tf", "/tf_static", odom_topic}
-    conns = [c for c in reader.connections if c.topic in wanted or c.topic == "/clock"]
+        wanted |= {TF.name, TF_STATIC.name, odom_topic}
+    conns = [c for c in reader.connections if c.topic in wanted or c.topic == CLOCK.name]
     st: dict[str, Any] = {"gt": _Series(min_dt) if gt else None, "odom": None, "base": {f: _Series(min_dt) for f in base_frames},
                           "map_odom": _Series(0.0), "first_cmd": None, "first_goal": None, "cmd_seen": False}
     if not gt and odom_topic in topics:
@@ -229,12 +230,12 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
     decode = decoder(reader, conns, distro)
     for conn, recv, raw in reader.messages(connections=conns):
         topic = conn.topic
-        if topic in goal_topics and conn.msgtype != "geometry_msgs/msg/PoseStamped":
+        if topic in goal_topics and conn.msgtype != GOAL_POSE.ros_type:
             if st["first_goal"] is None and ref is not None:
                 st["first_goal"] = ref[1] + (recv - ref[0]) * 1e-9
             continue
         v = decode(conn, raw)
-        if topic == "/clock":
+        if topic == CLOCK.name:
             ref = (recv, v)
         elif topic == cmd_topic:
             st["cmd_seen"] = True
@@ -255,7 +256,7 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
         elif topic == odom_topic and st["odom"] is not None:
             st["odom"].add(v[0], v[3], v[4], v[5])
             ref = (recv, v[0])
-        elif topic in ("/tf", "/tf_static"):
+        elif topic in (TF.name, TF_STATIC.name):
             for t, parent, child, x, y, yaw in v:
                 parent, child = parent.lstrip("/"), child.lstrip("/")
                 if parent == odom_frame and child in st["base"]:

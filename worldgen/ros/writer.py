@@ -20,12 +20,17 @@ ROS 2 run gives, each message stamped with simulation time in its header:
   Jazzy's nav2 may send): ``v, w`` rows from ``commands`` or read off the trajectory;
 - optionally ``/scan`` (sensor_msgs/LaserScan) from a ``scan`` callable
   ``(x, y, yaw) -> ranges`` and ``/ground_truth`` (nav_msgs/Odometry in ``map``), the
-  simulator's own pose of the model as ros_gz_bridge bridges ``gz.msgs.Odometry``.
+  simulator's own pose of the model as the ROS 2 bundle bridges it (every topic's name and type
+  is :mod:`worldgen.export.contract`'s).
 
 The bag's receive times (what ``ros2 bag record`` logs) are wall-clock times, a fixed
 epoch plus the simulation time: a reader must take times from the header stamps.
 The world and task go into the bag's ``custom_data`` metadata (rosbag2 metadata
 version 6 and later; ``worldgen.world_id``, ``worldgen.task``, ``worldgen.run``).
+
+:func:`write_run` is a thin function over :class:`BagWriter`, a bag written message by message
+as rosbags' own writer writes one (open, add a connection per topic, write, close), for a bag of
+other messages: a test's, or a run of another robot.
 """
 
 from __future__ import annotations
@@ -33,14 +38,16 @@ from __future__ import annotations
 import functools
 import math
 from pathlib import Path
-from typing import Callable, Optional, Sequence
+from typing import Any, Callable, Mapping, Optional, Sequence
 
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.export import contract
+from worldgen.export.contract import CLOCK, CMD_VEL, CMD_VEL_STAMPED_TYPE, GOAL_POSE, GROUND_TRUTH, ODOM, SCAN, TF, TF_STATIC
 from worldgen.ros.deps import require_rosbags
 
-__all__ = ["write_run", "STORAGES", "DISTROS", "WALL_EPOCH_NS", "DEFAULT_TOPICS"]
+__all__ = ["BagWriter", "write_run", "STORAGES", "DISTROS", "WALL_EPOCH_NS", "DEFAULT_TOPICS"]
 
 #: Storage plugins a bag can be written with.
 STORAGES = ("sqlite3", "mcap")
@@ -53,7 +60,8 @@ WALL_EPOCH_NS = 1_700_000_000 * 10**9
 DEFAULT_TOPICS = ("clock", "odom", "tf", "cmd_vel")
 #: What a message takes from its stamp to the recorder.
 RECEIVE_LATENCY_NS = 2_000_000
-_ALL_TOPICS = ("clock", "odom", "tf", "cmd_vel", "scan", "ground_truth")
+#: ``topics``' words and the contract's topics they write.
+_TOPICS = {"clock": CLOCK, "odom": ODOM, "tf": TF, "cmd_vel": CMD_VEL, "scan": SCAN, "ground_truth": GROUND_TRUTH}
 
 
 @functools.lru_cache(maxsize=None)
@@ -62,6 +70,79 @@ def _store(distro: str):
     from rosbags.typesys import Stores, get_typestore
 
     return get_typestore(Stores.ROS2_HUMBLE if distro == "humble" else Stores.ROS2_JAZZY)
+
+
+class BagWriter:
+    """A rosbag2 folder written message by message; a context manager (rosbags' ``Writer`` is the model)::
+
+        with BagWriter("runs/r0", metadata={"worldgen.task": "task_0"}) as bag:
+            clock = bag.add_connection("/clock")          # the contract's type for a topic it knows
+            bag.write(clock, WALL_EPOCH_NS, bag.types["rosgraph_msgs/msg/Clock"](clock=...))
+
+    ``path`` must not exist; ``storage`` is one of :data:`STORAGES`, ``distro`` (whose message definitions
+    the bag carries) one of :data:`DISTROS`; ``metadata`` goes into the bag's ``custom_data``. Messages are
+    serialised here (CDR, the release's typestore) and must be written in receive-time order.
+    """
+
+    def __init__(self, path, *, storage: str = "mcap", distro: str = "jazzy",
+                 metadata: Optional[Mapping[str, str]] = None):
+        require_rosbags()
+        if storage not in STORAGES:
+            raise ParameterError(f"parameter 'storage' must be one of {', '.join(STORAGES)}, got {storage!r}")
+        if distro not in DISTROS:
+            raise ParameterError(f"parameter 'distro' must be one of {', '.join(DISTROS)}, got {distro!r}")
+        self.path = Path(path)
+        if self.path.exists():
+            raise ParameterError(f"parameter 'path': '{self.path}' exists already; a bag is written into a new folder")
+        self.storage, self.distro = storage, distro
+        self.typestore = _store(distro)
+        self._metadata = {str(k): str(v) for k, v in (metadata or {}).items()}
+        self._writer: Any = None
+
+    @property
+    def types(self) -> dict[str, Any]:
+        """Message classes by type name (``types["nav_msgs/msg/Odometry"]``), of the bag's ROS 2 release."""
+        return self.typestore.types
+
+    def open(self) -> BagWriter:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+
+        plugin = StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3
+        writer = Writer(self.path, version=8, storage_plugin=plugin)
+        for key, value in self._metadata.items():
+            writer.set_custom_data(key, value)
+        writer.open()
+        self._writer = writer
+        return self
+
+    def add_connection(self, topic: str, msgtype: Optional[str] = None):
+        """A connection for ``topic``: ``msgtype``, else the type :mod:`worldgen.export.contract` gives it."""
+        if self._writer is None:
+            raise ParameterError(f"bag '{self.path}' is not open: add connections inside 'with BagWriter(...)'")
+        if msgtype is None:
+            known = {t.name: t.ros_type for t in contract.TOPICS}
+            if topic not in known:
+                raise ParameterError(f"parameter 'msgtype' is needed for {topic}, a topic worldgen.export.contract does not name")
+            msgtype = known[topic]
+        return self._writer.add_connection(topic, msgtype, typestore=self.typestore)
+
+    def write(self, connection, time_ns: int, message) -> None:
+        """``message`` on ``connection``, received at ``time_ns`` (wall clock, ns)."""
+        if self._writer is None:
+            raise ParameterError(f"bag '{self.path}' is not open: write inside 'with BagWriter(...)'")
+        self._writer.write(connection, time_ns, self.typestore.serialize_cdr(message, connection.msgtype))
+
+    def close(self) -> None:
+        """Finish the bag (its metadata.yaml); a second close does nothing."""
+        if self._writer is not None:
+            writer, self._writer = self._writer, None
+            writer.close()
+
+    def __enter__(self) -> BagWriter:
+        return self.open()
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
 
 def _quat(yaw: float) -> tuple[float, float, float, float]:
@@ -95,23 +176,103 @@ def _commands(traj: np.ndarray) -> np.ndarray:
     return out
 
 
-def _check(trajectory, topics, storage, distro) -> np.ndarray:
+def _check(trajectory, topics) -> np.ndarray:
     traj = np.asarray(trajectory, dtype=float)
     if traj.ndim != 2 or traj.shape[1] != 4 or len(traj) < 1 or not np.all(np.isfinite(traj)):
         raise ParameterError(f"parameter 'trajectory' must be a finite (n, 4) array t, x, y, yaw, got shape {traj.shape}")
     if np.any(np.diff(traj[:, 0]) < 0) or traj[0, 0] < 0:
         raise ParameterError("parameter 'trajectory' must have non-decreasing, non-negative times")
-    if storage not in STORAGES:
-        raise ParameterError(f"parameter 'storage' must be one of {', '.join(STORAGES)}, got {storage!r}")
-    if distro not in DISTROS:
-        raise ParameterError(f"parameter 'distro' must be one of {', '.join(DISTROS)}, got {distro!r}")
-    unknown = sorted(set(topics) - set(_ALL_TOPICS))
+    unknown = sorted(set(topics) - set(_TOPICS))
     if unknown:
-        raise ParameterError(f"parameter 'topics': unknown {', '.join(unknown)}; allowed: {', '.join(_ALL_TOPICS)}")
+        raise ParameterError(f"parameter 'topics': unknown {', '.join(unknown)}; allowed: {', '.join(_TOPICS)}")
     return traj
 
 
-# long: every topic's messages written in one pass over the trajectory, inside one writer context
+def _receive_ns(t: float) -> int:
+    return WALL_EPOCH_NS + int(round(t * 1e9))
+
+
+class _Messages:
+    """The run's messages, built with one release's message classes: stamps, headers, transforms, odometry."""
+
+    def __init__(self, types: Mapping[str, Any], base_frame: str):
+        self.T, self.base_frame = types, base_frame
+        self.zero6 = np.zeros(36)  # covariances: the same unknown for every message
+
+    def stamp(self, t: float):
+        ns = int(round(t * 1e9))
+        return self.T["builtin_interfaces/msg/Time"](sec=ns // 10**9, nanosec=ns % 10**9)
+
+    def header(self, t: float, frame: str):
+        return self.T["std_msgs/msg/Header"](stamp=self.stamp(t), frame_id=frame)
+
+    def twist(self, v: float, w: float):
+        V = self.T["geometry_msgs/msg/Vector3"]
+        return self.T["geometry_msgs/msg/Twist"](linear=V(x=v, y=0.0, z=0.0), angular=V(x=0.0, y=0.0, z=w))
+
+    def pose(self, p):
+        T = self.T
+        return T["geometry_msgs/msg/Pose"](position=T["geometry_msgs/msg/Point"](x=p[0], y=p[1], z=0.0),
+                                           orientation=T["geometry_msgs/msg/Quaternion"](*_quat(p[2])))
+
+    def tf(self, t: float, parent: str, child: str, p):
+        T = self.T
+        return T["geometry_msgs/msg/TransformStamped"](
+            header=self.header(t, parent), child_frame_id=child,
+            transform=T["geometry_msgs/msg/Transform"](translation=T["geometry_msgs/msg/Vector3"](x=p[0], y=p[1], z=0.0),
+                                                        rotation=T["geometry_msgs/msg/Quaternion"](*_quat(p[2]))))
+
+    def tf_message(self, transforms: list):
+        return self.T[TF.ros_type](transforms=transforms)
+
+    def odometry(self, t: float, frame: str, p, v: float, w: float):
+        T, zero6 = self.T, self.zero6
+        return T[ODOM.ros_type](
+            header=self.header(t, frame), child_frame_id=self.base_frame,
+            pose=T["geometry_msgs/msg/PoseWithCovariance"](pose=self.pose(p), covariance=zero6),
+            twist=T["geometry_msgs/msg/TwistWithCovariance"](twist=self.twist(v, w), covariance=zero6))
+
+    def scan(self, t: float, ranges: np.ndarray, angles: tuple[float, float, float, float]):
+        amin, amax, rmin, rmax = angles
+        inc = (amax - amin) / max(len(ranges) - 1, 1)
+        return self.T[SCAN.ros_type](
+            header=self.header(t, "base_scan"), angle_min=amin, angle_max=amax, angle_increment=inc, time_increment=0.0,
+            scan_time=0.0, range_min=rmin, range_max=rmax, ranges=ranges, intensities=np.zeros(0, dtype=np.float32))
+
+
+def _samples(m: _Messages, traj: np.ndarray, cmds: np.ndarray, spawn3, topics, drift: float, map_odom: bool,
+             scan, scan_angles) -> list[tuple[float, str, Any]]:
+    """(simulation time, topic, message) of every per-sample message, in the order a recorder gets them."""
+    v_of = np.interp(traj[:, 0], cmds[:, 0], cmds[:, 1]) if len(cmds) else np.zeros(len(traj))
+    w_of = np.interp(traj[:, 0], cmds[:, 0], cmds[:, 2]) if len(cmds) else np.zeros(len(traj))
+    out: list[tuple[float, str, Any]] = []
+    travelled, prev = 0.0, None
+    for k, (t, x, y, yaw) in enumerate(traj):
+        truth = (x, y, yaw)
+        if prev is not None:
+            travelled += math.hypot(x - prev[0], y - prev[1])
+        prev = truth
+        # The odometry is the true motion since the spawn, turned by the heading error accumulated so far.
+        rel, bias = _relative(spawn3, truth), drift * travelled
+        odom = (math.cos(bias) * rel[0] - math.sin(bias) * rel[1], math.sin(bias) * rel[0] + math.cos(bias) * rel[1],
+                rel[2] + bias)
+        if "clock" in topics:
+            out.append((t, CLOCK.name, m.T[CLOCK.ros_type](clock=m.stamp(t))))
+        if "odom" in topics:
+            out.append((t, ODOM.name, m.odometry(t, "odom", odom, float(v_of[k]), float(w_of[k]))))
+        if "ground_truth" in topics:
+            out.append((t, GROUND_TRUTH.name, m.odometry(t, "map", truth, float(v_of[k]), float(w_of[k]))))
+        if "tf" in topics:
+            transforms = [m.tf(t, "odom", m.base_frame, odom)]
+            if drift and map_odom:
+                # The localisation's map -> odom: truth = map_odom o odom, so map_odom = truth o odom^-1.
+                transforms.insert(0, m.tf(t, "map", "odom", _compose(truth, _relative(odom, (0.0, 0.0, 0.0)))))
+            out.append((t, TF.name, m.tf_message(transforms)))
+        if scan is not None and "scan" in topics:
+            out.append((t, SCAN.name, m.scan(t, np.asarray(scan(x, y, yaw), dtype=np.float32), scan_angles)))
+    return out
+
+
 def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, commands=None,
               topics: Sequence[str] = DEFAULT_TOPICS, storage: str = "mcap", distro: str = "jazzy",
               drift: float = 0.0, scan: Optional[Callable[[float, float, float], np.ndarray]] = None,
@@ -127,112 +288,30 @@ def write_run(path, trajectory, *, spawn: Optional[Sequence[float]] = None, comm
     ``scan_angles`` is LaserScan's ``angle_min, angle_max, range_min, range_max``.
     """
     require_rosbags()
-    from rosbags.rosbag2 import StoragePlugin, Writer
-
-    traj = _check(trajectory, topics, storage, distro)
+    traj = _check(trajectory, topics)
+    custom = {f"worldgen.{k}": str(v) for k, v in (("world_id", world_id), ("task", task), ("run", run)) if v is not None}
+    bag = BagWriter(path, storage=storage, distro=distro, metadata=custom)
     spawn3 = tuple(float(v) for v in (spawn if spawn is not None else traj[0, 1:4]))
     cmds = _commands(traj) if commands is None else np.asarray(commands, dtype=float).reshape(-1, 3)
-    ts = _store(distro)
-    T = ts.types
-    Header, Time = T["std_msgs/msg/Header"], T["builtin_interfaces/msg/Time"]
-    Vector3, Quaternion = T["geometry_msgs/msg/Vector3"], T["geometry_msgs/msg/Quaternion"]
-    Point, Pose = T["geometry_msgs/msg/Point"], T["geometry_msgs/msg/Pose"]
-    Twist = T["geometry_msgs/msg/Twist"]
-    zero6 = np.zeros(36)
-
-    def stamp(t: float):
-        ns = int(round(t * 1e9))
-        return Time(sec=ns // 10**9, nanosec=ns % 10**9)
-
-    def header(t: float, frame: str):
-        return Header(stamp=stamp(t), frame_id=frame)
-
-    def tf(t: float, parent: str, child: str, p):
-        return T["geometry_msgs/msg/TransformStamped"](
-            header=header(t, parent), child_frame_id=child,
-            transform=T["geometry_msgs/msg/Transform"](translation=Vector3(x=p[0], y=p[1], z=0.0),
-                                                        rotation=Quaternion(*_quat(p[2]))))
-
-    def odometry(t: float, frame: str, p, v: float, w: float):
-        return T["nav_msgs/msg/Odometry"](
-            header=header(t, frame), child_frame_id=base_frame,
-            pose=T["geometry_msgs/msg/PoseWithCovariance"](
-                pose=Pose(position=Point(x=p[0], y=p[1], z=0.0), orientation=Quaternion(*_quat(p[2]))), covariance=zero6),
-            twist=T["geometry_msgs/msg/TwistWithCovariance"](
-                twist=Twist(linear=Vector3(x=v, y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=w)), covariance=zero6))
-
-    path = Path(path)
-    if path.exists():
-        raise ParameterError(f"parameter 'path': '{path}' exists already; a bag is written into a new folder")
-    plugin = StoragePlugin.MCAP if storage == "mcap" else StoragePlugin.SQLITE3
-    # Messages go out in receive-time order, as a recorder writes them: gather (time, order, topic, msg) first.
-    out: list[tuple[int, int, str, object]] = []
-
-    def put(t: float, topic: str, msg) -> None:
-        out.append((WALL_EPOCH_NS + int(round(t * 1e9)) + RECEIVE_LATENCY_NS, len(out), topic, msg))
-
-    v_of = np.interp(traj[:, 0], cmds[:, 0], cmds[:, 1]) if len(cmds) else np.zeros(len(traj))
-    w_of = np.interp(traj[:, 0], cmds[:, 0], cmds[:, 2]) if len(cmds) else np.zeros(len(traj))
-    odom = (0.0, 0.0, 0.0)
-    travelled = 0.0
-    prev = None
-    for k, (t, x, y, yaw) in enumerate(traj):
-        truth = (x, y, yaw)
-        if prev is not None:
-            travelled += math.hypot(x - prev[0], y - prev[1])
-        prev = truth
-        # The odometry is the true motion since the spawn, turned by the heading error accumulated so far.
-        rel = _relative(spawn3, truth)
-        bias = drift * travelled
-        odom = (math.cos(bias) * rel[0] - math.sin(bias) * rel[1], math.sin(bias) * rel[0] + math.cos(bias) * rel[1],
-                rel[2] + bias)
-        if "clock" in topics:
-            put(t, "/clock", T["rosgraph_msgs/msg/Clock"](clock=stamp(t)))
-        if "odom" in topics:
-            put(t, "/odom", odometry(t, "odom", odom, float(v_of[k]), float(w_of[k])))
-        if "ground_truth" in topics:
-            put(t, "/ground_truth", odometry(t, "map", truth, float(v_of[k]), float(w_of[k])))
-        if "tf" in topics:
-            transforms = [tf(t, "odom", base_frame, odom)]
-            if drift and map_odom:
-                # The localisation's map -> odom: truth = map_odom o odom, so map_odom = truth o odom^-1.
-                inv = _relative(odom, (0.0, 0.0, 0.0))
-                transforms.insert(0, tf(t, "map", "odom", _compose(truth, inv)))
-            put(t, "/tf", T["tf2_msgs/msg/TFMessage"](transforms=transforms))
-        if scan is not None and "scan" in topics:
-            amin, amax, rmin, rmax = scan_angles
-            ranges = np.asarray(scan(x, y, yaw), dtype=np.float32)
-            inc = (amax - amin) / max(len(ranges) - 1, 1)
-            put(t, "/scan", T["sensor_msgs/msg/LaserScan"](
-                header=header(t, "base_scan"), angle_min=amin, angle_max=amax, angle_increment=inc, time_increment=0.0,
-                scan_time=0.0, range_min=rmin, range_max=rmax, ranges=ranges, intensities=np.zeros(0, dtype=np.float32)))
+    m = _Messages(bag.types, base_frame)
+    out = _samples(m, traj, cmds, spawn3, topics, drift, map_odom, scan, scan_angles)
     if "cmd_vel" in topics:
-        for t, v, w in cmds:
-            twist = Twist(linear=Vector3(x=float(v), y=0.0, z=0.0), angular=Vector3(x=0.0, y=0.0, z=float(w)))
-            put(float(t), "/cmd_vel", T["geometry_msgs/msg/TwistStamped"](header=header(float(t), base_frame), twist=twist)
-                if stamped_cmd else twist)
+        out += [(float(t), CMD_VEL.name, m.T[CMD_VEL_STAMPED_TYPE](header=m.header(float(t), base_frame),
+                                                                    twist=m.twist(float(v), float(w)))
+                 if stamped_cmd else m.twist(float(v), float(w))) for t, v, w in cmds]
     if goal is not None:
         gt_, gx, gy, gyaw = (float(v) for v in goal)
-        put(gt_, "/goal_pose", T["geometry_msgs/msg/PoseStamped"](
-            header=header(gt_, "map"), pose=Pose(position=Point(x=gx, y=gy, z=0.0), orientation=Quaternion(*_quat(gyaw)))))
+        out.append((gt_, GOAL_POSE.name, m.T[GOAL_POSE.ros_type](header=m.header(gt_, "map"), pose=m.pose((gx, gy, gyaw)))))
+    # Messages go out in receive-time order, as a recorder writes them (a stable sort: ties keep their order).
+    timed = sorted(((_receive_ns(t) + RECEIVE_LATENCY_NS, name, msg) for t, name, msg in out), key=lambda item: item[0])
     static = "tf" in topics and not drift and map_odom
-    types = {"/clock": "rosgraph_msgs/msg/Clock", "/odom": "nav_msgs/msg/Odometry", "/tf": "tf2_msgs/msg/TFMessage",
-             "/tf_static": "tf2_msgs/msg/TFMessage", "/scan": "sensor_msgs/msg/LaserScan",
-             "/ground_truth": "nav_msgs/msg/Odometry", "/goal_pose": "geometry_msgs/msg/PoseStamped",
-             "/cmd_vel": "geometry_msgs/msg/TwistStamped" if stamped_cmd else "geometry_msgs/msg/Twist"}
-    out.sort(key=lambda m: (m[0], m[1]))
-    writer = Writer(path, version=8, storage_plugin=plugin)
-    for key, value in (("world_id", world_id), ("task", task), ("run", run)):
-        if value is not None:
-            writer.set_custom_data(f"worldgen.{key}", str(value))
-    with writer:
-        conns = {}
-        for topic in sorted({m[2] for m in out} | ({"/tf_static"} if static else set())):
-            conns[topic] = writer.add_connection(topic, types[topic], typestore=ts)
+    types = {CMD_VEL.name: CMD_VEL_STAMPED_TYPE if stamped_cmd else CMD_VEL.ros_type}
+    with bag:
+        conns = {name: bag.add_connection(name, types.get(name))
+                 for name in sorted({item[1] for item in timed} | ({TF_STATIC.name} if static else set()))}
         if static:
             t0 = float(traj[0, 0])
-            msg = T["tf2_msgs/msg/TFMessage"](transforms=[tf(t0, "map", "odom", spawn3)])
-            writer.write(conns["/tf_static"], WALL_EPOCH_NS + int(round(t0 * 1e9)), ts.serialize_cdr(msg, types["/tf_static"]))
-        for when, _, topic, msg in out:
-            writer.write(conns[topic], when, ts.serialize_cdr(msg, types[topic]))
-    return path
+            bag.write(conns[TF_STATIC.name], _receive_ns(t0), m.tf_message([m.tf(t0, "map", "odom", spawn3)]))
+        for when, name, msg in timed:
+            bag.write(conns[name], when, msg)
+    return bag.path

@@ -23,6 +23,7 @@ from pathlib import Path
 from lxml import etree
 
 from worldgen.errors import OutputError
+from worldgen.export.contract import CMD_VEL, GROUND_TRUTH
 from worldgen.export.robot import DEFAULT_NAME
 from worldgen.export.xml import safe_parser
 from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate, user_cache
@@ -103,8 +104,8 @@ class GazeboBackend:
         self._model.write(self._robot_sdf)
         self._model.flush()
         self._bridge = subprocess.Popen(
-            [str(exe), self._server.world, "/cmd_vel", "/ground_truth/odom", str(round(self.dt * 1e9)), self._model.name,
-             self._robot_name, *(repr(float(v)) for v in spawn)],
+            [str(exe), self._server.world, CMD_VEL.gazebo_topic, GROUND_TRUTH.gazebo_topic, str(round(self.dt * 1e9)),
+             self._model.name, self._robot_name, *(repr(float(v)) for v in spawn)],
             env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
         first = self._read()
         if first != "ready":

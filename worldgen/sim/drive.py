@@ -6,7 +6,7 @@ bag and judged, the loop of a Gazebo + nav2 test closed without ROS.
     >>> folder = worldgen.generate("minimal", seed=2).write("worlds", preview=False)
     >>> outcome = drive(folder, "runs", sim="mujoco")            # or sim="gazebo"
     >>> outcome.passed, outcome.ended, outcome.run["collisions"], outcome.bag.name
-    (True, 'goal', [], 'minimal-s2-...-task_0-mujoco')
+    (True, 'goal', [], 'minimal-s2-...__task_0__mujoco')
 
 The controller is the environment's reference-path follower (:class:`worldgen.envs.policies.PathFollower`:
 pure pursuit with differential-drive kinematics), fed back from the simulator's own pose of the robot
@@ -103,6 +103,7 @@ def _backend(sim: str, world: WorldFolder):
         from worldgen.sim.mujoco import MujocoBackend
 
         return MujocoBackend(world.file_bytes("mjcf"), meta)
+    from worldgen.export.contract import SIM_GZ_RELEASE
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.bridge import GazeboBackend, world_step
 
@@ -112,7 +113,7 @@ def _backend(sim: str, world: WorldFolder):
     # lands on every command's end (the first at the end of the first), and no other message wakes the bridge.
     dt = world_step(sdf)
     per = steps_per_command(dt)
-    robot = robot_sdf(meta, gz_release="fortress", sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
+    robot = robot_sdf(meta, gz_release=SIM_GZ_RELEASE, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
     return GazeboBackend(sdf, robot, dt=dt, first_steps=per)
 
 
@@ -132,7 +133,10 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     opened = open_world(world, "argument WORLD")
     meta = opened.metadata
     chosen = opened.task(task, "option '--task'")
-    bag = Path(out) / f"{meta['world_id']}-{chosen['id']}-{sim}{'-straight' if straight else ''}"
+    # The bag is named as the judge names the run, <world_id>__<task>__<run>; the run part names only what
+    # differs between drives of one task (the simulator, the straight hook), never the world again.
+    run_part = f"{sim}{'-straight' if straight else ''}"
+    bag = Path(out) / f"{meta['world_id']}__{chosen['id']}__{run_part}"
     if bag.exists():
         raise ParameterError(f"option '--out': '{bag}' exists already; a run is written into a new folder")
     if Path(out).exists() and not Path(out).is_dir():
@@ -145,7 +149,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     finally:
         backend.close()
     wall["drive"] = time.perf_counter() - started
-    _write_bag(bag, trajectory, commands, meta, chosen)
+    _write_bag(bag, trajectory, commands, meta, chosen, run_part)
     wall["record"] = time.perf_counter() - started - wall["drive"]
     result = judge([bag], world=world)
     wall["judge"] = time.perf_counter() - started - wall["drive"] - wall["record"]
@@ -154,7 +158,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
                    float(trajectory[-1, 0] - trajectory[0, 0]), wall)
 
 
-def _write_bag(bag: Path, trajectory, commands, meta: dict, task: dict) -> None:
+def _write_bag(bag: Path, trajectory, commands, meta: dict, task: dict, run: str) -> None:
     """The run as a rosbag2 folder at ``bag``, complete or absent: written aside, then moved in whole."""
     import tempfile
 
@@ -165,7 +169,7 @@ def _write_bag(bag: Path, trajectory, commands, meta: dict, task: dict) -> None:
     with tempfile.TemporaryDirectory(prefix="worldgen-drive-") as tmp:
         write_run(Path(tmp) / bag.name, trajectory, spawn=(spawn[0], spawn[1], spawn[5]), commands=commands,
                   topics=("clock", "odom", "tf", "cmd_vel", "ground_truth"), world_id=meta["world_id"],
-                  task=task["id"], run=bag.name)
+                  task=task["id"], run=run)
         blobs = {str(p.relative_to(Path(tmp) / bag.name)): p.read_bytes()
                  for p in sorted((Path(tmp) / bag.name).rglob("*")) if p.is_file()}
     write_folder_atomically(bag.parent, bag.name, blobs)

@@ -28,10 +28,11 @@ EDGE_JUMP = 0.1
 
 
 def _world_with_sensors(folder: Path, sdf: Path) -> str:
-    from worldgen.ros.bundle import with_plugins
+    from worldgen.export.contract import SIM_GZ_RELEASE
+    from worldgen.export.ros2 import with_plugins
 
     text = sdf.read_text(encoding="utf-8")
-    return with_plugins(text, "fortress", str(folder.resolve()) + "/").decode()
+    return with_plugins(text, SIM_GZ_RELEASE, str(folder.resolve()) + "/").decode()
 
 
 def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> np.ndarray:
@@ -43,6 +44,7 @@ def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> tupl
     """(ranges, m; the message's header ``frame_id``) of the first scan the robot's gpu_lidar publishes at the
     first task's spawn in ``world`` (a world folder, a written World or a pack folder's world: Gazebo loads
     its world.sdf from disk). The frame is what a ROS 2 bridge passes on."""
+    from worldgen.export.contract import SCAN, SIM_GZ_RELEASE
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.textproto import first
 
@@ -54,14 +56,14 @@ def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> tupl
         sdf = Path(tmp) / source.name  # the world folder is left untouched; its meshes are named absolutely
         sdf.write_text(_world_with_sensors(opened.file("json").parent, source), encoding="utf-8")
         with GazeboServer(sdf, install=locate(), headless_rendering=True) as gz:
-            gz.spawn(robot_sdf(meta, gz_release="fortress", lidar_noise=lidar_noise), name="robot",
+            gz.spawn(robot_sdf(meta, gz_release=SIM_GZ_RELEASE, lidar_noise=lidar_noise), name="robot",
                      pose=(spawn[0], spawn[1], spawn[2], spawn[5]))
-            got = gz.echo("/scan", 1, timeout, step=50)  # the world is paused: stepped until the scan came
+            got = gz.echo(SCAN.gazebo_topic, 1, timeout, step=50)  # the world is paused: stepped until the scan came
     if not got:
-        raise GazeboError(f"no /scan within {timeout:.0f} s")
+        raise GazeboError(f"no {SCAN.gazebo_topic} within {timeout:.0f} s")
     ranges = np.array([float(r) for r in got[0].get("ranges", [])])
     if len(ranges) != int(first(got[0], "count", len(ranges))):
-        raise GazeboError(f"/scan held {len(ranges)} ranges for a count of {first(got[0], 'count')}")
+        raise GazeboError(f"{SCAN.gazebo_topic} held {len(ranges)} ranges for a count of {first(got[0], 'count')}")
     frame = next((first(d, "value") for h in got[0].get("header", []) for d in h.get("data", [])
                   if first(d, "key") == "frame_id"), "")
     # Gazebo reports +inf for a ray that hits nothing (REP 117); world.json writes range_max there.

@@ -9,7 +9,7 @@ import pytest
 from support.reftools_sdf import check_robot_sdf
 
 import worldgen
-from worldgen.ros import bundle as ros2
+from worldgen.export import ros2
 
 
 def _grid(pgm: bytes) -> np.ndarray:
@@ -83,6 +83,6 @@ def test_the_shipped_robot_publishes_what_the_bridge_takes(release, tmp_path):
     assert f'filename="{prefix}diff-drive-system"' in sdf
     named = set(re.findall(r"<(?:topic|odom_topic|tf_topic)>([^<]+)<", sdf))
     world_topics = {"/clock", "/contacts"}  # the world's, not the robot's
-    for entry in ros2.bridge_config("bot-1", release):
+    for entry in ros2.bridge_config(release):
         if entry["gz_topic_name"] not in world_topics:
             assert entry["gz_topic_name"].lstrip("/") in {t.lstrip("/") for t in named}, entry

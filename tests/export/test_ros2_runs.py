@@ -3,7 +3,7 @@ ROS's launch API, and run_loop.py over stand-in `ros2 launch` processes.
 
 The stand-ins perform substitutions and conditions as launch does (launch's substitution.py,
 conditions, OnProcessExit's callback with the exit event); they run the bundle's own code, they do not
-emulate ROS. The real Gazebo server's shutdown is in test_bundle_gazebo.py; docs/ros2.md says what was
+emulate ROS. The real Gazebo server's shutdown is in test_ros2_gazebo.py; docs/ros2.md says what was
 verified where.
 """
 
@@ -19,7 +19,7 @@ import pytest
 import yaml
 from support.bundle import load_script as load
 
-from worldgen.ros import bundle as ros2
+from worldgen.export import ros2
 
 # -- stand-ins of ROS's launch API ------------------------------------------------
 

@@ -1,4 +1,4 @@
-"""The ROS 2 bundle tests' shared world: two tasks, written with its bundle (one per test module)."""
+"""The ROS 2 bundle tests' shared world (test_ros2*.py): two tasks, written with its bundle (one per test module)."""
 
 import pytest
 from support.bundle import bundle_world
