@@ -12,10 +12,13 @@ oracles' :class:`~worldgen.testing.oracles.Ground` and to world.json (for drawin
   each read from its world.json and world.mjcf.xml (a pack built without MJCF is
   regenerated from its recorded generator, seed and parameters, and must give
   the recorded ``content_hash``).
+- :class:`FolderSource`: one written world folder, any of its tasks, every episode (a campaign's
+  run of a policy: :mod:`worldgen.campaign.systems`).
 """
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,7 +27,7 @@ from typing import Any, Callable, Mapping, Optional
 from worldgen.errors import ParameterError, quoted
 from worldgen.scene import Robot
 
-__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "make_source"]
+__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "FolderSource", "stored_world", "make_source"]
 
 
 @dataclass(eq=False)
@@ -224,48 +227,78 @@ class PackSource:
         return longest, True
 
     def world(self, index: int) -> EpisodeWorld:
-        from lxml import etree
-
-        from worldgen.export.xml import safe_parser
         from worldgen.groundtruth.ground import load as ground_of
-        from worldgen.scene import Robot as _Robot
 
         pw = self.pack[index]
-        meta = pw.metadata
-        task = _checked_task(pw.world_id, meta["tasks"][0])
-        if "mjcf" in meta.get("files", {}):
-            root = etree.fromstring(pw.read(meta["files"]["mjcf"]["path"]), safe_parser())
-        else:
-            root = self._regenerated_mjcf(pw, meta)
-        r = meta["robot"]
-        params = dict(meta.get("params", {}))
-        return EpisodeWorld(
-            world_id=pw.world_id, mjcf=root, robot=_Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
-            task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
-            floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
-            lidar_height=float(params.get("lidar_height", 0.3)), params=params,
-            _ground=lambda: ground_of(pw), _metadata=lambda: meta, _scene=lambda: self._regenerated(pw, meta).scene,
-            bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
-            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
+        return stored_world(pw.world_id, pw.metadata, pw.read, lambda: ground_of(pw),
+                            lambda: _regenerated(pw.world_id, pw.metadata))
 
-    @staticmethod
-    def _regenerated(pw, meta):
-        """The pack world regenerated from its recorded generator, seed and parameters (same content_hash)."""
-        from worldgen.api import generate
 
-        world = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
-                         **meta["params"])
-        if world.content_hash != meta["content_hash"]:
-            raise ParameterError(f"pack world {pw.world_id} does not regenerate with this worldgen version "
-                                 f"({world.content_hash} != {meta['content_hash']}); the environment needs its MJCF "
-                                 "and, for the geodesic reward, its scene")
-        return world
+def _regenerated(world_id: str, meta: dict):
+    """A stored world regenerated from its recorded generator, seed and parameters (same content_hash)."""
+    from worldgen.api import generate
 
-    @classmethod
-    def _regenerated_mjcf(cls, pw, meta):
-        from worldgen.export.xml import parse_bytes
+    world = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
+                     **meta["params"])
+    if world.content_hash != meta["content_hash"]:
+        raise ParameterError(f"world {world_id} does not regenerate with this worldgen version "
+                             f"({world.content_hash} != {meta['content_hash']}); the environment needs its MJCF "
+                             "and, for the geodesic reward, its scene")
+    return world
 
-        return parse_bytes(cls._regenerated(pw, meta).to_mjcf().encode()).getroot()
+
+class FolderSource:
+    """One written world folder for every episode, driving ``task`` (a task id of its world.json; None: the
+    first): what a campaign runs a policy in (worldgen.campaign.systems); set it as an env's ``source``."""
+
+    def __init__(self, folder, task: Optional[str] = None):
+        from worldgen.files import METADATA_NAME
+
+        self.folder = Path(folder)
+        try:
+            self.meta = json.loads((self.folder / METADATA_NAME).read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise ParameterError(f"parameter 'world' must be a world folder holding {METADATA_NAME}, "
+                                 f"got '{folder}' ({exc})") from None
+        ids = [str(t["id"]) for t in self.meta["tasks"]]
+        if task is not None and task not in ids:
+            raise ParameterError(f"parameter 'task' must be one of the world's tasks ({', '.join(ids)}), got {task!r}")
+        self.task = task
+
+    def __len__(self) -> int:
+        return 0
+
+    def world(self, seed) -> EpisodeWorld:
+        from worldgen.groundtruth.ground import load as ground_of
+
+        meta = self.meta
+        return stored_world(meta["world_id"], meta, lambda rel: (self.folder / rel).read_bytes(),
+                            lambda: ground_of(self.folder), lambda: _regenerated(meta["world_id"], meta), self.task)
+
+
+def stored_world(world_id: str, meta: dict, read: Callable[[str], bytes], ground: Callable[[], Any],
+                 regenerated: Callable[[], Any], task: Optional[str] = None) -> EpisodeWorld:
+    """The :class:`EpisodeWorld` of a written world (world.json ``meta``, its files by ``read``), driving
+    ``task`` (None: the first); ``regenerated()`` gives the World again where the MJCF or the scene is wanting."""
+    from lxml import etree
+
+    from worldgen.export.xml import parse_bytes, safe_parser
+    chosen = next((t for t in meta["tasks"] if task is None or t["id"] == task), meta["tasks"][0])
+    chosen = _checked_task(world_id, chosen)
+    if "mjcf" in meta.get("files", {}):
+        root = etree.fromstring(read(meta["files"]["mjcf"]["path"]), safe_parser())
+    else:
+        root = parse_bytes(regenerated().to_mjcf().encode()).getroot()
+    r = meta["robot"]
+    params = dict(meta.get("params", {}))
+    return EpisodeWorld(
+        world_id=world_id, mjcf=root, robot=Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
+        task=chosen, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
+        floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
+        lidar_height=float(params.get("lidar_height", 0.3)), params=params,
+        _ground=ground, _metadata=lambda: meta, _scene=lambda: regenerated().scene,
+        bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
+        door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):
