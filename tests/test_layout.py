@@ -138,7 +138,7 @@ def test_tests_mirror_the_package_and_share_helpers_only_through_support():
 FLOW = [
     {"errors"}, {"floats", "files", "seeding", "schema"}, {"params"}, {"scene"}, {"generators"}, {"feasibility"},
     {"groundtruth"}, {"people"}, {"export"}, {"ros"}, {"world"}, {"leveling"}, {"api"}, {"presets"},
-    {"verify"}, {"testing"}, {"pack"}, {"judge"}, {"envs"}, {"sim"}, {"cli"}, {"__main__"},
+    {"verify"}, {"testing"}, {"pack"}, {"judge"}, {"envs"}, {"sim"}, {"campaign"}, {"cli"}, {"__main__"},
 ]
 MAX_TOP_LEVEL = 10
 

@@ -1,0 +1,183 @@
+"""The systems under test of a campaign (worldgen.campaign.systems): each kind on a real world, judged as
+``worldgen judge`` judges a bag; a command that crashes, hangs or leaves no bag is unjudged with its reason;
+bad specs are one line; the planted-weakness policy fails only in its corner."""
+
+from __future__ import annotations
+
+import os
+import pickle
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import worldgen
+from worldgen.campaign import SYSTEM_KEYS, Outcome, system_from_spec
+from worldgen.errors import ParameterError
+
+pytest.importorskip("gymnasium")
+pytest.importorskip("mujoco")
+pytest.importorskip("rosbags")
+
+SCRIPT = Path(__file__).resolve().parent.parent / "support" / "bag_command.py"
+FOLLOWER = "worldgen.envs.policies:PathFollower.for_env"
+PLANTED = "support.planted:FreezesNearPeople.for_env"
+
+
+def command(mode: str, timeout: float = 60) -> dict:
+    line = f"{shlex.quote(sys.executable)} {shlex.quote(str(SCRIPT))} {mode} {{world}} {{task}} {{run}} {{bag}}"
+    return {"command": line, "timeout": timeout}
+
+
+@pytest.fixture(scope="module")
+def worlds(tmp_path_factory):
+    """A small cluttered world without people, and one where a person crosses the robot's way."""
+    root = tmp_path_factory.mktemp("systems")
+    plain = worldgen.generate("cluttered", seed=0, size=[8, 8], n_obstacles=6).write(root / "worlds", preview=False)
+    crossed = worldgen.generate("cluttered", seed=0, size=[8, 8], n_obstacles=4, n_people=1,
+                                people_scenario="crossing").write(root / "worlds", preview=False)
+    return {"plain": Path(plain), "crossed": Path(crossed), "root": root}
+
+
+def world_id(folder: Path) -> str:
+    return folder.name
+
+
+# -- each kind on a real world ---------------------------------------------------------------------------------
+
+def test_a_policy_in_the_environment_is_judged_as_its_bag(worlds, tmp_path):
+    system = system_from_spec({"policy": FOLLOWER})
+    out = system.run(worlds["plain"], "task_0", "run0", tmp_path)
+    assert isinstance(out, Outcome) and system.kind == "policy"
+    assert (out.verdict, out.reason) == ("passed", "")
+    row = out.row
+    assert row["outcome"] == "success" and row["readable"] is True
+    assert row["run"] == f"{world_id(worlds['plain'])}__task_0__run0"
+    assert row["collisions"] == [] and row["time_to_goal"] > 0 and row["source"] == "ground_truth"
+    assert Path(row["bag"]) == (tmp_path / "bags" / f"{world_id(worlds['plain'])}__task_0__run0").resolve()
+    assert out.seconds > 0
+    again = system.run(worlds["plain"], "task_0", "run0", tmp_path)  # the same world and policy: the same run
+    assert again.row == row
+
+
+def test_a_policy_that_raises_is_unjudged(worlds, tmp_path):
+    out = system_from_spec({"policy": "support.planted:Breaks.for_env"}).run(worlds["plain"], "task_0", "r", tmp_path)
+    assert out.verdict == "unjudged" and out.row == {}
+    assert out.reason == "policy raised RuntimeError: the network's weights are NaN"
+
+
+def test_the_reference_robot_drives_in_mujoco(worlds, tmp_path):
+    system = system_from_spec({"drive": {"sim": "mujoco"}})
+    assert system.kind == "drive"
+    out = system.run(worlds["plain"], "task_0", "ref", tmp_path)
+    assert (out.verdict, out.reason) == ("passed", "")
+    assert out.row["run"] == f"{world_id(worlds['plain'])}__task_0__ref" and out.row["collisions"] == []
+    assert Path(out.row["bag"]).is_dir()
+    assert [p.name for p in (tmp_path / "bags").iterdir()] == [f"{world_id(worlds['plain'])}__task_0__ref"]
+
+
+# -- the command kind ----------------------------------------------------------------------------------------
+
+def test_a_command_that_leaves_a_clean_bag_passes(worlds, tmp_path):
+    out = system_from_spec(command("success")).run(worlds["plain"], "task_0", "run0", tmp_path)
+    assert (out.verdict, out.reason) == ("passed", "")
+    assert out.row["outcome"] == "success" and out.row["run"] == f"{world_id(worlds['plain'])}__task_0__run0"
+
+
+def test_a_command_whose_robot_collides_fails_naming_the_collision(worlds, tmp_path):
+    out = system_from_spec(command("collision")).run(worlds["plain"], "task_0", "run0", tmp_path)
+    assert out.verdict == "failed"
+    assert out.reason.startswith("collision with obstacle_") and out.reason == out.row["reason"]
+    assert out.row["outcome"] == "failure" and out.row["collisions"]
+
+
+@pytest.mark.parametrize("mode, reason", [
+    ("crash", "exit status 1"),
+    ("nobag", "no readable bag: "),
+    ("garbage", "no readable bag: "),
+])
+def test_a_command_that_leaves_nothing_to_judge_is_unjudged(worlds, tmp_path, mode, reason):
+    out = system_from_spec(command(mode)).run(worlds["plain"], "task_0", "run0", tmp_path)
+    assert out.verdict == "unjudged" and out.row == {}
+    assert out.reason.startswith(reason) and "\n" not in out.reason
+    log = tmp_path / "logs" / f"{world_id(worlds['plain'])}__task_0__run0.log"
+    assert log.is_file()
+    if mode == "crash":
+        assert "lost the transform" in log.read_text()
+
+
+def test_a_command_past_its_timeout_is_killed_with_its_process_group(worlds, tmp_path):
+    started = time.perf_counter()
+    out = system_from_spec(command("hang", timeout=3)).run(worlds["plain"], "task_0", "run0", tmp_path)
+    assert (out.verdict, out.reason, out.row) == ("unjudged", "timed out after 3 s", {})
+    assert time.perf_counter() - started < 3 + 5 + 10  # the grace, and a loaded machine
+    child = int((tmp_path / "bags" / f"{world_id(worlds['plain'])}__task_0__run0.child").read_text())
+    for _ in range(50):  # the child, in the command's process group, died with it
+        try:
+            os.kill(child, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.1)
+    else:
+        pytest.fail(f"the command's child {child} outlived the timeout")
+
+
+def test_criteria_decide_the_verdict_and_name_the_failed_criterion(worlds, tmp_path):
+    strict = {"safety": {"obstacle_clearance": 5.0}}
+    out = system_from_spec(command("success"), criteria=strict).run(worlds["plain"], "task_0", "run0", tmp_path)
+    assert out.verdict == "failed" and out.row["success"] is True
+    assert out.reason.startswith("safety.obstacle_clearance: required >= 5")
+
+
+# -- the planted weakness --------------------------------------------------------------------------------------
+
+def test_the_planted_weakness_fails_only_where_a_person_comes_near_ahead(worlds, tmp_path):
+    planted = system_from_spec({"policy": PLANTED})
+    outside = planted.run(worlds["plain"], "task_0", "run0", tmp_path)
+    inside = planted.run(worlds["crossed"], "task_0", "run0", tmp_path)
+    assert (outside.verdict, inside.verdict) == ("passed", "failed")
+    assert inside.reason == "goal not reached"  # it froze: the time ran out
+    # The same follower without the flaw passes the crossed world: the failure is the weakness's.
+    sound = system_from_spec({"policy": "worldgen.envs.policies:TimedFollower.for_env"})
+    assert sound.run(worlds["crossed"], "task_0", "run1", tmp_path).verdict == "passed"
+
+
+# -- specs -----------------------------------------------------------------------------------------------------
+
+def test_systems_are_picklable_values(worlds):
+    for spec in ({"policy": FOLLOWER, "env": {"lidar_beams": 90}}, {"drive": {"sim": "mujoco"}}, command("success")):
+        system = system_from_spec(spec, criteria={"navigation": {"success_rate": 1.0}})
+        assert pickle.loads(pickle.dumps(system)) == system
+        hash(system)
+    assert SYSTEM_KEYS == {"policy", "env", "drive", "command", "timeout"}
+
+
+@pytest.mark.parametrize("spec, says", [
+    ({"policy": "no_such_module_xyz:make"}, "cannot import module 'no_such_module_xyz'"),
+    ({"policy": "worldgen.envs.policies:NoSuchPolicy"}, "has no 'NoSuchPolicy'"),
+    ({"policy": "worldgen.envs.policies"}, "must be 'module:factory'"),
+    ({"command": "true {world} {task}"}, "{bag}"),
+    ({"command": "true {bag} {where}"}, "unknown placeholder {where}"),
+    ({"command": "no-such-program-xyz {bag}"}, "not a program"),
+    ({"command": "true 'unclosed {bag}"}, "cannot be split"),
+    ({"policy": FOLLOWER, "drive": {"sim": "mujoco"}}, "exactly one kind of system (policy, drive, command), got policy and drive"),
+    ({}, "got none"),
+    ({"policy": FOLLOWER, "seed": 3}, "unknown key 'seed'"),
+    ({"policy": FOLLOWER, "timeout": 3}, "'timeout' does not go with policy"),
+    ({"policy": FOLLOWER, "env": {"lidar_beams": 0}}, "lidar_beams"),
+    ({"policy": FOLLOWER, "env": {"preset": "drl_arena"}}, "'preset' is the campaign's to choose"),
+    ({"drive": {"sim": "webots"}}, "system.drive.sim must be one of gazebo, mujoco"),
+    ({"command": "true {bag}", "timeout": 0}, "system.timeout must be a number of seconds > 0"),
+])
+def test_a_bad_spec_is_one_line(spec, says):
+    with pytest.raises(ParameterError) as err:
+        system_from_spec(spec)
+    assert says in str(err.value) and "\n" not in str(err.value)
+    assert err.value.exit_status == 2
+
+
+def test_bad_criteria_are_refused_before_any_run():
+    with pytest.raises(ParameterError, match="unknown section 'speed'"):
+        system_from_spec({"drive": {"sim": "mujoco"}}, criteria={"speed": {"max": 1}})
