@@ -181,3 +181,37 @@ def test_a_bad_spec_is_one_line(spec, says):
 def test_bad_criteria_are_refused_before_any_run():
     with pytest.raises(ParameterError, match="unknown section 'speed'"):
         system_from_spec({"drive": {"sim": "mujoco"}}, criteria={"speed": {"max": 1}})
+
+
+# -- the documented template for the ROS 2 bundle ----------------------------------------------------------
+
+def documented_template() -> dict:
+    import yaml
+
+    text = (Path(__file__).resolve().parents[2] / "docs" / "campaigns.md").read_text()
+    blocks = [b for b in text.split("```yaml\n")[1:] if "ros2 launch" in b]
+    assert len(blocks) == 1, "docs/campaigns.md holds one template for the ROS 2 bundle"
+    return yaml.safe_load(blocks[0].split("```")[0])["system"]
+
+
+@pytest.mark.parametrize("outcome, verdict, reason", [("succeeded", "passed", ""), ("crashed", "unjudged", "exit status 4")])
+def test_the_documented_bundle_template_runs_the_launch_file_and_judges_its_bag(tmp_path, monkeypatch, outcome,
+                                                                                verdict, reason):
+    world = Path(worldgen.generate("cluttered", seed=0, size=[8, 8], n_obstacles=6).write(
+        tmp_path / "worlds", preview=False, ros=True))
+    launch = list((world / "ros2" / "launch").glob("*.launch.py"))
+    assert len(launch) == 1  # the template finds it by this pattern
+    stand_in = tmp_path / "bin" / "ros2"
+    stand_in.parent.mkdir()
+    stand_in.write_text(f"#!/bin/sh\nexec {shlex.quote(sys.executable)} "
+                        f"{shlex.quote(str(SCRIPT.parent / 'stand_in_ros2.py'))} \"$@\"\n")
+    stand_in.chmod(0o755)
+    monkeypatch.setenv("PATH", f"{stand_in.parent}{os.pathsep}{os.environ['PATH']}")
+    monkeypatch.setenv("STAND_IN_OUTCOME", outcome)
+    system = system_from_spec(documented_template())
+    out = system.run(world, "task_0", "run0", tmp_path / "work")
+    assert (out.verdict, out.reason) == (verdict, reason)
+    bag = tmp_path / "work" / "bags" / f"{world.name}__task_0__run0"
+    if verdict == "passed":
+        assert out.row["run"] == bag.name and Path(out.row["bag"]) == bag.resolve()
+        assert (Path(f"{bag}.out") / f"{bag.name}.result.yaml").is_file()  # beside it, kept for reading

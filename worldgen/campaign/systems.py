@@ -54,7 +54,8 @@ class System(Protocol):
     """What a campaign runs: ``run`` drives ``task`` of the world folder ``world`` as run ``run``, writing
     into ``workdir``. Every kind is a frozen dataclass: picklable, sent to Dask workers."""
 
-    kind: str
+    @property
+    def kind(self) -> str: ...
 
     def run(self, world: Path, task: str, run: str, workdir: Path) -> Outcome: ...
 
@@ -164,12 +165,13 @@ class PolicySystem:
         meta = json.loads((Path(world) / METADATA_NAME).read_text(encoding="utf-8"))
         (x0, y0), (x1, y1) = meta["bounds"]["min"][:2], meta["bounds"]["max"][:2]
         # The goal distance is observed within the world's own diagonal unless the recipe fixes the bound.
-        settings = {"goal_distance_max": math.hypot(x1 - x0, y1 - y0)} | dict(self.env)
+        settings: dict[str, Any] = {"goal_distance_max": math.hypot(x1 - x0, y1 - y0)} | dict(self.env)
         env = gymnasium.make("worldgen/Navigation-v0", disable_env_checker=True, **settings)
         try:
-            env.unwrapped.source = source
+            u: Any = env.unwrapped
+            u.source = source
             obs, _ = env.reset(seed=0)  # the same world and policy: the same run
-            chosen = env.unwrapped.task
+            chosen = u.task
             try:
                 policy = _call_factory(_factory(self.policy), env)
             except Exception as exc:  # the policy's own error: no run to judge, not the robot failing
