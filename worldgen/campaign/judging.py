@@ -13,6 +13,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Optional
 
+from worldgen.errors import ParameterError
+
 __all__ = ["Outcome", "bag_of", "judged", "unjudged", "said"]
 
 
@@ -28,11 +30,19 @@ class Outcome:
 
 
 def bag_of(world: Path, task: str, run: str, workdir: Path) -> Path:
-    """Where this run's bag goes; a bag left there by a run that was killed is removed (the run starts over)."""
+    """Where this run's bag goes; a bag left there by a run that was killed is removed (the run starts over).
+    A folder that is no world, or a task it does not have, is a ParameterError: the campaign's mistake."""
     from worldgen.files import METADATA_NAME
 
-    world_id = json.loads((Path(world) / METADATA_NAME).read_text(encoding="utf-8"))["world_id"]
-    bag = Path(workdir) / "bags" / f"{world_id}__{task}__{run}"
+    try:
+        meta = json.loads((Path(world) / METADATA_NAME).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise ParameterError(f"parameter 'world' must be a world folder holding {METADATA_NAME}, got '{world}' "
+                             f"({exc})") from None
+    tasks = [str(t["id"]) for t in meta["tasks"]]
+    if task not in tasks:
+        raise ParameterError(f"parameter 'task' must be one of the world's tasks ({', '.join(tasks)}), got {task!r}")
+    bag = Path(workdir) / "bags" / f"{meta['world_id']}__{task}__{run}"
     if bag.is_dir():
         shutil.rmtree(bag)
     elif bag.exists():

@@ -161,6 +161,7 @@ class PolicySystem:
         from worldgen.sim.drive import write_bag
 
         started = time.perf_counter()
+        bag = bag_of(world, task, run, workdir)
         source = FolderSource(world, task)
         meta = json.loads((Path(world) / METADATA_NAME).read_text(encoding="utf-8"))
         (x0, y0), (x1, y1) = meta["bounds"]["min"][:2], meta["bounds"]["max"][:2]
@@ -183,7 +184,6 @@ class PolicySystem:
                 return unjudged(f"policy raised {said(exc)}", started)
         finally:
             env.close()
-        bag = bag_of(world, task, run, workdir)
         write_bag(bag, trajectory, commands, meta, chosen)
         return judged(bag, Path(world), task, run, self.criteria, started)
 
