@@ -24,6 +24,8 @@ pytest.importorskip("rosbags")
 SCRIPT = Path(__file__).resolve().parent.parent / "support" / "bag_command.py"
 FOLLOWER = "worldgen.envs.policies:PathFollower.for_env"
 PLANTED = "support.planted:FreezesNearPeople.for_env"
+#: The timed path turns on the spot: its followers need turn rates above the environment's default 1 rad/s.
+TURNS = {"angular_velocity": 4.0}
 
 
 def command(mode: str, timeout: float = 60) -> dict:
@@ -134,13 +136,13 @@ def test_criteria_decide_the_verdict_and_name_the_failed_criterion(worlds, tmp_p
 # -- the planted weakness --------------------------------------------------------------------------------------
 
 def test_the_planted_weakness_fails_only_where_a_person_comes_near_ahead(worlds, tmp_path):
-    planted = system_from_spec({"policy": PLANTED})
+    planted = system_from_spec({"policy": PLANTED, "env": TURNS})
     outside = planted.run(worlds["plain"], "task_0", "run0", tmp_path)
     inside = planted.run(worlds["crossed"], "task_0", "run0", tmp_path)
     assert (outside.verdict, inside.verdict) == ("passed", "failed")
     assert inside.reason == "goal not reached"  # it froze: the time ran out
     # The same follower without the flaw passes the crossed world: the failure is the weakness's.
-    sound = system_from_spec({"policy": "worldgen.envs.policies:TimedFollower.for_env"})
+    sound = system_from_spec({"policy": "worldgen.envs.policies:TimedFollower.for_env", "env": TURNS})
     assert sound.run(worlds["crossed"], "task_0", "run1", tmp_path).verdict == "passed"
 
 

@@ -12,8 +12,9 @@ people elsewhere) it passes; inside (a person crossing its way) it fails.
 People are where world.json's tracks have them at the episode's time: a privileged view, as the
 followers' own pose is; the campaign's worlds with impassive people move exactly so.
 
-Use it as the system ``{"policy": "support.planted:FreezesNearPeople.for_env"}`` (``tests/`` on sys.path,
-as pytest puts it there for this folder).
+Use it as the system ``{"policy": "support.planted:FreezesNearPeople.for_env", "env": {"angular_velocity": 4.0}}``
+(``tests/`` on sys.path, as pytest puts it there for this folder): the timed path turns its corners on the
+spot, and at the environment's default turn rate (1 rad/s) the follower lags behind it into obstacles.
 """
 
 from __future__ import annotations
