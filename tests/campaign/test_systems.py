@@ -80,6 +80,18 @@ def test_the_reference_robot_drives_in_mujoco(worlds, tmp_path):
     assert [p.name for p in (tmp_path / "bags").iterdir()] == [f"{world_id(worlds['plain'])}__task_0__ref"]
 
 
+
+def test_a_factory_without_arguments_is_called_without_the_environment(worlds, tmp_path):
+    out = system_from_spec({"policy": "support.planted:Stands"}).run(worlds["plain"], "task_0", "r", tmp_path)
+    assert (out.verdict, out.reason) == ("failed", "goal not reached")
+    assert out.row["path_length"] == 0.0
+
+
+def test_an_action_of_an_unknown_shape_is_the_recipes_mistake(worlds, tmp_path):
+    system = system_from_spec({"policy": "support.planted:TwoArguments"})
+    with pytest.raises(ParameterError, match=r"action\(\) must take \(observation\), \(x, y, yaw\) or \(x, y, yaw, t\)"):
+        system.run(worlds["plain"], "task_0", "r", tmp_path)
+
 # -- the command kind ----------------------------------------------------------------------------------------
 
 def test_a_command_that_leaves_a_clean_bag_passes(worlds, tmp_path):

@@ -26,7 +26,7 @@ import numpy as np
 from worldgen.envs.policies import PathFollower, TimedFollower
 from worldgen.scene.motion import positions_at
 
-__all__ = ["FreezesNearPeople", "Breaks", "FREEZE_DISTANCE", "FREEZE_CONE"]
+__all__ = ["FreezesNearPeople", "Breaks", "Stands", "TwoArguments", "FREEZE_DISTANCE", "FREEZE_CONE"]
 
 #: m from the robot's centre to a person's disc edge at which it freezes.
 FREEZE_DISTANCE = 1.5
@@ -83,4 +83,21 @@ class Breaks:
         self.steps -= 1
         if self.steps < 0:
             raise RuntimeError("the network's weights are NaN")
+        return np.zeros(2, dtype=np.float32)
+
+
+class Stands:
+    """Made without the environment (its factory, the class, takes no argument); it never moves."""
+
+    def action(self, observation) -> np.ndarray:
+        return np.zeros(2, dtype=np.float32)
+
+
+class TwoArguments:
+    """An ``action`` of no shape the campaign knows: (x, y)."""
+
+    def __init__(self, env):
+        self.env = env
+
+    def action(self, x, y) -> np.ndarray:
         return np.zeros(2, dtype=np.float32)

@@ -221,8 +221,6 @@ class DriveSystem:
         return judged(bag, Path(world), task, run, self.criteria, started)
 
 
-# -- command -----------------------------------------------------------------------------------------------
-
 # -- the recipe's block ------------------------------------------------------------------------------------
 
 def _criteria(criteria: Any) -> Optional[dict]:
