@@ -18,16 +18,16 @@ oracles' :class:`~worldgen.testing.oracles.Ground` and to world.json (for drawin
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any, Callable, Mapping, Optional
 
 from worldgen.errors import ParameterError, quoted
 from worldgen.scene import Robot
 
-__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "FolderSource", "stored_world", "make_source"]
+__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "FolderSource", "make_source"]
 
 
 @dataclass(eq=False)
@@ -227,78 +227,94 @@ class PackSource:
         return longest, True
 
     def world(self, index: int) -> EpisodeWorld:
+        from lxml import etree
+
+        from worldgen.export.xml import safe_parser
         from worldgen.groundtruth.ground import load as ground_of
+        from worldgen.scene import Robot as _Robot
 
         pw = self.pack[index]
-        return stored_world(pw.world_id, pw.metadata, pw.read, lambda: ground_of(pw),
-                            lambda: _regenerated(pw.world_id, pw.metadata))
+        meta = pw.metadata
+        task = _checked_task(pw.world_id, meta["tasks"][0])
+        if "mjcf" in meta.get("files", {}):
+            root = etree.fromstring(pw.read(meta["files"]["mjcf"]["path"]), safe_parser())
+        else:
+            root = self._regenerated_mjcf(pw, meta)
+        r = meta["robot"]
+        params = dict(meta.get("params", {}))
+        return EpisodeWorld(
+            world_id=pw.world_id, mjcf=root, robot=_Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
+            task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
+            floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
+            lidar_height=float(params.get("lidar_height", 0.3)), params=params,
+            _ground=lambda: ground_of(pw), _metadata=lambda: meta, _scene=lambda: self._regenerated(pw, meta).scene,
+            bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
+            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
 
+    @staticmethod
+    def _regenerated(pw, meta):
+        """The pack world regenerated from its recorded generator, seed and parameters (same content_hash)."""
+        from worldgen.api import generate
 
-def _regenerated(world_id: str, meta: dict):
-    """A stored world regenerated from its recorded generator, seed and parameters (same content_hash)."""
-    from worldgen.api import generate
+        world = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
+                         **meta["params"])
+        if world.content_hash != meta["content_hash"]:
+            raise ParameterError(f"pack world {pw.world_id} does not regenerate with this worldgen version "
+                                 f"({world.content_hash} != {meta['content_hash']}); the environment needs its MJCF "
+                                 "and, for the geodesic reward, its scene")
+        return world
 
-    world = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
-                     **meta["params"])
-    if world.content_hash != meta["content_hash"]:
-        raise ParameterError(f"world {world_id} does not regenerate with this worldgen version "
-                             f"({world.content_hash} != {meta['content_hash']}); the environment needs its MJCF "
-                             "and, for the geodesic reward, its scene")
-    return world
+    @classmethod
+    def _regenerated_mjcf(cls, pw, meta):
+        from worldgen.export.xml import parse_bytes
+
+        return parse_bytes(cls._regenerated(pw, meta).to_mjcf().encode()).getroot()
 
 
 class FolderSource:
     """One written world folder for every episode, driving ``task`` (a task id of its world.json; None: the
-    first): what a campaign runs a policy in (worldgen.campaign.systems); set it as an env's ``source``."""
+    first): what a campaign runs a policy in (worldgen.campaign.systems); set it as an env's ``source``.
+
+    The folder is read as a pack's world is (:meth:`PackSource.world`), through the oracles' ground truth
+    (:func:`worldgen.groundtruth.ground.load`); the MJCF must be there (a campaign writes it)."""
 
     def __init__(self, folder, task: Optional[str] = None):
-        from worldgen.files import METADATA_NAME
+        from worldgen.groundtruth.ground import load
 
         self.folder = Path(folder)
-        try:
-            self.meta = json.loads((self.folder / METADATA_NAME).read_text(encoding="utf-8"))
-        except (OSError, ValueError) as exc:
-            raise ParameterError(f"parameter 'world' must be a world folder holding {METADATA_NAME}, "
-                                 f"got '{folder}' ({exc})") from None
-        ids = [str(t["id"]) for t in self.meta["tasks"]]
+        self.ground = load(self.folder)
+        meta = self.ground.meta
+        ids = [str(t["id"]) for t in meta["tasks"]]
         if task is not None and task not in ids:
             raise ParameterError(f"parameter 'task' must be one of the world's tasks ({', '.join(ids)}), got {task!r}")
-        self.task = task
+        self.task = task if task is not None else ids[0]
+        if "mjcf" not in meta.get("files", {}):
+            raise ParameterError(f"world folder '{folder}' has no MJCF file; write the world with format mjcf "
+                                 "to run it in the environment")
 
     def __len__(self) -> int:
         return 0
 
     def world(self, seed) -> EpisodeWorld:
-        from worldgen.groundtruth.ground import load as ground_of
+        from lxml import etree
 
-        meta = self.meta
-        return stored_world(meta["world_id"], meta, lambda rel: (self.folder / rel).read_bytes(),
-                            lambda: ground_of(self.folder), lambda: _regenerated(meta["world_id"], meta), self.task)
+        from worldgen.export.xml import safe_parser
 
-
-def stored_world(world_id: str, meta: dict, read: Callable[[str], bytes], ground: Callable[[], Any],
-                 regenerated: Callable[[], Any], task: Optional[str] = None) -> EpisodeWorld:
-    """The :class:`EpisodeWorld` of a written world (world.json ``meta``, its files by ``read``), driving
-    ``task`` (None: the first); ``regenerated()`` gives the World again where the MJCF or the scene is wanting."""
-    from lxml import etree
-
-    from worldgen.export.xml import parse_bytes, safe_parser
-    chosen = next((t for t in meta["tasks"] if task is None or t["id"] == task), meta["tasks"][0])
-    chosen = _checked_task(world_id, chosen)
-    if "mjcf" in meta.get("files", {}):
-        root = etree.fromstring(read(meta["files"]["mjcf"]["path"]), safe_parser())
-    else:
-        root = parse_bytes(regenerated().to_mjcf().encode()).getroot()
-    r = meta["robot"]
-    params = dict(meta.get("params", {}))
-    return EpisodeWorld(
-        world_id=world_id, mjcf=root, robot=Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
-        task=chosen, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
-        floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
-        lidar_height=float(params.get("lidar_height", 0.3)), params=params,
-        _ground=ground, _metadata=lambda: meta, _scene=lambda: regenerated().scene,
-        bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
-        door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
+        meta = self.ground.meta
+        world_id = str(meta["world_id"])
+        task = _checked_task(world_id, next(t for t in meta["tasks"] if t["id"] == self.task))
+        root = etree.fromstring((self.folder / meta["files"]["mjcf"]["path"]).read_bytes(), safe_parser())
+        r = meta["robot"]
+        params = dict(meta.get("params", {}))
+        return EpisodeWorld(
+            world_id=world_id, mjcf=root, robot=Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
+            task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
+            floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
+            lidar_height=float(params.get("lidar_height", 0.3)), params=params,
+            _ground=lambda: self.ground, _metadata=lambda: meta,
+            _scene=lambda: PackSource._regenerated(SimpleNamespace(world_id=world_id), meta).scene,
+            bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
+            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):
