@@ -64,6 +64,20 @@ def test_a_policy_in_the_environment_is_judged_as_its_bag(worlds, tmp_path):
     assert again.row == row
 
 
+def test_a_policy_runs_in_a_world_that_would_not_regenerate(worlds, tmp_path):
+    """A shrunk world was edited since it was generated: the run needs its files only, never its generator."""
+    import json
+    import shutil
+
+    edited = tmp_path / "edited" / worlds["plain"].name
+    shutil.copytree(worlds["plain"], edited)
+    meta = json.loads((edited / "world.json").read_text())
+    meta["content_hash"] = "0" * len(meta["content_hash"])
+    (edited / "world.json").write_text(json.dumps(meta))
+    out = system_from_spec({"policy": FOLLOWER}).run(edited, "task_0", "run0", tmp_path / "work")
+    assert (out.verdict, out.reason) == ("passed", "")
+
+
 def test_a_policy_that_raises_is_unjudged(worlds, tmp_path):
     out = system_from_spec({"policy": "support.planted:Breaks.for_env"}).run(worlds["plain"], "task_0", "r", tmp_path)
     assert out.verdict == "unjudged" and out.row == {}
