@@ -159,6 +159,14 @@ def test_criteria_decide_the_verdict_and_name_the_failed_criterion(worlds, tmp_p
     assert out.reason.startswith("safety.obstacle_clearance: required >= 5")
 
 
+def test_a_success_rate_bound_is_read_per_run_as_its_point_form(worlds, tmp_path):
+    bound = {"navigation": {"success_rate": {"min": 0.95, "confidence": 0.95}}}
+    clean = system_from_spec(command("success"), criteria=bound).run(worlds["plain"], "task_0", "a", tmp_path)
+    crash = system_from_spec(command("collision"), criteria=bound).run(worlds["plain"], "task_0", "b", tmp_path)
+    assert (clean.verdict, crash.verdict) == ("passed", "failed")  # 1/1's lower bound (0.05) would fail both
+    assert crash.reason.startswith("collision with obstacle_")
+
+
 # -- the planted weakness --------------------------------------------------------------------------------------
 
 def test_the_planted_weakness_fails_only_where_a_person_comes_near_ahead(worlds, tmp_path):

@@ -227,10 +227,20 @@ class DriveSystem:
 # -- the recipe's block ------------------------------------------------------------------------------------
 
 def _criteria(criteria: Any) -> Optional[dict]:
-    """The criteria as ``worldgen judge`` reads them, read now (a file once, not in every worker)."""
+    """The criteria as ``worldgen judge`` reads them, read now (a file once, not in every worker).
+
+    Each run is judged alone, so a success rate's confidence form (``{min, confidence}``: a lower bound
+    over many runs, which one run can never lift above 1 - confidence) is read as its point form ``min``:
+    the run must succeed (for any ``min`` > 0). The campaign's tally of runs is where the bound belongs."""
     from worldgen.testing.evaluate import load_criteria
 
-    return None if criteria is None else load_criteria(criteria)
+    if criteria is None:
+        return None
+    checked = load_criteria(criteria)
+    rate = checked.get("navigation", {}).get("success_rate")
+    if isinstance(rate, Mapping):
+        checked["navigation"]["success_rate"] = rate["min"]
+    return checked
 
 
 def system_from_spec(spec: Mapping[str, Any], *, criteria: Any = None) -> System:
