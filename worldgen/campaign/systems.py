@@ -1,5 +1,13 @@
 """The systems a campaign tests, one interface and three kinds, each run judged as ``worldgen judge`` judges a bag.
 
+    >>> import worldgen
+    >>> from worldgen.campaign import system_from_spec
+    >>> folder = worldgen.generate("minimal", seed=2).write("worlds", preview=False)
+    >>> system = system_from_spec({"drive": {"sim": "mujoco"}})
+    >>> outcome = system.run(folder, "task_0", "run0", "work")
+    >>> outcome.verdict, outcome.reason, outcome.row["run"], outcome.row["collisions"]
+    ('passed', '', 'minimal-s2-...__task_0__run0', [])
+
 A recipe's ``system:`` block names exactly one (:func:`system_from_spec`):
 
 - ``{"policy": "module:factory", "env": {...}}``: the factory, called with the environment
