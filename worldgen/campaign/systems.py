@@ -22,8 +22,9 @@ A recipe's ``system:`` block names exactly one (:func:`system_from_spec`):
   rosbag2 bag at ``{bag}``.
 
 Every run ends as a bag in ``workdir/bags/<world id>__<task>__<run>`` judged by
-:func:`worldgen.judge.judge` against the world's truth: the policy's episode and the drive are recorded
-with :func:`worldgen.sim.drive.write_bag`, the command's bag is the command's. A command that exits
+:func:`worldgen.judge.judge` against the world's truth: the policy's episode is recorded with
+:func:`worldgen.campaign.judging.record` (the topics ``worldgen drive`` records), the drive's bag is ``worldgen
+drive``'s, the command's is the command's. A command that exits
 non-zero, outlives its timeout (its whole process group is killed) or leaves no readable bag is
 ``unjudged`` with the reason, never a failure of the robot; so is a policy that raises.
 """
@@ -43,7 +44,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Optional, Protocol
 
 from worldgen.campaign.command import DEFAULT_TIMEOUT, PLACEHOLDERS, CommandSystem, check_template, check_timeout
-from worldgen.campaign.judging import Outcome, bag_of, judged, said, unjudged
+from worldgen.campaign.judging import Outcome, bag_of, judged, record, said, unjudged
 from worldgen.errors import ParameterError, SimulatorError, quoted
 
 __all__ = ["Outcome", "System", "PolicySystem", "DriveSystem", "CommandSystem", "SYSTEM_KEYS", "PLACEHOLDERS",
@@ -169,7 +170,6 @@ class PolicySystem:
         import worldgen.envs  # noqa: F401  (registers worldgen/Navigation-v0)
         from worldgen.envs.source import FolderSource
         from worldgen.files import METADATA_NAME
-        from worldgen.sim.drive import write_bag
 
         started = time.perf_counter()
         bag = bag_of(world, task, run, workdir)
@@ -195,7 +195,7 @@ class PolicySystem:
                 return unjudged(f"policy raised {said(exc)}", started)
         finally:
             env.close()
-        write_bag(bag, trajectory, commands, meta, chosen)
+        record(bag, trajectory, commands, meta, chosen, run)
         return judged(bag, Path(world), task, run, self.criteria, started)
 
 

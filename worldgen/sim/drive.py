@@ -37,7 +37,7 @@ from worldgen.envs.policies import PathFollower
 from worldgen.errors import OutputError, ParameterError
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "Outcome",
-           "drive", "run_loop", "steps_per_command", "write_bag"]
+           "drive", "run_loop", "steps_per_command"]
 
 #: Simulators ``worldgen drive --sim`` knows.
 SIMS = ("gazebo", "mujoco")
@@ -166,7 +166,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     finally:
         backend.close()
     wall["drive"] = time.perf_counter() - started
-    write_bag(bag, trajectory, commands, meta, chosen)
+    _write_bag(bag, trajectory, commands, meta, chosen)
     wall["record"] = time.perf_counter() - started - wall["drive"]
     result = judge([bag], world=folder)
     wall["judge"] = time.perf_counter() - started - wall["drive"] - wall["record"]
@@ -175,7 +175,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
                    float(trajectory[-1, 0] - trajectory[0, 0]), wall)
 
 
-def write_bag(bag: Path, trajectory, commands, meta: dict, task: dict) -> None:
+def _write_bag(bag: Path, trajectory, commands, meta: dict, task: dict) -> None:
     """The run as a rosbag2 folder at ``bag``, complete or absent: written aside, then moved in whole."""
     import tempfile
 
