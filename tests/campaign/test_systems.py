@@ -225,7 +225,7 @@ def test_a_task_the_world_lacks_or_a_folder_without_a_world_is_the_campaigns_mis
     system = system_from_spec(spec)
     with pytest.raises(ParameterError, match=r"must be one of the world's tasks \(task_0\), got 'task_9'"):
         system.run(worlds["plain"], "task_9", "run0", tmp_path)
-    with pytest.raises(ParameterError, match="must be a world folder holding world.json"):
+    with pytest.raises(ParameterError, match="must be a World or a world folder with world.json"):
         system.run(tmp_path, "task_0", "run0", tmp_path)
 
 # -- the documented template for the ROS 2 bundle ----------------------------------------------------------

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import shutil
 import tempfile
 import time
@@ -36,13 +35,11 @@ class Outcome:
 def bag_of(world: Path, task: str, run: str, workdir: Path) -> Path:
     """Where this run's bag goes; a bag left there by a run that was killed is removed (the run starts over).
     A folder that is no world, or a task it does not have, is a ParameterError: the campaign's mistake."""
-    from worldgen.files import METADATA_NAME
+    from worldgen.groundtruth.ground import load
 
-    try:
-        meta = json.loads((Path(world) / METADATA_NAME).read_text(encoding="utf-8"))
-    except (OSError, ValueError) as exc:
-        raise ParameterError(f"parameter 'world' must be a world folder holding {METADATA_NAME}, got '{world}' "
-                             f"({exc})") from None
+    if not Path(world).is_dir():
+        raise ParameterError(f"parameter 'world' must be a world folder, got '{world}'")
+    meta = load(Path(world)).meta  # the folder's world.json, as the judge reads it
     tasks = [str(t["id"]) for t in meta["tasks"]]
     if task not in tasks:
         raise ParameterError(f"parameter 'task' must be one of the world's tasks ({', '.join(tasks)}), got {task!r}")

@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import importlib
 import inspect
-import json
 import math
 import os
 import shutil
@@ -169,12 +168,11 @@ class PolicySystem:
 
         import worldgen.envs  # noqa: F401  (registers worldgen/Navigation-v0)
         from worldgen.envs.source import FolderSource
-        from worldgen.files import METADATA_NAME
 
         started = time.perf_counter()
         bag = bag_of(world, task, run, workdir)
         source = FolderSource(world, task)
-        meta = json.loads((Path(world) / METADATA_NAME).read_text(encoding="utf-8"))
+        meta = source.ground.meta
         (x0, y0), (x1, y1) = meta["bounds"]["min"][:2], meta["bounds"]["max"][:2]
         # The goal distance is observed within the world's own diagonal unless the recipe fixes the bound.
         settings: dict[str, Any] = {"goal_distance_max": math.hypot(x1 - x0, y1 - y0)} | dict(self.env)
