@@ -78,6 +78,19 @@ def test_a_policy_runs_in_a_world_that_would_not_regenerate(worlds, tmp_path):
     assert (out.verdict, out.reason) == ("passed", "")
 
 
+def test_a_policy_runs_in_an_edited_world_with_reacting_people(tmp_path):
+    """Reacting people need the scene, which an edited (shrunk) world gives only with its edits replayed."""
+    from worldgen.verify.edits import with_edits
+
+    world = worldgen.generate("cluttered", seed=1, size=[8, 8], n_obstacles=4, n_people=2, people_behaviour="scared",
+                              people_scenario="crossing")
+    obstacle = next(n.name for n in world.scene.nodes if n.role == "obstacle")
+    edited = with_edits(world, [{"op": "remove", "node": obstacle}])
+    folder = Path(edited.write(tmp_path / "worlds", preview=False))
+    out = system_from_spec({"policy": FOLLOWER}).run(folder, "task_0", "run0", tmp_path / "work")
+    assert out.verdict in ("passed", "failed") and out.row["world_id"] == edited.world_id
+
+
 def test_a_policy_that_raises_is_unjudged(worlds, tmp_path):
     out = system_from_spec({"policy": "support.planted:Breaks.for_env"}).run(worlds["plain"], "task_0", "r", tmp_path)
     assert out.verdict == "unjudged" and out.row == {}

@@ -312,9 +312,27 @@ class FolderSource:
             floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
             lidar_height=float(params.get("lidar_height", 0.3)), params=params,
             _ground=lambda: self.ground, _metadata=lambda: meta,
-            _scene=lambda: PackSource._regenerated(SimpleNamespace(world_id=world_id), meta).scene,
+            _scene=lambda: _edited_scene(world_id, meta),
             bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
             door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
+
+
+def _edited_scene(world_id: str, meta: dict):
+    """The scene of a written world (what reacting people and the geodesic reward need): regenerated from its
+    recorded generator, seed and parameters, its recorded ``edits`` applied (a shrunk world, an edited
+    level), and checked against its ``content_hash``."""
+    if not meta.get("edits"):
+        return PackSource._regenerated(SimpleNamespace(world_id=world_id), meta).scene
+    from worldgen.api import generate
+    from worldgen.verify.edits import with_edits
+
+    base = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
+                    **meta["params"])
+    world = with_edits(base, meta["edits"])  # proven once, the world replay_edits rebuilds edit by edit
+    if world is None or world.content_hash != meta["content_hash"]:
+        raise ParameterError(f"world {world_id} does not regenerate with its edits with this worldgen version; "
+                             "the environment needs its scene for reacting people and the geodesic reward")
+    return world.scene
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):
