@@ -91,6 +91,33 @@ def test_a_policy_runs_in_an_edited_world_with_reacting_people(tmp_path):
     assert out.verdict in ("passed", "failed") and out.row["world_id"] == edited.world_id
 
 
+def test_among_reacting_people_a_policy_is_judged_against_where_they_walked(tmp_path, monkeypatch):
+    """The verdict and the person figures agree with the environment's own (Episode.figures: people as they
+    walked), not with world.json's recorded walks, which a person who stepped aside never kept to."""
+    import json
+
+    import worldgen.campaign.systems as systems
+
+    seen = []
+    episode = systems._episode
+
+    def spy(env, obs, act):
+        out = episode(env, obs, act)
+        seen.append(env.unwrapped.episode.figures())
+        return out
+
+    monkeypatch.setattr(systems, "_episode", spy)
+    world = worldgen.generate("cluttered", seed=2, size=[8, 8], n_obstacles=4, n_people=3, people_behaviour="surprised")
+    folder = Path(world.write(tmp_path / "worlds", preview=False))
+    system = system_from_spec({"policy": "worldgen.envs.policies:GapHeuristic.for_env"})
+    out = system.run(folder, "task_0", "run0", tmp_path / "work")
+    figures = seen[-1]
+    assert (out.verdict == "passed") == figures["success"]
+    assert out.row["min_separation"] == pytest.approx(figures["min_separation"], abs=1e-6)
+    walked = json.loads((tmp_path / "work" / "walked" / f"{world.world_id}__task_0__run0" / "world.json").read_text())
+    assert all("recorded_trajectory" in p for p in walked["people"])  # every one of them reacted
+
+
 def test_a_policy_that_raises_is_unjudged(worlds, tmp_path):
     out = system_from_spec({"policy": "support.planted:Breaks.for_env"}).run(worlds["plain"], "task_0", "r", tmp_path)
     assert out.verdict == "unjudged" and out.row == {}

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import csv
 import io
+import os
 import shutil
 import tempfile
 import time
@@ -14,7 +15,7 @@ from typing import Any, Optional
 
 from worldgen.errors import ParameterError
 
-__all__ = ["Outcome", "RECORDED", "bag_of", "record", "judged", "unjudged", "said"]
+__all__ = ["Outcome", "RECORDED", "bag_of", "record", "as_walked", "judged", "unjudged", "said"]
 
 #: The topics a run the campaign records itself (a policy's episode) is written with: what `worldgen drive`
 #: records, the simulator's own pose (``/ground_truth``) first among them.
@@ -64,6 +65,30 @@ def record(bag: Path, trajectory, commands, meta: dict, task: dict, run: str) ->
                             topics=RECORDED, world_id=meta["world_id"], task=task["id"], run=run)
         blobs = {str(p.relative_to(written)): p.read_bytes() for p in sorted(written.rglob("*")) if p.is_file()}
     return write_folder_atomically(bag.parent, bag.name, blobs)
+
+
+def as_walked(world: Path, meta: dict, walked: dict, into: Path) -> Path:
+    """The world folder ``into`` as the run met it: ``world``'s files (linked, not copied) with a world.json whose
+    reacting people walk the (k, 3) ``t, x, y`` rows they walked in the episode (``walked``: name -> rows),
+    their recorded walk kept as ``recorded_trajectory``, as the environment judges its own episodes
+    (:meth:`worldgen.envs.episode.Episode.figures`). Replaces an earlier one at ``into`` whole."""
+    import json
+
+    from worldgen.files import METADATA_NAME, write_atomically
+
+    people = [dict(p, trajectory=walked[str(p["name"])].tolist(), recorded_trajectory=p["trajectory"])
+              if str(p["name"]) in walked and len(walked[str(p["name"])]) >= 2 else p for p in meta.get("people") or []]
+    into = Path(into)
+    into.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{into.name}.", dir=into.parent))
+    for entry in sorted(Path(world).iterdir()):
+        if entry.name != METADATA_NAME:
+            (tmp / entry.name).symlink_to(entry.resolve())
+    write_atomically(tmp / METADATA_NAME, (json.dumps(dict(meta, people=people), sort_keys=True) + "\n").encode())
+    if into.exists():
+        shutil.rmtree(into)
+    os.replace(tmp, into)
+    return into
 
 
 def judged(bag: Path, world: Path, task: str, run: str, criteria: Optional[dict], started: float) -> Outcome:

@@ -26,7 +26,9 @@ Every run ends as a bag in ``workdir/bags/<world id>__<task>__<run>`` judged by
 :func:`worldgen.campaign.judging.record` (the topics ``worldgen drive`` records), the drive's bag is ``worldgen
 drive``'s, the command's is the command's. A command that exits
 non-zero, outlives its timeout (its whole process group is killed) or leaves no readable bag is
-``unjudged`` with the reason, never a failure of the robot; so is a policy that raises.
+``unjudged`` with the reason, never a failure of the robot; so is a policy that raises. A policy's run among
+people who react to the robot is judged against where they walked in the episode
+(:func:`~worldgen.campaign.judging.as_walked`).
 """
 
 from __future__ import annotations
@@ -43,7 +45,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Optional, Protocol
 
 from worldgen.campaign.command import DEFAULT_TIMEOUT, PLACEHOLDERS, CommandSystem, check_template, check_timeout
-from worldgen.campaign.judging import Outcome, bag_of, judged, record, said, unjudged
+from worldgen.campaign.judging import Outcome, as_walked, bag_of, judged, record, said, unjudged
 from worldgen.errors import ParameterError, SimulatorError, quoted
 
 __all__ = ["Outcome", "System", "PolicySystem", "DriveSystem", "CommandSystem", "SYSTEM_KEYS", "PLACEHOLDERS",
@@ -191,10 +193,15 @@ class PolicySystem:
                 trajectory, commands = _episode(env, obs, act)
             except Exception as exc:
                 return unjudged(f"policy raised {said(exc)}", started)
+            walkers = u.episode.walkers
+            walked = walkers.reacted if walkers is not None else {}
         finally:
             env.close()
         record(bag, trajectory, commands, meta, chosen, run)
-        return judged(bag, Path(world), task, run, self.criteria, started)
+        # People who react to the robot walked elsewhere than world.json has them: the run is judged against
+        # where they went, as the environment judges its episodes (a person who stepped aside is not hit).
+        truth = as_walked(Path(world), meta, walked, bag.parent.parent / "walked" / bag.name) if walked else Path(world)
+        return judged(bag, truth, task, run, self.criteria, started)
 
 
 def _call_factory(factory: Callable, env) -> Any:
