@@ -268,6 +268,15 @@ def test_a_task_the_world_lacks_or_a_folder_without_a_world_is_the_campaigns_mis
     with pytest.raises(ParameterError, match="must be a World or a world folder with world.json"):
         system.run(tmp_path, "task_0", "run0", tmp_path)
 
+
+@pytest.mark.parametrize("spec", [{"policy": FOLLOWER}, {"drive": {"sim": "mujoco"}}])
+def test_a_world_written_without_its_mjcf_cannot_run_in_mujoco(tmp_path, spec):
+    folder = worldgen.generate("cluttered", seed=0, size=[8, 8], n_obstacles=6).write(tmp_path / "w", formats=["sdf"],
+                                                                                       preview=False)
+    with pytest.raises(ParameterError, match="no MJCF file|has no mjcf file"):
+        system_from_spec(spec).run(Path(folder), "task_0", "run0", tmp_path / "work")
+
+
 # -- the documented template for the ROS 2 bundle ----------------------------------------------------------
 
 def documented_template() -> dict:
