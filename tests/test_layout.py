@@ -138,7 +138,7 @@ def test_tests_mirror_the_package_and_share_helpers_only_through_support():
 FLOW = [
     {"errors"}, {"floats", "files", "seeding", "schema"}, {"params"}, {"scene"}, {"generators"}, {"feasibility"},
     {"groundtruth"}, {"people"}, {"export"}, {"ros"}, {"world"}, {"pipeline"}, {"leveling"}, {"api"}, {"presets"},
-    {"verify"}, {"pack"}, {"judge"}, {"testing"}, {"envs"}, {"sim"}, {"cli"}, {"__main__"},
+    {"verify"}, {"pack"}, {"judge"}, {"testing"}, {"envs"}, {"sim"}, {"campaign"}, {"cli"}, {"__main__"},
 ]
 MAX_TOP_LEVEL = 10
 
@@ -407,6 +407,8 @@ WORLD_JSON_NAMED = {
     "pack/verify.py": "checks that a pack's manifest lists world.json with its sha256; parses it through the reader",
     "verify/folder.py": "checks a received folder's raw bytes: a missing or broken world.json is the verdict of its "
                         "`metadata` check, not a usage error, and a fresh export's world.json is compared with it",
+    "campaign/judging.py": "a writer: the per-run copy of a world folder whose world.json holds the people as they "
+                           "walked in the episode, which the judge then reads through the reader",
 }
 
 

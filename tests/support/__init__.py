@@ -6,7 +6,9 @@
 - ``draft``: one unchecked draw of a generator.
 - the modules beside this one: ``reftools_*`` (the reference consumers of each format), ``scenes``
   (hand-built scenes that use every feature), ``exact_reference`` (an independent exact planner),
-  ``cli`` (running the command), ``checks`` (geometric re-checks of a world), ``fuzzing``.
+  ``cli`` (running the command), ``checks`` (geometric re-checks of a world), ``fuzzing``; for campaigns,
+  ``planted`` (a policy with a planted weakness), ``bag_command`` and ``stand_in_ros2`` (stand-in robot stacks
+  that leave bags).
 """
 
 from __future__ import annotations

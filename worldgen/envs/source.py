@@ -12,6 +12,8 @@ oracles' :class:`~worldgen.groundtruth.ground.Ground` and to world.json (for dra
   each read from its world.json and world.mjcf.xml (a pack built without MJCF is
   regenerated from its recorded generator, seed and parameters, and must give
   the recorded ``content_hash``).
+- :class:`FolderSource`: one written world folder, any of its tasks, every episode (a campaign's
+  run of a policy: :mod:`worldgen.campaign.systems`).
 """
 
 from __future__ import annotations
@@ -19,12 +21,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any, Callable, Mapping, Optional
 
 from worldgen.errors import ParameterError, quoted
 from worldgen.scene import Robot
 
-__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "make_source"]
+__all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "FolderSource", "make_source"]
 
 
 @dataclass(eq=False)
@@ -264,6 +267,70 @@ class PackSource:
         from worldgen.export.xml import parse_bytes
 
         return parse_bytes(cls._regenerated(pw, meta).to_mjcf().encode()).getroot()
+
+
+class FolderSource:
+    """One written world folder for every episode, driving ``task`` (a task id of its world.json; None: the
+    first): what a campaign runs a policy in (worldgen.campaign.systems); set it as an env's ``source``.
+
+    The folder is read as a pack's world is (:meth:`PackSource.world`), through the oracles' ground truth
+    (:func:`worldgen.groundtruth.ground.load`); the MJCF must be there (a campaign writes it)."""
+
+    def __init__(self, folder, task: Optional[str] = None):
+        from worldgen.groundtruth.ground import load
+
+        self.folder = Path(folder)
+        self.ground = load(self.folder)
+        meta = self.ground.meta
+        ids = [str(t["id"]) for t in meta["tasks"]]
+        if task is not None and task not in ids:
+            raise ParameterError(f"parameter 'task' must be one of the world's tasks ({', '.join(ids)}), got {task!r}")
+        self.task = task if task is not None else ids[0]
+        if "mjcf" not in meta.get("files", {}):
+            raise ParameterError(f"world folder '{folder}' has no MJCF file; write the world with format mjcf "
+                                 "to run it in the environment")
+
+    def __len__(self) -> int:
+        return 0
+
+    def world(self, seed) -> EpisodeWorld:
+        from lxml import etree
+
+        from worldgen.export.xml import safe_parser
+
+        meta = self.ground.meta
+        world_id = str(meta["world_id"])
+        task = _checked_task(world_id, next(t for t in meta["tasks"] if t["id"] == self.task))
+        root = etree.fromstring((self.folder / meta["files"]["mjcf"]["path"]).read_bytes(), safe_parser())
+        r = meta["robot"]
+        params = dict(meta.get("params", {}))
+        return EpisodeWorld(
+            world_id=world_id, mjcf=root, robot=Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
+            task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
+            floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
+            lidar_height=float(params.get("lidar_height", 0.3)), params=params,
+            _ground=lambda: self.ground, _metadata=lambda: meta,
+            _scene=lambda: _edited_scene(world_id, meta),
+            bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
+            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
+
+
+def _edited_scene(world_id: str, meta: dict):
+    """The scene of a written world (what reacting people and the geodesic reward need): regenerated from its
+    recorded generator, seed and parameters, its recorded ``edits`` applied (a shrunk world, an edited
+    level), and checked against its ``content_hash``."""
+    if not meta.get("edits"):
+        return PackSource._regenerated(SimpleNamespace(world_id=world_id), meta).scene
+    from worldgen.api import generate
+    from worldgen.verify.edits import with_edits
+
+    base = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
+                    **meta["params"])
+    world = with_edits(base, meta["edits"])  # proven once, the world replay_edits rebuilds edit by edit
+    if world is None or world.content_hash != meta["content_hash"]:
+        raise ParameterError(f"world {world_id} does not regenerate with its edits with this worldgen version; "
+                             "the environment needs its scene for reacting people and the geodesic reward")
+    return world.scene
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):
