@@ -281,3 +281,77 @@ def test_random_streams_are_made_only_in_seeding_py():
              if path.name != "seeding.py"
              for i, line in enumerate(path.read_text().splitlines(), 1) if made.search(line)]
     assert not found, "random streams made outside seeding.py:\n" + "\n".join(found)
+
+
+# -- house rules without blind spots ------------------------------------------------------------------
+
+def exception_classes(sources: dict[str, str]) -> dict[str, tuple[str, bool]]:
+    """Every class of ``sources`` (module name -> source text) that is an ``Exception``, wherever it is defined
+    (module level, inside a class or a function), mapped to (where, whether it descends from WorldgenError).
+
+    Read from the source, not imported: a module behind an optional extra is read like any other. A base is
+    known by its last name (``errors.WorldgenError`` is ``WorldgenError``); a base the package does not define
+    is a builtin exception when ``builtins`` has it, or, from a third party, when its name says it is one."""
+    import builtins
+
+    builtin = {n: v for n, v in vars(builtins).items() if isinstance(v, type) and issubclass(v, BaseException)}
+    bases, where = {}, {}
+    for module, text in sources.items():
+        for node in ast.walk(ast.parse(text)):
+            if isinstance(node, ast.ClassDef):
+                names = [b.attr if isinstance(b, ast.Attribute) else b.id if isinstance(b, ast.Name) else ""
+                         for b in node.bases]
+                key = f"{module}.{node.name}"
+                bases[key], where[key] = names, f"{module}:{node.lineno} {node.name}"
+    by_name: dict[str, list[str]] = {}
+    for key in bases:
+        by_name.setdefault(key.rpartition(".")[2], []).append(key)
+
+    def kind(name: str, seen: frozenset = frozenset()) -> set[str]:
+        """What a base called ``name`` is: {"root"} for WorldgenError's line, {"error"} for an Exception,
+        {"interrupt"} for a BaseException that is no Exception (KeyboardInterrupt: never caught as an error)."""
+        if name == "WorldgenError":
+            return {"root", "error"}
+        if name in builtin:
+            return {"error"} if issubclass(builtin[name], Exception) else {"interrupt"}
+        found: set[str] = set()
+        for key in by_name.get(name, ()):
+            if key not in seen:
+                for base in bases[key]:
+                    found |= kind(base, seen | {key})
+        if not by_name.get(name) and name.endswith(("Error", "Exception")):
+            found.add("error")
+        return found
+
+    out = {}
+    for key in bases:
+        kinds: set[str] = set().union(*[kind(b, frozenset({key})) for b in bases[key]]) if bases[key] else set()
+        if key.endswith(".WorldgenError"):
+            kinds |= {"root"}
+        if "error" in kinds and "interrupt" not in kinds:
+            out[key] = (where[key], "root" in kinds)
+    return out
+
+
+def test_the_exception_finder_sees_classes_outside_errors_py():
+    found = exception_classes({
+        "errors": "class WorldgenError(Exception): pass\nclass BagError(WorldgenError, ValueError): pass",
+        "a": "from errors import BagError\nclass Mine(BagError): pass\nclass Stray(ValueError): pass\n"
+             "def f():\n    class _Local(RuntimeError): pass\nclass Plain: pass\nclass Stop(KeyboardInterrupt): pass",
+        "b": "import pytest\nclass Third(pytest.UsageError): pass\nclass Deep(errors.WorldgenError): pass",
+    })
+    assert {k: v[1] for k, v in found.items()} == {
+        "errors.WorldgenError": True, "errors.BagError": True, "a.Mine": True, "a.Stray": False, "a._Local": False,
+        "b.Third": False, "b.Deep": True}
+
+
+def test_every_exception_class_in_the_package_is_a_worldgen_error():
+    """Callers catch WorldgenError, and the command line maps it to one line with its exit status: an exception
+    class of the package that is not one escapes both, whichever module defines it (private ones too: an
+    internal signal that leaks is still the package's error). A KeyboardInterrupt's subclass (a build stopped
+    by Ctrl-C) is an interrupt, not an error, and stays out of ``except Exception``."""
+    found = exception_classes({name: path.read_text() for name, path in modules().items()})
+    assert "worldgen.errors.WorldgenError" in found and "worldgen.sim.gazebo.GazeboError" in found
+    stray = sorted(where for where, rooted in found.values() if not rooted)
+    assert not stray, "exception classes that do not descend from WorldgenError (worldgen/errors.py):\n" + \
+        "\n".join(stray)
