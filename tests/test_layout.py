@@ -355,3 +355,36 @@ def test_every_exception_class_in_the_package_is_a_worldgen_error():
     stray = sorted(where for where, rooted in found.values() if not rooted)
     assert not stray, "exception classes that do not descend from WorldgenError (worldgen/errors.py):\n" + \
         "\n".join(stray)
+
+
+def files_py_names() -> set[str]:
+    """The file names worldgen/files.py spells: its module-level strings with a dot (``WORLDS_DIR`` is a word)."""
+    return {node.value.value for node in ast.parse((PACKAGE / "files.py").read_text()).body
+            if isinstance(node, ast.Assign) and isinstance(node.value, ast.Constant)
+            and isinstance(node.value.value, str) and "." in node.value.value}
+
+
+def file_names_spelled(text: str, names: set[str]) -> list[tuple[int, str]]:
+    """Where ``text`` spells one of ``names`` as a string: the whole string, or its last part after a slash (the
+    literal piece of ``f"{folder}/world.json"``). A sentence that mentions a name in passing is no spelling."""
+    return [(node.lineno, node.value) for node in ast.walk(ast.parse(text))
+            if isinstance(node, ast.Constant) and isinstance(node.value, str)
+            and (node.value in names or ("/" in node.value and node.value.rpartition("/")[2] in names))]
+
+
+def test_the_file_name_finder_sees_paths_built_around_a_name():
+    text = 'a = "world.sdf"\nb = f"{d}/world.sdf"\nc = "the world.sdf of a folder"\nd = "world.sdfx"'
+    assert file_names_spelled(text, {"world.sdf"}) == [(1, "world.sdf"), (2, "/world.sdf")]
+
+
+def test_every_file_name_the_package_writes_is_spelled_only_in_files_py():
+    """files.py names the files of a world folder (the formats' included), of a pack and of a report folder; a
+    second spelling anywhere else (a template's name, a temporary file handed to a simulator, a path built
+    with an f-string) is one a rename would miss."""
+    names = files_py_names()
+    assert {"world.json", "world.sdf", "world.mjcf.xml", "world.urdf", "world.usda", "world.usdc",
+            "report.json", "report.csv", "report.md"} <= names
+    found = [f"{path.relative_to(PACKAGE.parent)}:{line} {value!r}" for name, path in sorted(modules().items())
+             if path.name != "files.py" or path.parent != PACKAGE
+             for line, value in file_names_spelled(path.read_text(), names)]
+    assert not found, "file names spelled outside worldgen/files.py:\n" + "\n".join(found)

@@ -17,23 +17,35 @@ from typing import Mapping
 
 from worldgen.errors import OutputError
 
-__all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "MAP_YAML_NAME", "MANIFEST_NAME",
-           "INDEX_NAME", "WORLDS_DIR", "BUILD_STATE_DIR", "creation_mode", "safe_relative", "write_atomically",
-           "write_folder_atomically", "refuse_other_world", "recorded_content_hash"]
+__all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "MAP_YAML_NAME", "SDF_NAME", "MJCF_NAME",
+           "URDF_NAME", "USDA_NAME", "USDC_NAME", "MANIFEST_NAME", "INDEX_NAME", "WORLDS_DIR", "BUILD_STATE_DIR",
+           "REPORT_JSON_NAME", "REPORT_CSV_NAME", "REPORT_MD_NAME", "REPORT_RUNS_DIR", "creation_mode", "safe_relative",
+           "write_atomically", "write_folder_atomically", "refuse_other_world", "recorded_content_hash"]
 
-#: A world folder: its ground truth, scenario, picture and nav2 map (the formats' files are named in
-#: worldgen.export.formats).
+#: A world folder: its ground truth, scenario, picture and nav2 map.
 METADATA_NAME = "world.json"
 SCENARIO_NAME = "scenario.yaml"
 PREVIEW_NAME = "preview.png"
 MAP_IMAGE_NAME = "map.pgm"
 MAP_YAML_NAME = "map.yaml"
+#: A world folder's file of each format (worldgen.export.formats tables them with their writers); a template of
+#: worldgen/templates and the file a simulator is handed carry the same names.
+SDF_NAME = "world.sdf"
+MJCF_NAME = "world.mjcf.xml"
+URDF_NAME = "world.urdf"
+USDA_NAME = "world.usda"
+USDC_NAME = "world.usdc"
 #: A pack folder: the manifest (written last: its presence means the build finished), the index, the worlds.
 MANIFEST_NAME = "manifest.json"
 INDEX_NAME = "index.csv"
 WORLDS_DIR = "worlds"
 #: A pack build's records of finished jobs, kept until the manifest is written (a resume reads them).
 BUILD_STATE_DIR = ".build"
+#: A report folder of ``worldgen judge`` (worldgen.judge.report): the report three ways, a picture per run.
+REPORT_JSON_NAME = "report.json"
+REPORT_CSV_NAME = "report.csv"
+REPORT_MD_NAME = "report.md"
+REPORT_RUNS_DIR = "runs"
 
 
 def creation_mode(full: int) -> int:

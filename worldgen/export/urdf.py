@@ -49,12 +49,13 @@ import numpy as np
 from worldgen.errors import SceneError
 from worldgen.export.bodies import RESERVED_NAME, joints_by_child, mass_properties
 from worldgen.export.xml import XmlText, escape_attr, fill, load_template, sub
+from worldgen.files import URDF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose
 
 __all__ = ["to_urdf", "TEMPLATE", "link_offset", "joint_origin"]
 
-TEMPLATE = "world.urdf"
+TEMPLATE = URDF_NAME  # worldgen/templates names each skeleton after the file it becomes
 
 
 def link_offset(joint: Joint | None) -> np.ndarray:

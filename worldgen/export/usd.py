@@ -40,6 +40,7 @@ import numpy as np
 from worldgen.errors import WorldgenError
 from worldgen.export.usd_motion import TIME_CODES_PER_SECOND, write_movers, write_tasks
 from worldgen.export.usd_prims import SHAPE_PRIM, Specs, matrix_quaternion, quaternion, require_pxr
+from worldgen.files import USDC_NAME
 from worldgen.floats import fmt, round_float
 from worldgen.scene import Mesh, Node, Scene
 from worldgen.scene.graph import Joint, Task
@@ -73,7 +74,7 @@ def to_usdc(scene: Scene, name: str = "default", tasks: Sequence[Task] = (), dur
 
     layer = _layer(scene, name, tasks, duration)
     with tempfile.TemporaryDirectory(prefix="worldgen-usdc-") as folder:
-        path = Path(folder) / "world.usdc"  # usd-core writes a crate file only to a path, by its extension
+        path = Path(folder) / USDC_NAME  # usd-core writes a crate file only to a path, by its extension
         if not layer.Export(str(path)):
             raise WorldgenError(f"usd-core could not write {path.name}")
         return path.read_bytes()

@@ -17,6 +17,7 @@ from typing import Any, Iterable, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import WorldgenError, optional_available, require_optional
+from worldgen.files import USDA_NAME
 from worldgen.floats import DECIMALS, round_float
 from worldgen.scene.shapes import Box, Cylinder, Mesh, Sphere
 
@@ -91,7 +92,7 @@ class Specs:
     def __init__(self, pxr):
         self.Sdf, self.Gf, self.Vt = pxr.Sdf, pxr.Gf, pxr.Vt
         self.T = pxr.Sdf.ValueTypeNames
-        self.layer = pxr.Sdf.Layer.CreateAnonymous("world.usda")
+        self.layer = pxr.Sdf.Layer.CreateAnonymous(USDA_NAME)
         # Box prims that differ only in their extents are copied from one written here (see shape()).
         self._templates = pxr.Sdf.Layer.CreateAnonymous("templates.usda")
         self._template_paths: dict[tuple, Any] = {}

@@ -26,6 +26,7 @@ import numpy as np
 
 from worldgen.errors import OutputError
 from worldgen.export.topdown import COLOURS as TOPDOWN_COLOURS
+from worldgen.files import REPORT_CSV_NAME, REPORT_JSON_NAME, REPORT_MD_NAME, REPORT_RUNS_DIR
 
 __all__ = ["write_report", "RUN_COLUMNS", "draw_run", "COLOURS"]
 
@@ -154,13 +155,13 @@ def draw_run(world: Path, task: Optional[str], trajectory: np.ndarray, row: dict
 def write_report(result, out) -> Path:
     """Write the report folder of a :class:`~worldgen.judge.runs.JudgeResult` at ``out``; returns ``out``."""
     out = Path(out)
-    if out.exists() and not (out.is_dir() and ((out / "report.json").is_file() or not any(out.iterdir()))):
+    if out.exists() and not (out.is_dir() and ((out / REPORT_JSON_NAME).is_file() or not any(out.iterdir()))):
         raise OutputError(f"--out '{out}' exists and is not a report folder; give a new folder or an earlier report's")
     tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
     old = out.with_name(f".{out.name}.old-{os.getpid()}")
     try:
         shutil.rmtree(tmp, ignore_errors=True)
-        (tmp / "runs").mkdir(parents=True)
+        (tmp / REPORT_RUNS_DIR).mkdir(parents=True)
         report = result.report
         worlds: dict = {}
         for k, (row, plot) in enumerate(zip(report["runs"], result.plots)):
@@ -169,12 +170,12 @@ def write_report(result, out) -> Path:
                 continue
             image = draw_run(plot["world"], plot["task"], result.trajectory(k), row, worlds)
             if image is not None:
-                name = f"runs/{_safe(str(row['run']))}.png"
+                name = f"{REPORT_RUNS_DIR}/{_safe(str(row['run']))}.png"
                 image.save(tmp / name, format="PNG")
                 row["picture"] = name
-        (tmp / "report.json").write_text(json.dumps(report, indent=2, sort_keys=True, default=str) + "\n")
-        (tmp / "report.csv").write_text(_csv(report))
-        (tmp / "report.md").write_text(_markdown(report))
+        (tmp / REPORT_JSON_NAME).write_text(json.dumps(report, indent=2, sort_keys=True, default=str) + "\n")
+        (tmp / REPORT_CSV_NAME).write_text(_csv(report))
+        (tmp / REPORT_MD_NAME).write_text(_markdown(report))
         if out.exists():
             out.rename(old)
         tmp.rename(out)

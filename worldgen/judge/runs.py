@@ -133,7 +133,7 @@ def _index(pack) -> dict[str, Path]:
         finally:
             opened.close()
     found = {}
-    for meta in sorted(root.glob("*/world.json")):
+    for meta in sorted(root.glob(f"*/{METADATA_NAME}")):
         try:
             found[str(json.loads(meta.read_text())["world_id"])] = meta.parent
         except (OSError, ValueError, KeyError, TypeError):

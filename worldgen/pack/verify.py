@@ -16,7 +16,7 @@ import tempfile
 from pathlib import Path
 from typing import Iterator
 
-from worldgen.files import INDEX_NAME, WORLDS_DIR
+from worldgen.files import INDEX_NAME, METADATA_NAME, WORLDS_DIR
 from worldgen.pack.manifest import index_bytes
 from worldgen.pack.pack import Pack
 
@@ -44,7 +44,7 @@ def verify_pack(path, regenerate: bool = False) -> Iterator[tuple[bool, str]]:
 
 def _world(pack: Pack, world, validate, regenerate: bool) -> tuple[bool, str]:
     src = pack.source
-    meta_rel = f"{world.folder}/world.json"
+    meta_rel = f"{world.folder}/{METADATA_NAME}"
     if meta_rel not in world.files:
         return False, f"FAIL {world.world_id}: files: world.json is not listed in the manifest"
     for rel, digest in sorted(world.files.items()):

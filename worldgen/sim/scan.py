@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from worldgen.files import METADATA_NAME
+from worldgen.files import METADATA_NAME, SDF_NAME
 from worldgen.sim.gazebo import GazeboError, GazeboServer, locate
 
 __all__ = ["gazebo_scan", "read_scan", "edge_rays", "EDGE_JUMP"]
@@ -50,7 +50,7 @@ def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> tupl
     meta = json.loads((folder / METADATA_NAME).read_text(encoding="utf-8"))
     spawn = meta["tasks"][0]["spawn"]
     with tempfile.TemporaryDirectory(prefix="worldgen-scan-") as tmp:
-        sdf = Path(tmp) / "world.sdf"  # the world folder is left untouched; its meshes are named absolutely
+        sdf = Path(tmp) / SDF_NAME  # the world folder is left untouched; its meshes are named absolutely
         sdf.write_text(_world_with_sensors(folder, meta["files"]["sdf"]["path"]), encoding="utf-8")
         with GazeboServer(sdf, install=locate(), headless_rendering=True) as gz:
             gz.spawn(robot_sdf(meta, gz_release="fortress", lidar_noise=lidar_noise), name="robot",
