@@ -388,3 +388,33 @@ def test_every_file_name_the_package_writes_is_spelled_only_in_files_py():
              if path.name != "files.py" or path.parent != PACKAGE
              for line, value in file_names_spelled(path.read_text(), names)]
     assert not found, "file names spelled outside worldgen/files.py:\n" + "\n".join(found)
+
+
+def renames(text: str) -> list[tuple[int, str]]:
+    """Where ``text`` moves a file or folder into place by hand: ``os.rename``/``os.replace``/``os.renames``,
+    ``shutil.move``, or a path's ``.rename(target)``/``.replace(target)`` (one argument, unlike ``str.replace``)."""
+    out = []
+    for node in ast.walk(ast.parse(text)):
+        if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)):
+            continue
+        owner = node.func.value.id if isinstance(node.func.value, ast.Name) else None
+        call = f"{owner}.{node.func.attr}" if owner else f".{node.func.attr}"
+        if call in {"os.rename", "os.replace", "os.renames", "shutil.move"} or \
+                (node.func.attr in {"rename", "replace"} and len(node.args) == 1 and not node.keywords):
+            out.append((node.lineno, call))
+    return out
+
+
+def test_the_rename_finder_sees_paths_renamed_and_not_strings_replaced():
+    text = ("os.replace(a, b)\ntmp.rename(out)\nshutil.move(a, b)\nPath(x).replace(y)\n"
+            "s.replace('a', 'b')\ndataclasses.replace(r, checks=())\nos.path.join(a, b)")
+    assert renames(text) == [(1, "os.replace"), (2, "tmp.rename"), (3, "shutil.move"), (4, ".replace")]
+
+
+def test_files_and_folders_are_moved_into_place_only_in_files_py():
+    """A write is atomic when it is written aside, flushed, then renamed: files.py does it (write_atomically,
+    write_folder_atomically, atomic_folder, move_into_place), with the fsync and the file modes a rename by
+    hand forgets, and the swap an existing folder needs."""
+    found = [f"{path.relative_to(PACKAGE.parent)}:{line} {call}" for name, path in sorted(modules().items())
+             if path != PACKAGE / "files.py" for line, call in renames(path.read_text())]
+    assert not found, "renames outside worldgen/files.py (use its atomic writers):\n" + "\n".join(found)

@@ -25,6 +25,7 @@ from lxml import etree
 from worldgen.errors import OutputError
 from worldgen.export.robot import DEFAULT_NAME
 from worldgen.export.xml import safe_parser
+from worldgen.files import move_into_place
 from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate, user_cache
 
 __all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "GazeboBackend", "world_step"]
@@ -63,7 +64,7 @@ def build_bridge(env: dict[str, str] | None = None) -> Path:
             built = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
             if built.returncode != 0:
                 raise GazeboError(f"building the Gazebo drive bridge failed: {built.stderr.strip()[:500]}")
-            os.replace(out, exe)  # a rename: a parallel run never starts half a binary
+            move_into_place(out, exe)  # a rename: a parallel run never starts half a binary
     except OSError as exc:
         raise OutputError(f"cannot build the Gazebo drive bridge in '{exe.parent}' ({exc.strerror or exc}); "
                           "set XDG_CACHE_HOME to a writable folder") from None
