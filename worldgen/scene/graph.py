@@ -28,8 +28,6 @@ __all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Phys
 #: Every role a node may have. Markers carry no collision geometry.
 ROLES = ("floor", "wall", "obstacle", "door", "door_frame", "marker")
 
-#: Names become element names in three formats and file names of meshes: keep them plain.
-
 
 @dataclass(frozen=True)
 class Material:
