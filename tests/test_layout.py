@@ -418,3 +418,18 @@ def test_files_and_folders_are_moved_into_place_only_in_files_py():
     found = [f"{path.relative_to(PACKAGE.parent)}:{line} {call}" for name, path in sorted(modules().items())
              if path != PACKAGE / "files.py" for line, call in renames(path.read_text())]
     assert not found, "renames outside worldgen/files.py (use its atomic writers):\n" + "\n".join(found)
+
+
+#: Lines under MAX_LINES a module keeps free: a module standing at the cap is one change from having its text
+#: squeezed to fit (docstrings re-wrapped long, blank lines dropped) instead of being split where its
+#: concerns part.
+HEADROOM = 20
+
+
+def test_modules_keep_headroom_under_the_line_cap():
+    """A module that grows toward the cap is split by concern (server apart from install, a structure's
+    building apart from its queries) while there is still room to do it, not squeezed under it."""
+    found = [f"{path.relative_to(PACKAGE.parent)} has {n} lines" for name, path in sorted(modules().items())
+             if (n := len(path.read_text().splitlines())) > MAX_LINES - HEADROOM]
+    assert not found, f"modules within {HEADROOM} lines of the {MAX_LINES}-line cap (split them by concern):\n" + \
+        "\n".join(found)

@@ -21,7 +21,7 @@ from worldgen.floats import round_float
 from worldgen.scene.mover import Mover
 from worldgen.scene.names import NAME_PATTERN
 from worldgen.scene.pose import Pose
-from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, unit_inertia
+from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, canonical_shape, unit_inertia
 
 __all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN", "Mover"]
 
@@ -338,25 +338,13 @@ class Scene:
         return Scene(self.nodes, self.joints, self.bounds, self.physics, tuple(movers))
 
 
-def _canonical_shape(shape) -> Optional[dict]:
-    if shape is None:
-        return None
-    d = {k: ([round_float(x) for x in v] if isinstance(v, (list, tuple)) else (round_float(v) if isinstance(v, float) else v))
-         for k, v in shape.describe().items()}
-    if isinstance(shape, Mesh):
-        d["geometry_sha256"] = hashlib.sha256(
-            np.round(shape.vertices, 6).astype("<f8").tobytes() + shape.faces.astype("<i8").tobytes()
-        ).hexdigest()
-    return d
-
-
 def _canonical_node(n: Node) -> dict:
     return {
         "name": n.name,
         "role": n.role,
         "parent": n.parent,
         "pose": [round_float(v) for v in n.pose.as_list()],
-        "shape": _canonical_shape(n.shape),
+        "shape": canonical_shape(n.shape),
         "static": n.static,
         "mass": round_float(n.mass),
         "collision": n.collision,
