@@ -173,6 +173,7 @@ class ConfigSpace:
 
     def _grid_clear(self, a, b, ok, skip1, skip2) -> np.ndarray:
         grid = self._grid
+        assert grid is not None, "called only when the space has a grid"
         step = grid.h / 2
         d = b - a
         steps = np.maximum(np.ceil(np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2) / step).astype(np.int64), 1)
@@ -260,8 +261,8 @@ class ConfigSpace:
         sweep = np.asarray(sweep, dtype=float)
         # The box: the arc's extreme points are its ends and the axis directions it sweeps over.
         x0, y0, x1, y1 = self.box
-        for k, (ux, uy) in enumerate(((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))):
-            ang = k * np.pi / 2
+        for quarter, (ux, uy) in enumerate(((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))):
+            ang = quarter * np.pi / 2
             swept = np.mod(ang - start, 2 * np.pi) <= sweep
             px, py = c[:, 0] + rho * ux, c[:, 1] + rho * uy
             margin = np.minimum(np.minimum(px - x0, x1 - px), np.minimum(py - y0, y1 - py))

@@ -106,7 +106,7 @@ class Planner:
         self._heap = [(float(np.hypot(*(goal - start))), 0, 0)]
         self._tie = 1
         self._expanded: dict[tuple[int, int], list[tuple[float, float]]] = {}
-        self._best = (math.inf, None)
+        self._best: tuple[float, Optional[tuple[int, np.ndarray, np.ndarray]]] = (math.inf, None)
         heap = self._heap
         while heap and heap[0][0] < self._best[0] - 1e-12:
             limit = heap[0][0] + max(BATCH, BATCH_SHARE * heap[0][0])
@@ -337,15 +337,17 @@ class Planner:
                 asks.append((i, c, self._angle0[c] + (rel0 if node.side > 0 else node.rel), sweep))
         asks = [a for a in asks if a[0] not in out]
         if asks:
-            i, c, start, sweep = (np.array(v) for v in zip(*asks))
-            free = self.cs.arc_clearance(c.astype(np.int64), start, sweep) >= -1e-9
-            out.update(int(k) for k in i[free])
+            who, circle, start, sweep = (np.array(v) for v in zip(*asks))
+            free = self.cs.arc_clearance(circle.astype(np.int64), start, sweep) >= -1e-9
+            out.update(int(k) for k in who[free])
         return out
 
     # -- the answer --------------------------------------------------------
     def _route(self, start, goal) -> Route:
         nodes = self._nodes
-        g, (i, n_out, q_out) = self._best
+        g, found = self._best
+        assert found is not None, "called once a search has found a path"
+        i, n_out, q_out = found
         points = [goal, q_out]
         contacts = []
         out_normal = n_out

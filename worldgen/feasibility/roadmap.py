@@ -47,8 +47,8 @@ class Roadmap(TangentGraph):
         super().__init__(cs)
         self._ways: dict[int, tuple] = {}
         # A query's tangents: from a point to every circle, each side; twice (the start's, the goal's).
-        self._ends_rows = tuple(np.tile(a, 2) for a in every_side(np.full(cs.n_circles, -1), np.arange(cs.n_circles),
-                                                                  (1,), (1, -1)))
+        src, dst, s1, s2 = every_side(np.full(cs.n_circles, -1), np.arange(cs.n_circles), (1,), (1, -1))
+        self._ends_rows = (np.tile(src, 2), np.tile(dst, 2), np.tile(s1, 2), np.tile(s2, 2))
 
     def _piece_blocked(self, chain: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(the last position at or before angle ``u`` on ``chain``, or the chain's start - 1: before its

@@ -293,5 +293,7 @@ def walk_plan(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping
         still = np.all(xy[1:-1] == xy[:-2], axis=1) & np.all(xy[1:-1] == xy[2:], axis=1)
         keep = np.r_[True, ~still, True]
         rows = np.column_stack([times[keep], xy[keep]])
-        people.append(Mover(f"person_{i}", plan.radius, PERSON_HEIGHT, rows, False, params["friction"], person=True))
+        # Mover takes the (k, 3) array as it is and stores it as rows (its __post_init__), faster than tuples here.
+        people.append(Mover(f"person_{i}", plan.radius, PERSON_HEIGHT, rows, False,  # type: ignore[arg-type]
+                            params["friction"], person=True))
     return tuple(people)

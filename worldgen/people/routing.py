@@ -72,7 +72,7 @@ class Router:
         (``waiting``: those not yet set off, left alone)."""
         reached = ~self.done & ~waiting & (np.hypot(*(self.target - p).T) < ARRIVE)
         for i in np.flatnonzero(reached):
-            self._advance(i, p[i])
+            self._advance(int(i), p[i])
         if step % LOOK:
             return
         live = np.flatnonzero(~self.done & ~waiting)
