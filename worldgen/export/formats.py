@@ -102,8 +102,9 @@ def require_formats(formats: Iterable[str]) -> None:
     once and leaves nothing behind.
     """
     for f in normalise_formats(formats):
-        if TABLE[f].requires:
-            _function(TABLE[f].requires)()
+        requires = TABLE[f].requires
+        if requires:
+            _function(requires)()
 
 
 def render(fmt: str, scene, name: str, params: Mapping[str, Any], sdf_version: str = "1.9", world=None) -> bytes:

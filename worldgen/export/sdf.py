@@ -183,6 +183,7 @@ class _ModelWriter:
                         f"but that node's parent is {node.parent!r}")
                 self._joint(out, joint, names)
             else:
+                assert node.parent is not None, "every node but the root has a parent"
                 self._fixed(out, self._fresh(f"{node.name}_fixed"), node.parent, node.name)
         out.close("model")
 

@@ -213,7 +213,7 @@ def _write_joint(out: XmlText, node: Node, joint: Joint | None, parent_joint: Jo
     else:
         origin = _matrix_attrs(joint_origin(node, joint, parent_joint))
     out.empty("origin", origin)
-    if kind == "revolute":
+    if kind == "revolute" and joint is not None:  # revolute: a joint of that kind
         out.empty("axis", f' xyz="{fmt_seq(joint.axis)}"')
         lo, hi = joint.limits
         # The written pose is the joint's zero: measure the limits from the initial angle.

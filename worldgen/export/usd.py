@@ -185,12 +185,12 @@ class _NodeWriter:
                 raise WorldgenError(f"the USD exporter needs revolute joint {joint.name!r}'s child "
                                     f"{joint.child!r} to be dynamic (a static child cannot turn)")
         for node, prim in bodies:
-            joint = self.joint_of.get(node.name)
-            if joint is not None and joint.kind == "revolute":
-                self._revolute(prim, joint)
-            elif joint is not None or node.parent is not None:
+            held = self.joint_of.get(node.name)
+            if held is not None and held.kind == "revolute":
+                self._revolute(prim, held)
+            elif held is not None or node.parent is not None:
                 # Held to its parent (or to the world) as the SDF holds it; a root with no joint is a free body.
-                self._fixed(prim, node, joint.name if joint is not None else f"{node.name}_fixed")
+                self._fixed(prim, node, held.name if held is not None else f"{node.name}_fixed")
 
     def _node(self, parent, node: Node, rigid: bool):
         specs = self.specs
@@ -251,6 +251,7 @@ class _NodeWriter:
     def _fixed(self, body, node: Node, name: str) -> None:
         joint = self.joint_of.get(node.name)
         parent = joint.parent if joint is not None else node.parent
+        assert parent is not None, "called for a node with a joint or a parent"
         prim = self.specs.prim(body, name, "PhysicsFixedJoint")
         self._ends(prim, parent, node.name)
         child_in_parent = np.linalg.inv(self._parent_matrix(parent)) @ self.scene.world_matrix(node.name)

@@ -19,7 +19,7 @@ import numpy as np
 from worldgen.errors import WorldgenError, optional_available, require_optional
 from worldgen.files import USDA_NAME
 from worldgen.floats import DECIMALS, round_float
-from worldgen.scene.shapes import Box, Cylinder, Mesh, Sphere
+from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, Sphere
 
 __all__ = ["SHAPE_PRIM", "INSTALL_HINT", "require_pxr", "usd_available", "Specs", "quaternion", "matrix_quaternion"]
 
@@ -139,6 +139,7 @@ class Specs:
         same colour, material and body, then given its sizes: the same specs as writing it field by
         field, for about half the cost (boxes and cylinders are most of a world).
         """
+        template: Shape
         if isinstance(shape, Box):
             key, template = ("box", tuple(rgba), material, rigid, name), Box((1.0, 1.0, 1.0))
         elif isinstance(shape, Cylinder):

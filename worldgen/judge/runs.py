@@ -343,7 +343,7 @@ def _assemble(judged: Optional[dict], extra: list[dict]) -> dict:
             row["outcome"] = "success" if row.get("success") else "failure"
         rows.append(row)
     unjudged = sum(r["outcome"] == "unjudged" for r in rows)
-    report = dict(judged) if judged else {"passed": False, "failures": [], "summary": {"runs": 0, "successes": 0},
+    report: dict[str, Any] = dict(judged) if judged else {"passed": False, "failures": [], "summary": {"runs": 0, "successes": 0},
                                           "criteria": []}
     report["runs"] = rows
     report["summary"] = dict(report["summary"]) | {"bags": len(extra), "unjudged": unjudged}

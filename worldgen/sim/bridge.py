@@ -19,6 +19,7 @@ import subprocess
 import tempfile
 from importlib import resources
 from pathlib import Path
+from typing import IO
 
 from lxml import etree
 
@@ -91,7 +92,7 @@ class GazeboBackend:
         self._robot_sdf, self._robot_name = robot_sdf, DEFAULT_NAME  # robot_sdf's model name
         self._server: GazeboServer | None = None
         self._bridge: subprocess.Popen | None = None
-        self._model = None
+        self._model: IO[str] | None = None  # the robot's SDF, a file the bridge reads
 
     def start(self, spawn: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
         """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
@@ -100,11 +101,11 @@ class GazeboBackend:
         self._server = GazeboServer(self.world_sdf, install=install).start()
         # The server's environment carries its own IGN_PARTITION: the bridge must share it.
         env = self._server.env
-        self._model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
-        self._model.write(self._robot_sdf)
-        self._model.flush()
+        self._model = model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
+        model.write(self._robot_sdf)
+        model.flush()
         self._bridge = subprocess.Popen(
-            [str(exe), self._server.world, "/cmd_vel", "/ground_truth/odom", str(round(self.dt * 1e9)), self._model.name,
+            [str(exe), self._server.world, "/cmd_vel", "/ground_truth/odom", str(round(self.dt * 1e9)), model.name,
              self._robot_name, *(repr(float(v)) for v in spawn)],
             env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
         first = self._read()
