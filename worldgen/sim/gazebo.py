@@ -224,8 +224,9 @@ class GazeboServer:
     def log(self) -> tuple[str, str]:
         """The server's (stdout, stderr) so far, colour codes removed."""
         logdir = Path(self._logdir.name)
-        return tuple(_ANSI.sub("", (logdir / s).read_text(errors="replace")) if (logdir / s).exists() else ""
-                     for s in ("stdout", "stderr"))  # type: ignore[return-value]
+        out, err = (_ANSI.sub("", (logdir / s).read_text(errors="replace")) if (logdir / s).exists() else ""
+                    for s in ("stdout", "stderr"))
+        return out, err
 
     def problems(self) -> list[str]:
         """Gazebo's error and warning lines so far (stdout and stderr), without the known harmless ones (those

@@ -73,6 +73,7 @@ class EditedWorld(World):
 
     @cached_property
     def content_hash(self) -> str:
+        # The generated world's own hash, through the cached_property on World (mypy reads it as the value).
         identity = {"world": World.content_hash.func(self),  # type: ignore[attr-defined]
                     "tasks": [_task_dict(t) for t in self.tasks], "edits": list(self.edits)}
         text = json.dumps(identity, sort_keys=True, separators=(",", ":"))
