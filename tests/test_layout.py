@@ -308,8 +308,8 @@ def exception_classes(sources: dict[str, str]) -> dict[str, tuple[str, bool]]:
         by_name.setdefault(key.rpartition(".")[2], []).append(key)
 
     def kind(name: str, seen: frozenset = frozenset()) -> set[str]:
-        """What a base called ``name`` is: {"root"} for WorldgenError's line, {"error"} for an Exception,
-        {"interrupt"} for a BaseException that is no Exception (KeyboardInterrupt: never caught as an error)."""
+        """What a base called ``name`` makes a class: "error" for an Exception, with "root" when WorldgenError is
+        among its ancestors; "interrupt" for a BaseException that is no Exception (KeyboardInterrupt)."""
         if name == "WorldgenError":
             return {"root", "error"}
         if name in builtin:
