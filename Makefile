@@ -46,7 +46,7 @@ demo: $(STAMP)
 	@echo "  $(VENV)/bin/worldgen pack build examples/recipes/ci_smoke.yaml --out packs/ci_smoke --jobs 2   # many worlds, one manifest"
 
 ## test: install with the test extras, lint (ruff: pyflakes, pycodestyle, import order), check the
-## public API's types (mypy), then run the whole suite
+## whole package's types (mypy), then run the whole suite
 test: $(TEST_STAMP)
 	$(VENV)/bin/ruff check worldgen tests benchmarks examples
 	$(VENV)/bin/mypy

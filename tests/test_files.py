@@ -31,3 +31,37 @@ def test_writers_racing_for_one_world_folder_all_succeed_and_leave_it_whole(tmp_
     assert errors == []
     assert sorted(p.name for p in tmp_path.iterdir()) == ["w"]  # no temporary folder left behind
     assert (tmp_path / "w" / "sub" / "a.txt").read_bytes() == b"a" * 1000
+
+
+def test_an_atomic_folder_replaces_the_old_one_whole_or_leaves_it(tmp_path):
+    import pytest
+
+    from worldgen.errors import OutputError
+    from worldgen.files import atomic_folder
+
+    with atomic_folder(tmp_path, "report", "report folder") as tmp:
+        assert tmp.parent == tmp_path and tmp.name != "report"
+        (tmp / "a.txt").write_text("first")
+    with pytest.raises(ZeroDivisionError), atomic_folder(tmp_path, "report") as tmp:
+        (tmp / "a.txt").write_text("second")
+        1 / 0
+    assert (tmp_path / "report" / "a.txt").read_text() == "first"
+    with pytest.raises(OutputError, match="^cannot write report folder '.*report': "), \
+            atomic_folder(tmp_path, "report", "report folder") as tmp:
+        (tmp / "missing" / "a.txt").write_text("third")  # an OSError in the block
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+    with atomic_folder(tmp_path, "report") as tmp:
+        (tmp / "b.txt").write_text("fourth")
+    assert sorted(p.name for p in (tmp_path / "report").iterdir()) == ["b.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+
+
+def test_a_file_another_program_made_is_moved_into_place(tmp_path):
+    from worldgen.files import move_into_place
+
+    made = tmp_path / "made"
+    made.write_bytes(b"\x7fELF")
+    made.chmod(0o755)
+    move_into_place(made, tmp_path / "exe")
+    assert not made.exists() and (tmp_path / "exe").read_bytes() == b"\x7fELF"
+    assert (tmp_path / "exe").stat().st_mode & 0o111

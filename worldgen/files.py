@@ -1,8 +1,9 @@
 """The files worldgen writes: their names, and writing them so that no reader ever sees half of one.
 
 Every stage names a file through the constants here (``"world.json"`` is written once, in this
-module), and every file or folder a command leaves behind goes through :func:`write_atomically` or
-:func:`write_folder_atomically`: written beside its target, flushed, then renamed into place.
+module), and every file or folder a command leaves behind goes through :func:`write_atomically`,
+:func:`write_folder_atomically` or :func:`atomic_folder` (a file another program made, through
+:func:`move_into_place`): written beside its target, flushed, then renamed into place.
 """
 
 from __future__ import annotations
@@ -12,28 +13,42 @@ import json
 import os
 import shutil
 import tempfile
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Mapping
+from typing import Iterator, Mapping
 
 from worldgen.errors import OutputError
 
-__all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "MAP_YAML_NAME", "MANIFEST_NAME",
-           "INDEX_NAME", "WORLDS_DIR", "BUILD_STATE_DIR", "creation_mode", "safe_relative", "write_atomically",
-           "write_folder_atomically", "refuse_other_world", "recorded_content_hash"]
+__all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "MAP_YAML_NAME", "SDF_NAME", "MJCF_NAME",
+           "URDF_NAME", "USDA_NAME", "USDC_NAME", "MANIFEST_NAME", "INDEX_NAME", "WORLDS_DIR", "BUILD_STATE_DIR",
+           "REPORT_JSON_NAME", "REPORT_CSV_NAME", "REPORT_MD_NAME", "REPORT_RUNS_DIR", "creation_mode", "safe_relative",
+           "write_atomically", "atomic_folder", "write_folder_atomically", "move_into_place", "refuse_other_world",
+           "recorded_content_hash"]
 
-#: A world folder: its ground truth, scenario, picture and nav2 map (the formats' files are named in
-#: worldgen.export.formats).
+#: A world folder: its ground truth, scenario, picture and nav2 map.
 METADATA_NAME = "world.json"
 SCENARIO_NAME = "scenario.yaml"
 PREVIEW_NAME = "preview.png"
 MAP_IMAGE_NAME = "map.pgm"
 MAP_YAML_NAME = "map.yaml"
+#: A world folder's file of each format (worldgen.export.formats tables them with their writers); a template of
+#: worldgen/templates and the file a simulator is handed carry the same names.
+SDF_NAME = "world.sdf"
+MJCF_NAME = "world.mjcf.xml"
+URDF_NAME = "world.urdf"
+USDA_NAME = "world.usda"
+USDC_NAME = "world.usdc"
 #: A pack folder: the manifest (written last: its presence means the build finished), the index, the worlds.
 MANIFEST_NAME = "manifest.json"
 INDEX_NAME = "index.csv"
 WORLDS_DIR = "worlds"
 #: A pack build's records of finished jobs, kept until the manifest is written (a resume reads them).
 BUILD_STATE_DIR = ".build"
+#: A report folder of ``worldgen judge`` (worldgen.judge.report): the report three ways, a picture per run.
+REPORT_JSON_NAME = "report.json"
+REPORT_CSV_NAME = "report.csv"
+REPORT_MD_NAME = "report.md"
+REPORT_RUNS_DIR = "runs"
 
 
 def creation_mode(full: int) -> int:
@@ -93,8 +108,15 @@ def refuse_other_world(target: Path, content_hash: str) -> None:
                           f"(--overwrite on the command line) to replace it")
 
 
-def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]) -> Path:
-    """Write ``blobs`` (relative path -> bytes) as ``out_dir/name``; complete or absent."""
+@contextmanager
+def atomic_folder(out_dir: Path, name: str, what: str = "world folder") -> Iterator[Path]:
+    """A temporary folder beside ``out_dir/name`` for the block to fill, which becomes ``out_dir/name`` whole
+    when the block ends (replacing a folder there) or is removed when it raises.
+
+    Every file in it is flushed to disk before the rename, so a crash leaves the old folder or the new one.
+    An OSError in the block or in the rename is an OutputError naming ``what`` (``"report folder"``).
+    """
+    out_dir = Path(out_dir)
     if "/" in name or name in ("", ".", ".."):
         raise OutputError(f"refusing folder name {name!r}")
     try:
@@ -108,38 +130,68 @@ def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]
         raise OutputError(f"cannot write to output folder '{out_dir}': {exc.strerror or exc}") from None
     target = out_dir / name
     try:
-        for rel, data in sorted(blobs.items()):
-            path = tmp / safe_relative(rel)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            with open(path, "wb") as fh:
-                fh.write(data)
-                fh.flush()
-                os.fsync(fh.fileno())
+        yield tmp
+        _sync_tree(tmp)
         os.chmod(tmp, creation_mode(0o777))
-        try:
-            os.rename(tmp, target)
-        except OSError as exc:
-            if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY):
-                raise
-            # The folder is there (a rebuild, or another worker of a pack writing the same world this very
-            # moment): swap it out, then in; a folder another worker renames in between is swapped out too.
-            old = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".old", dir=out_dir))
-            for k in range(8):
-                try:
-                    os.rename(target, old / f"w{k}")
-                except FileNotFoundError:
-                    pass
-                try:
-                    os.rename(tmp, target)
-                    break
-                except OSError as again:
-                    if again.errno not in (errno.EEXIST, errno.ENOTEMPTY) or k == 7:
-                        raise
-            shutil.rmtree(old, ignore_errors=True)
+        _rename_folder(tmp, target)
     except OSError as exc:
         shutil.rmtree(tmp, ignore_errors=True)
-        raise OutputError(f"cannot write world folder '{target}': {exc.strerror or exc}") from None
+        raise OutputError(f"cannot write {what} '{target}': {exc.strerror or exc}") from None
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    return target
+
+
+def write_folder_atomically(out_dir: Path, name: str, blobs: Mapping[str, bytes]) -> Path:
+    """Write ``blobs`` (relative path -> bytes) as ``out_dir/name``; complete or absent."""
+    with atomic_folder(out_dir, name) as tmp:
+        for rel, data in sorted(blobs.items()):
+            path = tmp / safe_relative(rel)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_bytes(data)
+    return Path(out_dir) / name
+
+
+def move_into_place(made: Path, target: Path) -> None:
+    """Move the file or folder ``made`` (another program's output, e.g. a compiler's or a finished bag folder, on
+    the same file system) to ``target`` whole: flushed, then renamed, so no reader ever runs or opens half of it."""
+    _sync_file(Path(made))
+    os.replace(made, target)
+
+
+def _sync_file(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)  # fsync acts on the file, whatever the descriptor was opened for (POSIX)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _sync_tree(folder: Path) -> None:
+    for path in sorted(folder.rglob("*")):
+        if path.is_file() and not path.is_symlink():
+            _sync_file(path)
+
+
+def _rename_folder(tmp: Path, target: Path) -> None:
+    try:
+        os.rename(tmp, target)
+        return
+    except OSError as exc:
+        if exc.errno not in (errno.EEXIST, errno.ENOTEMPTY):
+            raise
+    # The folder is there (a rebuild, or another worker of a pack writing the same world this very
+    # moment): swap it out, then in; a folder another worker renames in between is swapped out too.
+    old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
+    for k in range(8):
+        try:
+            os.rename(target, old / f"w{k}")
+        except FileNotFoundError:
+            pass
+        try:
+            os.rename(tmp, target)
+            break
+        except OSError as again:
+            if again.errno not in (errno.EEXIST, errno.ENOTEMPTY) or k == 7:
+                raise
+    shutil.rmtree(old, ignore_errors=True)

@@ -10,7 +10,6 @@ import worldgen
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.planner import Planner
-from worldgen.people import crowd
 from worldgen.people.places import SLACK, people_footprints
 from worldgen.people.reach import Pockets
 
@@ -44,10 +43,10 @@ def test_a_walk_with_the_proof_is_the_walk_without_it(monkeypatch):
     kw = {"n_obstacles": 65, "n_people": 10}
     proven = []
     apart = Pockets.apart
-    monkeypatch.setattr(crowd.Pockets, "apart", lambda self, a, b: proven.append(apart(self, a, b)) or proven[-1])
+    monkeypatch.setattr(Pockets, "apart", lambda self, a, b: proven.append(apart(self, a, b)) or proven[-1])
     fast = worldgen.generate("cluttered", seed=5, **kw)
     assert sum(proven) >= 100, sum(proven)  # most queries of this walk were places in another pocket
-    monkeypatch.setattr(crowd.Pockets, "apart", lambda self, a, b: False)
+    monkeypatch.setattr(Pockets, "apart", lambda self, a, b: False)
     slow = worldgen.generate("cluttered", seed=5, **kw)
     assert fast.content_hash == slow.content_hash and any(m.person for m in fast.scene.movers)
     assert [np.asarray(m.trajectory).tolist() for m in fast.scene.movers] == \

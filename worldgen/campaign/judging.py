@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import csv
 import io
-import os
 import shutil
 import tempfile
 import time
@@ -74,20 +73,16 @@ def as_walked(world: Path, meta: dict, walked: dict, into: Path) -> Path:
     (:meth:`worldgen.envs.episode.Episode.figures`). Replaces an earlier one at ``into`` whole."""
     import json
 
-    from worldgen.files import METADATA_NAME, write_atomically
+    from worldgen.files import METADATA_NAME, atomic_folder
 
     people = [dict(p, trajectory=walked[str(p["name"])].tolist(), recorded_trajectory=p["trajectory"])
               if str(p["name"]) in walked and len(walked[str(p["name"])]) >= 2 else p for p in meta.get("people") or []]
     into = Path(into)
-    into.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{into.name}.", dir=into.parent))
-    for entry in sorted(Path(world).iterdir()):
-        if entry.name != METADATA_NAME:
-            (tmp / entry.name).symlink_to(entry.resolve())
-    write_atomically(tmp / METADATA_NAME, (json.dumps(dict(meta, people=people), sort_keys=True) + "\n").encode())
-    if into.exists():
-        shutil.rmtree(into)
-    os.replace(tmp, into)
+    with atomic_folder(into.parent, into.name, "run's world folder") as tmp:
+        for entry in sorted(Path(world).iterdir()):
+            if entry.name != METADATA_NAME:
+                (tmp / entry.name).symlink_to(entry.resolve())
+        (tmp / METADATA_NAME).write_bytes((json.dumps(dict(meta, people=people), sort_keys=True) + "\n").encode())
     return into
 
 

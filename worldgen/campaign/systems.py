@@ -36,7 +36,6 @@ from __future__ import annotations
 import importlib
 import inspect
 import math
-import os
 import shutil
 import tempfile
 import time
@@ -221,6 +220,7 @@ class DriveSystem:
     kind: str = "drive"
 
     def run(self, world: Path, task: str, run: str, workdir: Path) -> Outcome:
+        from worldgen.files import move_into_place
         from worldgen.sim.drive import drive
 
         started = time.perf_counter()
@@ -231,7 +231,7 @@ class DriveSystem:
                 done = drive(world, scratch, sim=self.sim, task=task)
             except SimulatorError as exc:  # the simulator broke down: nothing to judge
                 return unjudged(f"{self.sim} failed: {exc}", started)
-            os.replace(done.bag, bag)  # the campaign's name for it, judged as the campaign's run
+            move_into_place(done.bag, bag)  # the campaign's name for it, judged as the campaign's run
         finally:
             shutil.rmtree(scratch, ignore_errors=True)
         return judged(bag, Path(world), task, run, self.criteria, started)

@@ -15,6 +15,7 @@ import click
 
 from worldgen.cli.context import CONTEXT as _CONTEXT
 from worldgen.errors import ParameterError, read_user_text
+from worldgen.files import REPORT_JSON_NAME
 
 __all__ = ["compare_command", "read_runs", "format_comparison"]
 
@@ -25,7 +26,7 @@ def read_runs(path) -> list[dict]:
     path = Path(path)
     if not path.exists():
         raise ParameterError(f"report folder '{path}' does not exist")
-    file = path / "report.json" if path.is_dir() else path
+    file = path / REPORT_JSON_NAME if path.is_dir() else path
     if path.is_dir() and not file.is_file():
         raise ParameterError(f"'{path}' has no report.json; give a report folder written by 'worldgen judge'")
     text = read_user_text(file, "report")

@@ -114,8 +114,8 @@ def judge_command(bags: Sequence[Path], world: Optional[Path], pack: Optional[Pa
     else:
         result = judge(bags, criteria, world=world, pack=pack, runs=runs_table, start=start, read_options=options)
     folder = write_report(result, out)
-    for line in bag_lines(result.report["runs"]):
-        click.echo(line, err=True)
+    for text in bag_lines(result.report["runs"]):
+        click.echo(text, err=True)
     s = result.report["summary"]
     click.echo(f"{s['bags']} bags, {s.get('runs', 0)} judged, {s.get('successes', 0)} succeeded, "
                f"{s['unjudged']} unjudged: {'PASS' if result.passed else 'FAIL'}")

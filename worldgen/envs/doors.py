@@ -27,7 +27,7 @@ The trigger is tested at the start of every env step.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import Any, Sequence
 
 import numpy as np
 from lxml import etree
@@ -80,7 +80,7 @@ class Openers:
     def __init__(self, model, data, doors: Sequence[dict], mode: str, trigger: float, speed: float):
         self.mode, self.trigger, self.speed = mode, float(trigger), float(speed)
         self._data, self._model = data, model
-        self._doors = []
+        self._doors: list[dict[str, Any]] = []
         for d in _openable(doors, mode):
             joint = model.joint(d["joint"])
             lo, hi = d["limits"]

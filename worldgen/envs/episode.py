@@ -34,6 +34,7 @@ from typing import Optional
 
 import numpy as np
 
+from worldgen.envs.reacting import Walkers
 from worldgen.judge.figures import DOOR_DEBOUNCE, Contact
 
 __all__ = ["Episode", "spl"]
@@ -67,7 +68,7 @@ class Episode:
         self.touching: frozenset = frozenset()
         self.done = False
         #: The world's movers and people (:class:`~worldgen.envs.reacting.Walkers`), set by the environment.
-        self.walkers = None
+        self.walkers: Optional[Walkers] = None
 
     def record(self, t: float, x: float, y: float, yaw: float) -> None:
         self.rows.append((t, x, y, yaw))
@@ -118,7 +119,8 @@ class Episode:
             door_contacts=tuple(self.door_contacts))
         limit: Optional[float] = task.get("time_limit")
         # evaluate's rule (worldgen.judge.evaluate): the goal, within the scenario's max_time, and no collision.
-        ok = bool(run.reached_goal and not run.collisions and (limit is None or run.time_to_goal <= limit))
+        ok = bool(run.reached_goal and not run.collisions
+                  and (limit is None or (run.time_to_goal is not None and run.time_to_goal <= limit)))
         out = run.as_dict()
         out.update(success=ok, spl=spl(ok, ref, length), reference_path_length=ref,
                    doors_opened=[{"time": c.time, "entity": c.entity} for c in self.door_openings])

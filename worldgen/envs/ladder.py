@@ -24,6 +24,7 @@ def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int]
 
     import worldgen
     import worldgen.envs  # noqa: F401  (registers the environment)
+    from worldgen.envs.navigation import NavigationEnv
     from worldgen.envs.probes import run_episode
     from worldgen.envs.source import OneWorldSource
     from worldgen.errors import InfeasibleError
@@ -31,6 +32,7 @@ def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int]
     # The probes read neither the reward nor the geodesic field; the straight-line reward keeps the reset from
     # building the field (about 20-40 ms of each episode's 0.1-0.3 s), and success is the same whatever the reward.
     env = gymnasium.make("worldgen/Navigation-v0", generator="minimal", reward="euclidean_progress").unwrapped
+    assert isinstance(env, NavigationEnv)
     out: dict[int, list[bool]] = {}
     try:
         for level in levels:

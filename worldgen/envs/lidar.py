@@ -96,6 +96,7 @@ class Lidar:
         """What the policy sees of noise-free ``ranges``: noise added (drawn from ``rng``), clipped, binned."""
         out = ranges
         if self.noise > 0.0:
+            assert rng is not None, "a noisy lidar draws its noise from a generator"
             draws = rng.normal(0.0, self.noise, self.beams)
             out = np.where(ranges < self.range_max, ranges + draws, ranges)
             np.clip(out, self.range_min, self.range_max, out=out)

@@ -67,7 +67,7 @@ from __future__ import annotations
 
 import math
 import time
-from typing import Any, Optional
+from typing import TYPE_CHECKING, Any, Optional
 
 import numpy as np
 
@@ -78,15 +78,19 @@ from worldgen.envs.doors import Openers, add_openers
 from worldgen.envs.episode import Episode
 from worldgen.envs.geodesic import GeodesicField
 from worldgen.envs.lidar import Lidar
+from worldgen.envs.period import run_period
 from worldgen.envs.reacting import walkers_of
 from worldgen.envs.reward import StepOutcome, reward
-from worldgen.envs.robot import add_robot, compile_world
-from worldgen.envs.source import PackSource, make_source
+from worldgen.envs.robot import RobotModel, add_robot, compile_world
+from worldgen.envs.source import EpisodeWorld, PackSource, make_source
 from worldgen.errors import CallOrderError, ParameterError
 from worldgen.judge.figures import Contact
 from worldgen.seeding import check_seed, draw_seed, env_rngs
 
-gym = require_gymnasium()
+if TYPE_CHECKING:  # the checker reads Gymnasium's types; at run time a missing extra is one clear line
+    import gymnasium as gym
+else:
+    gym = require_gymnasium()
 
 __all__ = ["NavigationEnv"]
 
@@ -94,7 +98,7 @@ __all__ = ["NavigationEnv"]
 class NavigationEnv(gym.Env):
     """Point-goal navigation in worldgen worlds (see the module's docstring for every space and rule)."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}
 
     def __init__(self, generator: Optional[str] = None, params: Optional[dict] = None, preset: Optional[str] = None,
                  pack=None, render_mode: Optional[str] = None, difficulty: Optional[str] = None, curriculum: Any = None,
@@ -131,8 +135,8 @@ class NavigationEnv(gym.Env):
         self._world_rng: Optional[np.random.Generator] = None
         self._noise_rng: Optional[np.random.Generator] = None
         self._next_index = 0
-        self._sim = None
-        self.world = None
+        self._sim: Optional[RobotModel] = None
+        self.world: Optional[EpisodeWorld] = None
         self.episode: Optional[Episode] = None
         self._painter = None
         self.reset_timings: dict = {}
@@ -157,6 +161,7 @@ class NavigationEnv(gym.Env):
             if seed is None:
                 return self.curriculum.next_world(self.source, self._world_rng)
             self.curriculum.leave()  # a world the caller chose: not the curriculum's episode
+        assert self._world_rng is not None, "reset() seeds the world stream first"
         seed = draw_seed(self._world_rng) if seed is None else check_seed(seed, "option 'world_seed'")
         return self.source.world(seed), {"world_seed": seed}
 
@@ -191,7 +196,7 @@ class NavigationEnv(gym.Env):
         t3 = time.perf_counter()
         self._movers = movers
         if len(movers):
-            movers.place(sim.data, sim.mocap, movers.positions([0.0])[0])
+            movers.place(sim.data, sim.mocap, movers.positions(np.zeros(1))[0])
         import mujoco
         mujoco.mj_forward(sim.model, sim.data)
         self._openers = Openers(sim.model, sim.data, world.doors, cfg.doors, cfg.door_trigger, cfg.door_speed)
@@ -256,6 +261,12 @@ class NavigationEnv(gym.Env):
         return self._sim.pose()
 
     # -- stepping -------------------------------------------------------------------------------------------
+    def _running(self) -> tuple[RobotModel, Episode, EpisodeWorld]:
+        """The episode's compiled world, its record and its world; CallOrderError before the first reset."""
+        if self._sim is None or self.episode is None or self.world is None:
+            raise CallOrderError("call reset() first: there is no episode yet")
+        return self._sim, self.episode, self.world
+
     def step(self, action):
         if self.episode is None or self.episode.done:
             raise CallOrderError("call reset() first: the episode has not started or has ended")
@@ -263,7 +274,7 @@ class NavigationEnv(gym.Env):
         if a.shape != (2,) or not np.all(np.isfinite(a)):
             raise ParameterError(f"parameter 'action' must be two finite numbers (v m/s, w rad/s), got {action!r}")
         v, w = np.clip(a, self._act_lo, self._act_hi)
-        sim, ep = self._sim, self.episode
+        sim, ep, _ = self._running()
         data = sim.data
         data.ctrl[sim.ctrl] = (v, 0.0, w)
         previous = self._goal_polar(*sim.pose())[0]
@@ -295,42 +306,8 @@ class NavigationEnv(gym.Env):
 
     def _simulate(self) -> bool:
         """One control period of physics steps (movers driven before each); True when a contact began."""
-        import mujoco
-
-        sim, ep = self._sim, self.episode
-        model, data = sim.model, sim.data
-        n = self._substeps
-        movers = self._movers
-        xy = None
-        if len(movers):  # reacting people see the robot where it is, moving as it did over the last period
-            rows = ep.rows
-            (t0, x0, y0, _), (t1, x1, y1, _) = rows[max(len(rows) - 2, 0)], rows[-1]
-            v = ((x1 - x0) / (t1 - t0), (y1 - y0) / (t1 - t0)) if t1 > t0 else (0.0, 0.0)
-            xy = movers.period(data.time, model.opt.timestep, n, (x1, y1), v, self.world.robot.radius)
-        began = False
-        for k in range(n):
-            if xy is not None:
-                movers.place(data, sim.mocap, xy[k])
-            mujoco.mj_step(model, data)
-            if data.ncon or ep.touching:
-                if ep.touch(data.time, self._touching()):
-                    began = True
-                    if self.config.terminate_on_collision:
-                        break
-        return began
-
-    def _touching(self) -> frozenset:
-        """Names of the entities the robot's geom is in contact with now (the floor left out)."""
-        import mujoco
-
-        sim, data = self._sim, self._sim.data
-        if not data.ncon:
-            return frozenset()
-        pairs = data.contact.geom[: data.ncon]
-        mine = (pairs[:, 0] == sim.geom) | (pairs[:, 1] == sim.geom)
-        others = np.where(pairs[mine, 0] == sim.geom, pairs[mine, 1], pairs[mine, 0])
-        return frozenset(mujoco.mj_id2name(sim.model, mujoco.mjtObj.mjOBJ_GEOM, int(g)) or f"geom_{int(g)}"
-                         for g in others if int(g) not in sim.floor)
+        sim, ep, world = self._running()
+        return run_period(sim, ep, self._movers, self._substeps, world.robot.radius, self.config.terminate_on_collision)
 
     def _goal_polar(self, x: float, y: float, yaw: float) -> tuple[float, float]:
         dx, dy = self._goal[0] - x, self._goal[1] - y
@@ -338,7 +315,7 @@ class NavigationEnv(gym.Env):
         return math.hypot(dx, dy), angle
 
     def _observe(self) -> np.ndarray:
-        sim = self._sim
+        sim = self._running()[0]
         x, y, yaw = sim.pose()
         self._ranges = self.lidar.cast(sim.model, sim.data, x, y, yaw, self._lidar_height, sim.body)
         scan = self.lidar.observe(self._ranges, self._noise_rng)

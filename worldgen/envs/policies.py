@@ -179,6 +179,7 @@ def drive_timed(env, **reset) -> dict:
     follower = TimedFollower.for_env(env)
     u = env.unwrapped
     while True:
-        _, _, terminated, truncated, info = env.step(follower.action(*u.robot_pose, u.episode.rows[-1][0]))
+        x, y, yaw = u.robot_pose
+        _, _, terminated, truncated, info = env.step(follower.action(x, y, yaw, u.episode.rows[-1][0]))
         if terminated or truncated:
             return info

@@ -47,7 +47,8 @@ class Walkers:
                 [Tube(float(m["tube"]["d"]), float(m["tube"]["tau"])) if m.get("tube") else Tube(0.0, 0.0)
                  for m in who], wall_gap if len(self.reacting) else None)
         self.rows: list[list[tuple[float, float, float]]] = []
-        self._rows, self._rows_of = None, None
+        self._rows: slice | np.ndarray | None = None  # where place() writes: a slice when the indices run on
+        self._rows_of: Optional[np.ndarray] = None
         self.reset()
 
     def __len__(self) -> int:
@@ -62,7 +63,7 @@ class Walkers:
     def positions(self, times: np.ndarray) -> np.ndarray:
         """(len(times), movers, 2) where the scripts have everyone (reacting people: where they are now)."""
         xy = self.script.positions(times)
-        if len(self.reacting):
+        if self.reactions is not None and len(self.reacting):
             xy[:, self.people[self.reacting]] = self.reactions.p[self.reacting]
         return xy
 

@@ -53,13 +53,13 @@ class TopDown:
         """
         image = self.background.copy()
         overlay = Image.new("RGBA", image.size, (0, 0, 0, 0))
-        pen = ImageDraw.Draw(overlay)
+        beams = ImageDraw.Draw(overlay)
         x, y, yaw = pose
         step = max(1, int(math.ceil(len(ranges) / MAX_BEAMS_DRAWN)))
         origin = self._px(x, y)
         for a, r in zip(beam_angles[::step], ranges[::step]):
             end = self._px(x + r * math.cos(yaw + a), y + r * math.sin(yaw + a))
-            pen.line([origin, end], fill=BEAM_COLOUR + (70,), width=1)
+            beams.line([origin, end], fill=BEAM_COLOUR + (70,), width=1)
         image.paste(overlay, (0, 0), overlay)
         pen = Pen(image, self.layout)
         if len(track) > 1:

@@ -30,6 +30,7 @@ changed between MuJoCo 3 releases.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from lxml import etree
@@ -59,8 +60,8 @@ class RobotModel:
     are ignored; ``mocap``: the mocap index of each mover, in world.json order.
     """
 
-    model: object
-    data: object
+    model: Any  # mujoco.MjModel and MjData: mujoco ships no type information
+    data: Any
     body: int
     geom: int
     qpos: np.ndarray

@@ -171,7 +171,9 @@ class GeneratorSource:
         size = self.resolved.get("size")
         if size is not None:
             return math.hypot(*size), True
-        (x0, y0), (x1, y1) = self.world(0).bounds
+        bounds = self.world(0).bounds
+        assert bounds is not None, "a generated world's episode has its bounds"
+        (x0, y0), (x1, y1) = bounds
         return math.hypot(x1 - x0, y1 - y0), False
 
     def world(self, seed: int) -> EpisodeWorld:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any, Iterable, Mapping, Optional
 
 from worldgen.errors import ParameterError
+from worldgen.files import MJCF_NAME, SDF_NAME, URDF_NAME, USDA_NAME, USDC_NAME
 
 __all__ = ["Format", "TABLE", "FORMATS", "ALL_FORMATS", "FILE_NAMES", "SDF_VERSIONS", "normalise_formats", "render",
            "movers_note", "uses_meshes", "require_formats", "unavailable_formats"]
@@ -59,14 +60,14 @@ class Format:
 #: usd-core (the ``usd`` extra) and is written only when asked for. SDF movers are <actor>s, which Drake rejects: the
 #: ``sdf_actors`` parameter leaves them out for Drake users (docs/formats.md).
 TABLE: dict[str, Format] = {f.name: f for f in (
-    Format("sdf", "world.sdf", "worldgen.export.sdf:to_sdf", "actor", "sdf_actors", SDF_VERSIONS, meshes=True),
-    Format("mjcf", "world.mjcf.xml", "worldgen.export.mjcf:to_mjcf", "mocap_body"),
-    Format("urdf", "world.urdf", "worldgen.export.urdf:to_urdf", None, meshes=True),
-    Format("usd", "world.usda", "worldgen.export.usd:to_usd", "kinematic_body", optional=True,
+    Format("sdf", SDF_NAME, "worldgen.export.sdf:to_sdf", "actor", "sdf_actors", SDF_VERSIONS, meshes=True),
+    Format("mjcf", MJCF_NAME, "worldgen.export.mjcf:to_mjcf", "mocap_body"),
+    Format("urdf", URDF_NAME, "worldgen.export.urdf:to_urdf", None, meshes=True),
+    Format("usd", USDA_NAME, "worldgen.export.usd:to_usd", "kinematic_body", optional=True,
            requires="worldgen.export.usd_prims:require_pxr",
            world_args="worldgen.export.usd_motion:writer_args"),
     # The same stage in USD's binary crate form: smaller (5.0 against 12.7 kB for door seed 0 with a mover), not diffable.
-    Format("usdc", "world.usdc", "worldgen.export.usd:to_usdc", "kinematic_body", optional=True,
+    Format("usdc", USDC_NAME, "worldgen.export.usd:to_usdc", "kinematic_body", optional=True,
            requires="worldgen.export.usd_prims:require_pxr",
            world_args="worldgen.export.usd_motion:writer_args", binary=True),
 )}
@@ -101,8 +102,9 @@ def require_formats(formats: Iterable[str]) -> None:
     once and leaves nothing behind.
     """
     for f in normalise_formats(formats):
-        if TABLE[f].requires:
-            _function(TABLE[f].requires)()
+        requires = TABLE[f].requires
+        if requires:
+            _function(requires)()
 
 
 def render(fmt: str, scene, name: str, params: Mapping[str, Any], sdf_version: str = "1.9", world=None) -> bytes:

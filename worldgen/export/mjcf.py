@@ -39,13 +39,14 @@ from typing import Optional
 from worldgen.errors import SceneError
 from worldgen.export.bodies import joints_by_child, mass_properties
 from worldgen.export.xml import XmlText, fill, load_template, sub
+from worldgen.files import MJCF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere
 from worldgen.scene.mover import MOVER_RGBA
 
 __all__ = ["to_mjcf", "TEMPLATE"]
 
-TEMPLATE = "world.mjcf.xml"
+TEMPLATE = MJCF_NAME  # worldgen/templates names each skeleton after the file it becomes
 #: MuJoCo's defaults for the torsional and rolling friction coefficients.
 TORSIONAL_FRICTION = 0.005
 ROLLING_FRICTION = 0.0001

@@ -91,7 +91,7 @@ def blocking(entity, robot: Mapping[str, float]) -> bool:
     return z1 > 0.0 and z0 < robot["height"] + robot["clearance"]
 
 
-def _inflated(kind: str, geo, grow: float):
+def _inflated(kind: str, geo, grow: float) -> tuple[str, Any]:
     if kind == "circle":
         return "circle", (geo[0], geo[1], geo[2] + grow)
     ring = shapely.Polygon(geo).buffer(grow, quad_segs=8)

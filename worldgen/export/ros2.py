@@ -184,7 +184,7 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
     another) and ``robot.urdf`` (robot_state_publisher's), named ``robot_name``.
     """
     from worldgen.export.robot import robot_sdf, robot_urdf
-    from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
+    from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME, SDF_NAME
     from worldgen.groundtruth.truth import doors_start_shut, start_occupancy_map
 
     row = release(gz_release or DEFAULT_GZ_RELEASE)
@@ -202,10 +202,10 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
         files[f"{BUNDLE_DIR}/{MAP_YAML_NAME}"] = grid.yaml(MAP_IMAGE_NAME)
     files[f"{BUNDLE_DIR}/{ROBOT_SDF}"] = robot_sdf(world, name=robot, gz_release=row.name).encode()
     files[f"{BUNDLE_DIR}/{ROBOT_URDF}"] = robot_urdf(world, name=robot).encode()
-    sdf_file = "world.sdf"
+    sdf_file = SDF_NAME
     if gz_release is not None:
-        files[f"{BUNDLE_DIR}/world.sdf"] = with_plugins(world.export("sdf", sdf_version), gz_release, "../")
-        sdf_file = f"{BUNDLE_DIR}/world.sdf"
+        files[f"{BUNDLE_DIR}/{SDF_NAME}"] = with_plugins(world.export("sdf", sdf_version), gz_release, "../")
+        sdf_file = f"{BUNDLE_DIR}/{SDF_NAME}"
     values = {"WORLD_ID": world.world_id, "WORLD_NAME": world.world_id, "ROS_NAME": name,
               "FOLDER": folder_name or world.folder_name, "SDF": sdf_file, "ROBOT": robot, "MAP": nav2_map(world),
               "ROBOT_SDF": ROBOT_SDF, "ROBOT_URDF": ROBOT_URDF,

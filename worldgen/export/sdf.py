@@ -75,6 +75,7 @@ from worldgen.errors import ParameterError, WorldgenError
 from worldgen.export.actor_path import TENSION, actor_waypoints
 from worldgen.export.formats import SDF_VERSIONS
 from worldgen.export.xml import XmlText, escape_text, fill, load_template
+from worldgen.files import SDF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose
 from worldgen.scene.graph import Joint
@@ -82,7 +83,7 @@ from worldgen.scene.mover import MOVER_RGBA, Mover
 
 __all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "HOLD_SECONDS", "script_rows", "to_sdf"]
 
-TEMPLATE = "world.sdf"
+TEMPLATE = SDF_NAME  # worldgen/templates names each skeleton after the file it becomes
 #: Smallest principal moment written (kg m^2): floats keep 6 decimals, and a
 #: moment rounded to 0 would make the inertia invalid for every physics engine.
 MIN_MOMENT = 1e-6
@@ -182,6 +183,7 @@ class _ModelWriter:
                         f"but that node's parent is {node.parent!r}")
                 self._joint(out, joint, names)
             else:
+                assert node.parent is not None, "every node but the root has a parent"
                 self._fixed(out, self._fresh(f"{node.name}_fixed"), node.parent, node.name)
         out.close("model")
 

@@ -49,12 +49,13 @@ import numpy as np
 from worldgen.errors import SceneError
 from worldgen.export.bodies import RESERVED_NAME, joints_by_child, mass_properties
 from worldgen.export.xml import XmlText, escape_attr, fill, load_template, sub
+from worldgen.files import URDF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose
 
 __all__ = ["to_urdf", "TEMPLATE", "link_offset", "joint_origin"]
 
-TEMPLATE = "world.urdf"
+TEMPLATE = URDF_NAME  # worldgen/templates names each skeleton after the file it becomes
 
 
 def link_offset(joint: Joint | None) -> np.ndarray:
@@ -212,7 +213,7 @@ def _write_joint(out: XmlText, node: Node, joint: Joint | None, parent_joint: Jo
     else:
         origin = _matrix_attrs(joint_origin(node, joint, parent_joint))
     out.empty("origin", origin)
-    if kind == "revolute":
+    if kind == "revolute" and joint is not None:  # revolute: a joint of that kind
         out.empty("axis", f' xyz="{fmt_seq(joint.axis)}"')
         lo, hi = joint.limits
         # The written pose is the joint's zero: measure the limits from the initial angle.

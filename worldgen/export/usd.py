@@ -40,6 +40,7 @@ import numpy as np
 from worldgen.errors import WorldgenError
 from worldgen.export.usd_motion import TIME_CODES_PER_SECOND, write_movers, write_tasks
 from worldgen.export.usd_prims import SHAPE_PRIM, Specs, matrix_quaternion, quaternion, require_pxr
+from worldgen.files import USDC_NAME
 from worldgen.floats import fmt, round_float
 from worldgen.scene import Mesh, Node, Scene
 from worldgen.scene.graph import Joint, Task
@@ -73,7 +74,7 @@ def to_usdc(scene: Scene, name: str = "default", tasks: Sequence[Task] = (), dur
 
     layer = _layer(scene, name, tasks, duration)
     with tempfile.TemporaryDirectory(prefix="worldgen-usdc-") as folder:
-        path = Path(folder) / "world.usdc"  # usd-core writes a crate file only to a path, by its extension
+        path = Path(folder) / USDC_NAME  # usd-core writes a crate file only to a path, by its extension
         if not layer.Export(str(path)):
             raise WorldgenError(f"usd-core could not write {path.name}")
         return path.read_bytes()
@@ -184,12 +185,12 @@ class _NodeWriter:
                 raise WorldgenError(f"the USD exporter needs revolute joint {joint.name!r}'s child "
                                     f"{joint.child!r} to be dynamic (a static child cannot turn)")
         for node, prim in bodies:
-            joint = self.joint_of.get(node.name)
-            if joint is not None and joint.kind == "revolute":
-                self._revolute(prim, joint)
-            elif joint is not None or node.parent is not None:
+            held = self.joint_of.get(node.name)
+            if held is not None and held.kind == "revolute":
+                self._revolute(prim, held)
+            elif held is not None or node.parent is not None:
                 # Held to its parent (or to the world) as the SDF holds it; a root with no joint is a free body.
-                self._fixed(prim, node, joint.name if joint is not None else f"{node.name}_fixed")
+                self._fixed(prim, node, held.name if held is not None else f"{node.name}_fixed")
 
     def _node(self, parent, node: Node, rigid: bool):
         specs = self.specs
@@ -250,6 +251,7 @@ class _NodeWriter:
     def _fixed(self, body, node: Node, name: str) -> None:
         joint = self.joint_of.get(node.name)
         parent = joint.parent if joint is not None else node.parent
+        assert parent is not None, "called for a node with a joint or a parent"
         prim = self.specs.prim(body, name, "PhysicsFixedJoint")
         self._ends(prim, parent, node.name)
         child_in_parent = np.linalg.inv(self._parent_matrix(parent)) @ self.scene.world_matrix(node.name)

@@ -17,8 +17,9 @@ from typing import Any, Iterable, Optional, Sequence
 import numpy as np
 
 from worldgen.errors import WorldgenError, optional_available, require_optional
+from worldgen.files import USDA_NAME
 from worldgen.floats import DECIMALS, round_float
-from worldgen.scene.shapes import Box, Cylinder, Mesh, Sphere
+from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, Sphere
 
 __all__ = ["SHAPE_PRIM", "INSTALL_HINT", "require_pxr", "usd_available", "Specs", "quaternion", "matrix_quaternion"]
 
@@ -91,7 +92,7 @@ class Specs:
     def __init__(self, pxr):
         self.Sdf, self.Gf, self.Vt = pxr.Sdf, pxr.Gf, pxr.Vt
         self.T = pxr.Sdf.ValueTypeNames
-        self.layer = pxr.Sdf.Layer.CreateAnonymous("world.usda")
+        self.layer = pxr.Sdf.Layer.CreateAnonymous(USDA_NAME)
         # Box prims that differ only in their extents are copied from one written here (see shape()).
         self._templates = pxr.Sdf.Layer.CreateAnonymous("templates.usda")
         self._template_paths: dict[tuple, Any] = {}
@@ -138,6 +139,7 @@ class Specs:
         same colour, material and body, then given its sizes: the same specs as writing it field by
         field, for about half the cost (boxes and cylinders are most of a world).
         """
+        template: Shape
         if isinstance(shape, Box):
             key, template = ("box", tuple(rgba), material, rigid, name), Box((1.0, 1.0, 1.0))
         elif isinstance(shape, Cylinder):

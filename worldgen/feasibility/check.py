@@ -69,7 +69,7 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     plans = _Plans.of(scene, tasks, robot, colliders, spawns, goals)
     checks = (inside, free["spawn"], free["goal"], plans.path_exists(), plans.path_clearance(tasks, robot))
     narrowest = min(plans.passages) if plans.passages and not plans.no_path else None
-    informational = ()
+    informational: tuple[Check, ...] = ()
     if door_joints(initial):
         informational = (_reachable_initial(initial, tasks, robot),)
     return FeasibilityReport(checks, tuple(plans.paths), narrowest, CHECKER, informational)
@@ -169,7 +169,7 @@ def _reachable_initial(initial: Scene, tasks, robot: Robot) -> Check:
     """
     report = check(fixed_scene(initial), tasks, robot)
     if report.feasible:
-        longest = max(p.length for p in report.paths)
+        longest = max(p.length for p in report.paths if p is not None)  # feasible: every task has one
         return Check("reachable_initial_state", True, longest,
                      f"every task can be driven with the doors as they start; longest path {longest:.3f} m")
     failed = "; ".join(f"{c.name}: {c.detail}" for c in report.failed())

@@ -206,7 +206,7 @@ class Colliders:
                     best, at, who = float(d), p, self.names[c]
                 bounds[p, c] = np.inf  # measured: never again
             if best < threshold or np.all(np.isinf(bounds)):
-                return Nearest(best, at, who, queries, tuple(float(v) for v in where[at]))
+                return Nearest(best, at, who, queries, (float(where[at][0]), float(where[at][1])))
             # Nothing close enough: widen to every pair (rare: wide-open worlds).
             threshold = np.inf
 

@@ -24,9 +24,9 @@ from functools import cached_property
 from typing import Optional
 
 import numpy as np
-import shapely
 
-from worldgen.feasibility.geometry import Obstacles2D, point_segment_distance, segment_segment_distance
+from worldgen.feasibility.corners import NEAR_MARGIN, corner_circles
+from worldgen.feasibility.geometry import Obstacles2D, cross, point_segment_distance, segment_segment_distance
 from worldgen.feasibility.grid import SegmentGrid
 
 __all__ = ["ConfigSpace", "TOUCH", "CONE_SLACK", "NEAR_MARGIN"]
@@ -41,29 +41,6 @@ CONE_SLACK = 1e-9
 GRID_FROM = 250
 #: Samples along each segment in the first round of the grid's walk (half a cell apart; doubling).
 WALK = 4
-#: How far beyond touching (as a fraction of the radius) an obstacle's neighbours are kept.
-NEAR_MARGIN = 0.1
-#: Polygon vertices whose cone is narrower than this (rad) are collinear: no circle.
-_FLAT = 1e-12
-
-
-def _neighbours(obstacles: Obstacles2D, reach: float) -> tuple[np.ndarray, np.ndarray]:
-    """CSR (start (N + 1,), ids) of the other obstacles whose boxes lie within ``reach`` of each one's."""
-    n = len(obstacles)
-    if n < 2:
-        return np.zeros(n + 1, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    b = obstacles.boxes
-    tree = shapely.STRtree(shapely.box(b[:, 0], b[:, 1], b[:, 2], b[:, 3]))
-    qi, ti = tree.query(shapely.box(b[:, 0] - reach, b[:, 1] - reach, b[:, 2] + reach, b[:, 3] + reach))
-    keep = qi != ti
-    qi, ti = qi[keep], ti[keep]
-    order = np.lexsort((ti, qi))
-    qi, ti = qi[order], ti[order]
-    return np.searchsorted(qi, np.arange(n + 1)).astype(np.int64), ti.astype(np.int64)
-
-
-def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
 
 def _unskipped(seg: np.ndarray, o: np.ndarray, skip1, skip2) -> tuple[np.ndarray, np.ndarray]:
@@ -119,54 +96,11 @@ class ConfigSpace:
 
     @classmethod
     def build(cls, obstacles: Obstacles2D, radius: float, bounds) -> "ConfigSpace":
+        """The configuration space of a disc of ``radius`` among ``obstacles`` within ``bounds`` ((x0, y0),
+        (x1, y1)): its corner circles as :mod:`~worldgen.feasibility.corners` builds them."""
         (x0, y0), (x1, y1) = bounds
         box = (x0 + radius, y0 + radius, x1 - radius, y1 - radius)
-        nd, n = obstacles.n_discs, len(obstacles)
-        # Polygon corners, all rings at once: edge k runs from vertex k to the next of its ring.
-        e = obstacles.edge_b - obstacles.edge_a
-        normals = np.stack([e[:, 1], -e[:, 0]], axis=1)
-        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-300)
-        ring_start = obstacles.edge_start[obstacles.edge_owner]
-        ring_len = obstacles.edge_start[obstacles.edge_owner + 1] - ring_start
-        local = np.arange(len(e)) - ring_start
-        before = normals[ring_start + (local - 1) % np.maximum(ring_len, 1)]  # the edge ending at vertex k
-        width = np.arctan2(_cross(before, normals), np.einsum("ij,ij->i", before, normals))
-        keep = width > _FLAT
-        corner = np.flatnonzero(keep)
-        poly_owner = obstacles.edge_owner[corner] + nd
-        # Circle ids: the discs', then each polygon's kept corners in ring order.
-        count = np.concatenate([np.ones(nd, dtype=np.int64), np.bincount(poly_owner - nd, minlength=n - nd)])
-        first = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
-        ids = nd + np.arange(len(corner))
-        own_first = first[poly_owner]
-        own_count = count[poly_owner]
-        pos = ids - own_first
-        x_axis = np.tile([[1.0, 0.0]], (nd, 1))
-        centre = np.concatenate([obstacles.disc_xy, obstacles.edge_a[corner]])
-        rho = np.concatenate([obstacles.disc_r + radius, np.full(len(corner), float(radius))])
-        cone_a = np.concatenate([x_axis, before[corner]])
-        cone_b = np.concatenate([x_axis, normals[corner]])
-        cone_w = np.concatenate([np.full(nd, 2 * np.pi), width[corner]])
-        owner = np.concatenate([np.arange(nd), poly_owner]).astype(np.int64)
-        nxt = np.concatenate([np.full(nd, -1), own_first + (pos + 1) % np.maximum(own_count, 1)]).astype(np.int64)
-        prv = np.concatenate([np.full(nd, -1), own_first + (pos - 1) % np.maximum(own_count, 1)]).astype(np.int64)
-        lo, hi = obstacles.boxes[:, :2], obstacles.boxes[:, 2:]
-        hull_c = (lo + hi) / 2
-        hull_r = np.hypot(*(hi - lo).T) / 2 + radius
-        if nd:
-            hull_c[:nd] = obstacles.disc_xy
-            hull_r[:nd] = obstacles.disc_r + radius
-        # The core: the centre's distance to the nearest edge line, where it lies inside the polygon.
-        core_r = hull_r.copy()
-        if len(e):
-            inward = _cross(e, hull_c[nd + obstacles.edge_owner] - obstacles.edge_a) / np.maximum(
-                np.linalg.norm(e, axis=1), 1e-300)
-            depth = np.full(n - nd, np.inf)
-            np.minimum.at(depth, obstacles.edge_owner, inward)
-            core_r[nd:] = np.where(depth > 0, depth + radius, -1.0)
-        nb_start, nb_ids = _neighbours(obstacles, (2 + NEAR_MARGIN) * radius)
-        return cls(obstacles, float(radius), box, centre, rho, cone_a, cone_b, cone_w, owner, nxt, prv,
-                   first, hull_c, hull_r, core_r, nb_start, nb_ids)
+        return cls(obstacles, float(radius), box, **corner_circles(obstacles, radius))
 
     @property
     def n_circles(self) -> int:
@@ -182,7 +116,7 @@ class ConfigSpace:
     def in_cone(self, circle: np.ndarray, normal: np.ndarray) -> np.ndarray:
         """(m,) bool: the outward ``normal`` (m, 2) lies in the cone of ``circle`` (m,)."""
         a, b = self.cone_a[circle], self.cone_b[circle]
-        inside = (_cross(a, normal) >= -CONE_SLACK) & (_cross(normal, b) >= -CONE_SLACK)
+        inside = (cross(a, normal) >= -CONE_SLACK) & (cross(normal, b) >= -CONE_SLACK)
         return self.full[circle] | inside
 
     @property
@@ -239,6 +173,7 @@ class ConfigSpace:
 
     def _grid_clear(self, a, b, ok, skip1, skip2) -> np.ndarray:
         grid = self._grid
+        assert grid is not None, "called only when the space has a grid"
         step = grid.h / 2
         d = b - a
         steps = np.maximum(np.ceil(np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2) / step).astype(np.int64), 1)
@@ -281,7 +216,7 @@ class ConfigSpace:
         ap, bp = a[s], b[s]
         close = segment_segment_distance(ap, bp, obs.edge_a[e], obs.edge_b[e]) < r
         # A segment wholly inside a polygon crosses no edge: its start lies left of every edge.
-        left = _cross(obs.edge_b[e] - obs.edge_a[e], ap - obs.edge_a[e]) >= 0
+        left = cross(obs.edge_b[e] - obs.edge_a[e], ap - obs.edge_a[e]) >= 0
         # Per pair: any edge close, or every edge with the start on its left (counted, as ufunc.at would).
         n = len(unsure)
         blocked = (np.bincount(pair, close, n) > 0) | (np.bincount(pair, ~left, n) == 0)
@@ -326,8 +261,8 @@ class ConfigSpace:
         sweep = np.asarray(sweep, dtype=float)
         # The box: the arc's extreme points are its ends and the axis directions it sweeps over.
         x0, y0, x1, y1 = self.box
-        for k, (ux, uy) in enumerate(((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))):
-            ang = k * np.pi / 2
+        for quarter, (ux, uy) in enumerate(((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))):
+            ang = quarter * np.pi / 2
             swept = np.mod(ang - start, 2 * np.pi) <= sweep
             px, py = c[:, 0] + rho * ux, c[:, 1] + rho * uy
             margin = np.minimum(np.minimum(px - x0, x1 - px), np.minimum(py - y0, y1 - py))

@@ -20,7 +20,7 @@ import shapely
 
 from worldgen.scene.footprint import Footprint
 
-__all__ = ["Obstacles2D", "point_segment_distance", "segment_segment_distance"]
+__all__ = ["Obstacles2D", "cross", "point_segment_distance", "segment_segment_distance"]
 
 
 def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -36,7 +36,8 @@ def point_segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nd
     return np.sqrt(dx * dx + dy * dy)
 
 
-def _cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+def cross(u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The z component of ``u x v``, (..., 2) arrays: positive where ``v`` turns counter-clockwise from ``u``."""
     return u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0]
 
 
@@ -183,7 +184,7 @@ class Obstacles2D:
 
     def _inside_polygon(self, pts: np.ndarray, e: np.ndarray, pair: np.ndarray, n_pairs: int) -> np.ndarray:
         """Per (point, edge) row: True where the point lies left of every edge of its pair's polygon."""
-        left = _cross(self.edge_b[e] - self.edge_a[e], pts - self.edge_a[e]) >= 0
+        left = cross(self.edge_b[e] - self.edge_a[e], pts - self.edge_a[e]) >= 0
         all_left = np.ones(n_pairs, dtype=bool)
         np.logical_and.at(all_left, pair, left)
         return all_left[pair]

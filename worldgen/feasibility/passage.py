@@ -119,11 +119,11 @@ def _joins(obstacles: Obstacles2D, bounds, reach: float):
         keep = qi < ti
         i, j = qi[keep], ti[keep]
         gap, touch = _pair_gaps(obstacles, i, j)
-        near = gap < reach
-        gaps.append(gap[near])
-        pa.append(i[near])
-        pb.append(j[near])
-        touches.append(touch[near])
+        close = gap < reach
+        gaps.append(gap[close])
+        pa.append(i[close])
+        pb.append(j[close])
+        touches.append(touch[close])
     gap, a, b = np.concatenate(gaps), np.concatenate(pa), np.concatenate(pb)
     touch = np.concatenate(touches)
     order = np.lexsort((b, a, gap))

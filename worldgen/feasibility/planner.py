@@ -17,10 +17,13 @@ Nothing is built ahead:
 - Tangents between two obstacles are computed once and shared by every node on them.
 - A node reached no cheaper than an already expanded node on the same circle
   can reach it along the arc is skipped (it is dominated).
-- Nodes whose keys lie within :data:`BATCH` of the smallest (or :data:`BATCH_SHARE` of that key,
-  whichever is wider) are expanded together, so that the geometry runs in few, large vectorised calls. Expanding
-  a node a little early never loses the optimum: every node stays reachable,
-  and the search stops only when no key left is below the best path found.
+- Nodes whose keys lie within :data:`BATCH` of the smallest (or :data:`BATCH_SHARE` of that
+  key, whichever is wider) are expanded together, so that the geometry runs in few, large
+  vectorised calls. Expanding a node a little early never loses the optimum: every node stays
+  reachable, and the search stops only when no key left is below the best path found.
+
+The bounds themselves, and the band of obstacles a node asks for at once, are
+:mod:`~worldgen.feasibility.bounds`'s.
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ from typing import Optional
 
 import numpy as np
 
+from worldgen.feasibility.bounds import lower_bounds, next_band
 from worldgen.feasibility.cspace import ConfigSpace
 from worldgen.feasibility.route import Contact, Route
 from worldgen.feasibility.tangents import (
@@ -48,8 +52,6 @@ __all__ = ["Planner"]
 #: Slack (m) added to a node's bound when it asks for tangents, so that one
 #: request covers the obstacles just beyond it.
 BAND = 0.25
-#: At least this many obstacles per request, for the same reason.
-MIN_BATCH = 8
 #: Nodes whose keys lie within this (m) of the smallest are expanded together. Tuned on cluttered
 #: 20 x 20 m worlds (40 seeds each, same paths): 0.5 and 16 took 3.2 / 14.3 ms a query at 50 / 200
 #: obstacles, these 2.7 / 13.5 ms; no batching (0) is fastest at 50 but 1.5x slower at 200.
@@ -104,7 +106,7 @@ class Planner:
         self._heap = [(float(np.hypot(*(goal - start))), 0, 0)]
         self._tie = 1
         self._expanded: dict[tuple[int, int], list[tuple[float, float]]] = {}
-        self._best = (math.inf, None)
+        self._best: tuple[float, Optional[tuple[int, np.ndarray, np.ndarray]]] = (math.inf, None)
         heap = self._heap
         while heap and heap[0][0] < self._best[0] - 1e-12:
             limit = heap[0][0] + max(BATCH, BATCH_SHARE * heap[0][0])
@@ -252,45 +254,13 @@ class Planner:
 
     # -- bounds, bands and tables --------------------------------------------
     def _bounds(self, nodes: list[_Node]) -> np.ndarray:
-        """(k, N) per node: a lower bound on the length of any path through it whose next obstacle is each one.
-
-        The path goes on through a point x of the obstacle's bounding disc (centre c,
-        radius r), so it is at least g + |p - x| + |x - goal|, which is at least both
-        |p - c| + |c - goal| - 2 r and, for x at distance d >= (distance from c to the
-        line p-goal) - r from that line, 2 sqrt((|p - goal| / 2)^2 + d^2).
-        """
-        cs, goal = self.cs, self._goal
-        p = np.array([n.point for n in nodes])[:, None, :]
-        g = np.array([n.g for n in nodes])[:, None]
-        c = cs.hull_c[None, :, :]
-        d = c - p
-        to_c = np.sqrt(d[..., 0] ** 2 + d[..., 1] ** 2)
-        c_goal = np.hypot(cs.hull_c[:, 0] - goal[0], cs.hull_c[:, 1] - goal[1])[None, :]
-        via = to_c + c_goal - 2 * cs.hull_r[None, :]
-        u = goal[None, None, :] - p
-        span = np.sqrt(u[..., 0] ** 2 + u[..., 1] ** 2)
-        off = np.abs(d[..., 0] * u[..., 1] - d[..., 1] * u[..., 0]) / np.maximum(span, 1e-300)
-        off = np.maximum(off - cs.hull_r[None, :], 0.0)
-        via = np.maximum(via, np.where(span > 0, 2 * np.sqrt(span * span / 4 + off * off), 0.0))
-        lb = g + np.maximum(via, span)
-        for k, node in enumerate(nodes):
-            if node.circle >= 0:
-                lb[k, cs.owner[node.circle]] = np.inf
-        return lb
+        """(k, N) per node: a lower bound on the length of any path through it whose next obstacle is each one."""
+        return lower_bounds(self.cs, self._goal, np.array([n.point for n in nodes]), np.array([n.g for n in nodes]),
+                            np.array([n.circle for n in nodes]))
 
     def _band(self, node: _Node, hi: float) -> tuple[np.ndarray, float]:
-        """The obstacles whose bound lies in (node.done, hi], at least :data:`MIN_BATCH` of them when there
-        are; and the bound up to which obstacles are then taken."""
-        todo = node.lb > node.done
-        band = np.flatnonzero(todo & (node.lb <= hi))
-        if len(band) < MIN_BATCH:
-            rest = np.flatnonzero(todo & np.isfinite(node.lb))
-            if len(rest) <= MIN_BATCH:
-                band = rest
-            else:
-                band = rest[np.argpartition(node.lb[rest], MIN_BATCH - 1)[:MIN_BATCH]]
-        upto = max(hi, float(node.lb[band].max())) if len(band) else hi
-        return band, upto
+        """The obstacles whose bound lies in (node.done, hi], and the bound up to which they are taken."""
+        return next_band(node.lb, node.done, hi)
 
     def _blockers(self, nodes: list[_Node], upto: Optional[float]) -> np.ndarray:
         """Ids of the obstacles that can meet a tangent leaving any of ``nodes``' obstacles towards one
@@ -367,15 +337,17 @@ class Planner:
                 asks.append((i, c, self._angle0[c] + (rel0 if node.side > 0 else node.rel), sweep))
         asks = [a for a in asks if a[0] not in out]
         if asks:
-            i, c, start, sweep = (np.array(v) for v in zip(*asks))
-            free = self.cs.arc_clearance(c.astype(np.int64), start, sweep) >= -1e-9
-            out.update(int(k) for k in i[free])
+            who, circle, start, sweep = (np.array(v) for v in zip(*asks))
+            free = self.cs.arc_clearance(circle.astype(np.int64), start, sweep) >= -1e-9
+            out.update(int(k) for k in who[free])
         return out
 
     # -- the answer --------------------------------------------------------
     def _route(self, start, goal) -> Route:
         nodes = self._nodes
-        g, (i, n_out, q_out) = self._best
+        g, found = self._best
+        assert found is not None, "called once a search has found a path"
+        i, n_out, q_out = found
         points = [goal, q_out]
         contacts = []
         out_normal = n_out

@@ -5,11 +5,9 @@ person starts, a replan). :class:`~worldgen.feasibility.planner.Planner` builds 
 each query (about 2 ms a query among 50 obstacles); here it is built once, every free common tangent
 between circles of different obstacles and the grown edges, and a query only adds its two ends.
 
-Every tangent leaves a circle on a side (the way the path winds round it) and arrives on another on a
-side (:mod:`~worldgen.feasibility.tangents`). On each (circle, side), a *chain*, those points are
-sorted the way the path winds; a path arriving at one may leave at any later one, over the arc
-between, if that arc keeps the clearance: exactly when each piece between consecutive points does, so
-the pieces are measured once, and a point's ways out are gathered when a search first needs them.
+The graph, its chains of tangent points and which pieces of their arcs are blocked, is
+:mod:`~worldgen.feasibility.roadmap_graph`'s; here are the queries over it, and a point's ways out along
+its chain, gathered when a search first needs them and kept for the next.
 
 A query is A* over the arrival points, the straight-line distance to the goal its heuristic (consistent:
 no arc or leg is shorter than its chord). The start's tangents enter chains at new points (going on to
@@ -27,15 +25,12 @@ from typing import Optional
 import numpy as np
 
 from worldgen.feasibility.cspace import ConfigSpace
+from worldgen.feasibility.roadmap_graph import EPS, SPAN, TWO_PI, TangentGraph
 from worldgen.feasibility.route import Contact, Route
-from worldgen.feasibility.tangents import Tangents, every_side, grown_edges, lonely_circles, tangents
+from worldgen.feasibility.tangents import Tangents, every_side, tangents
 
 __all__ = ["Roadmap"]
 
-#: Angles (rad) within this of each other count as one: the planner's tolerance on a sweep.
-EPS = 1e-9
-#: Chain keys: chain id times _SPAN plus the winding angle (< 2 pi + a hair), one sorted array for all.
-_SPAN, _TWO_PI = 8.0, 2 * math.pi
 #: A start tangent's clearance is tested together with those whose cost is within this (m) of it: one
 #: vectorised test for the few the search is about to reach.
 VERIFY_BAND = 1.0
@@ -44,107 +39,21 @@ VERIFY_BAND = 1.0
 _STATE, _SEED, _GOAL, _DIRECT = 0, 1, 2, 3
 
 
-class Roadmap:
-    """Shortest paths in one configuration space, all of them over one tangent graph built here."""
+class Roadmap(TangentGraph):
+    """Shortest paths in one configuration space, all of them over one tangent graph built once
+    (:class:`~worldgen.feasibility.roadmap_graph.TangentGraph`)."""
 
     def __init__(self, cs: ConfigSpace):
-        self.cs = cs
-        self._arc_free = lonely_circles(cs)
-        self._angle0 = np.arctan2(cs.cone_a[:, 1], cs.cone_a[:, 0])
-        self._full = cs.full
-        self.tans = self._all_tangents()
-        t = self.tans
-        n = len(t)
-        # Positions: departures of every tangent (rows 0..n-1), then arrivals (n..2n-1), sorted by chain and angle.
-        circle = np.concatenate([t.src, t.dst])
-        side = np.concatenate([t.s1, t.s2])
-        rel = self._rel(circle, np.concatenate([t.nq, t.nt]))
-        chain = circle * 2 + (side < 0)
-        u = self._wind(circle, side, rel)
-        order = np.lexsort((u, chain))
-        self._chain = chain[order]
-        self._u = u[order]
-        self._rel_sorted = rel[order]
-        self._key = self._chain * _SPAN + self._u
-        self._node = order  # what each position is: a departure (< n) or an arrival (>= n) of tangent node % n
-        at = np.empty(2 * n, dtype=np.int64)
-        at[order] = np.arange(2 * n)
-        self._arrival_pos = at[n:]  # tangent j arrives at this position
-        self._points = np.concatenate([t.q, t.t])[order]
-        self._start = np.searchsorted(self._chain, np.arange(2 * cs.n_circles + 1)).astype(np.int64)
-        self._blocked, self._head = self._gaps()
-        # Hot per-position data as Python lists: the search reads them one at a time.
-        self._u_l, self._chain_l, self._node_l = self._u.tolist(), self._chain.tolist(), self._node.tolist()
-        self._start_l, self._full_l, self._rho_l = self._start.tolist(), self._full.tolist(), cs.rho.tolist()
-        self._len_l, self._arr_l = t.length.tolist(), self._arrival_pos.tolist()
-        self._px, self._py = self._points[:, 0].tolist(), self._points[:, 1].tolist()
-        self._n = n
+        super().__init__(cs)
         self._ways: dict[int, tuple] = {}
         # A query's tangents: from a point to every circle, each side; twice (the start's, the goal's).
-        self._ends_rows = tuple(np.tile(a, 2) for a in every_side(np.full(cs.n_circles, -1), np.arange(cs.n_circles),
-                                                                  (1,), (1, -1)))
-
-    # -- the graph ------------------------------------------------------------
-    def _all_tangents(self) -> Tangents:
-        """Every free tangent between circles of different obstacles (each side), and the grown edges.
-
-        Computed one way round only: the tangent from circle 1 on side s1 to circle 2 on side s2, walked
-        backwards, is the one from circle 2 on side -s2 to circle 1 on side -s1 (the same segment and normals).
-        """
-        cs = self.cs
-        c = np.arange(cs.n_circles)
-        src, dst = np.repeat(c, len(c)), np.tile(c, len(c))
-        keep = cs.owner[src] < cs.owner[dst]
-        one = tangents(cs, *every_side(src[keep], dst[keep]))
-        back = Tangents(one.dst, one.src, -one.s2, -one.s1, one.t, one.q, one.nt, one.nq, one.length)
-        return Tangents.concat([one, back, grown_edges(cs).tans])
-
-    def _rel(self, circle: np.ndarray, normals: np.ndarray) -> np.ndarray:
-        """Angle (rad) of each outward normal from its circle's cone start, counter-clockwise (the planner's)."""
-        ang = np.mod(np.arctan2(normals[:, 1], normals[:, 0]) - self._angle0[circle], 2 * np.pi)
-        return np.where(~self._full[circle] & (ang > self.cs.cone_w[circle] + 1e-6), 0.0, ang)
-
-    def _wind(self, circle: np.ndarray, side: np.ndarray, rel: np.ndarray) -> np.ndarray:
-        """The angle along the way the path winds (side -1 winds clockwise: from the cone's end)."""
-        w = self.cs.cone_w[circle]
-        u = np.where(side > 0, rel, w - rel)
-        return np.where(self._full[circle], np.mod(u, 2 * np.pi), u)
-
-    def _gaps(self) -> tuple[np.ndarray, np.ndarray]:
-        """Which pieces of each chain's arc do not keep the clearance: (positions,) from each position to the
-        next of its chain (wrapping on a full circle; to the cone's end after a polygon corner's last), and
-        (chains,) from the cone's start to the chain's first position (the whole circle or cone if none)."""
-        m, cs = len(self._u), self.cs
-        circle = self._chain // 2
-        last = np.r_[self._chain[1:] != self._chain[:-1], True] if m else np.zeros(0, dtype=bool)
-        first_of = self._start[self._chain]
-        nxt = np.where(last, first_of, np.arange(1, m + 1))
-        nxt_u = np.where(last, np.where(self._full[circle], self._u[first_of] + 2 * np.pi, cs.cone_w[circle]),
-                         self._u[np.minimum(np.arange(1, m + 1), m - 1)] if m else 0.0)
-        nxt_rel = np.where(last & ~self._full[circle], np.where(self._chain % 2 == 0, cs.cone_w[circle], 0.0),
-                           self._rel_sorted[nxt % max(m, 1)] if m else 0.0)
-        sweep = nxt_u - self._u
-        i = np.flatnonzero((sweep > 0) & ~self._arc_free[circle])
-        blocked = np.zeros(m, dtype=bool)
-        blocked[i] = ~self._arcs_clear(self._chain[i], self._rel_sorted[i], nxt_rel[i], sweep[i])
-        # Heads: from the cone's start (on side -1, its end) to the first position.
-        chains = np.arange(2 * cs.n_circles)
-        c = chains // 2
-        empty = self._start[1:] == self._start[:-1]
-        head_u = np.where(empty, cs.cone_w[c], self._u[np.minimum(self._start[:-1], max(m - 1, 0))] if m else 0.0)
-        head_u = np.where(self._full[c] & ~empty, 0.0, head_u)  # a full circle's wrap is a gap already
-        head_rel = np.where(empty, np.where(chains % 2 == 0, cs.cone_w[c], 0.0),
-                            self._rel_sorted[np.minimum(self._start[:-1], max(m - 1, 0))] if m else 0.0)
-        from_rel = np.where(chains % 2 == 0, 0.0, cs.cone_w[c])
-        head = np.zeros(len(chains), dtype=bool)
-        j = np.flatnonzero(head_u > 0)
-        head[j] = ~self._arcs_clear(chains[j], from_rel[j], head_rel[j], head_u[j])
-        return blocked, head
+        src, dst, s1, s2 = every_side(np.full(cs.n_circles, -1), np.arange(cs.n_circles), (1,), (1, -1))
+        self._ends_rows = (np.tile(src, 2), np.tile(dst, 2), np.tile(s1, 2), np.tile(s2, 2))
 
     def _piece_blocked(self, chain: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(the last position at or before angle ``u`` on ``chain``, or the chain's start - 1: before its
         first; whether the piece of arc holding ``u`` is blocked). An arc within a clear piece is clear."""
-        raw = np.searchsorted(self._key, chain * _SPAN + u, side="right") - 1
+        raw = np.searchsorted(self._key, chain * SPAN + u, side="right") - 1
         s, e = self._start[chain], self._start[chain + 1]
         before = raw < s
         at = np.where(before & self._full[chain // 2] & (e > s), e - 1, raw)
@@ -178,8 +87,8 @@ class Roadmap:
             j = self._node_l[p]
             if j >= n:
                 continue  # an arrival: nothing leaves there
-            sweep = u[p] - u[k] + (_TWO_PI if idx >= m else 0.0)
-            sweep = 0.0 if sweep < 0.0 or (full and sweep > _TWO_PI - EPS) else sweep
+            sweep = u[p] - u[k] + (TWO_PI if idx >= m else 0.0)
+            sweep = 0.0 if sweep < 0.0 or (full and sweep > TWO_PI - EPS) else sweep
             out.append((self._arr_l[j], rho * sweep + self._len_l[j], j, sweep))
         got = (lo, hi, s, m, out)
         self._ways[k] = got
@@ -260,8 +169,8 @@ class Roadmap:
                     if idx < lo and full:
                         idx += m
                     if lo <= idx <= hi:
-                        sweep = u[p] - u[k] + (_TWO_PI if idx >= m else 0.0) + extra
-                        sweep = 0.0 if sweep < 0.0 or (full and sweep > _TWO_PI - EPS) else sweep
+                        sweep = u[p] - u[k] + (TWO_PI if idx >= m else 0.0) + extra
+                        sweep = 0.0 if sweep < 0.0 or (full and sweep > TWO_PI - EPS) else sweep
                         total = g + rho * sweep + length
                         if total < goal_f[r]:
                             goal_f[r] = total
@@ -292,21 +201,6 @@ class Roadmap:
         keep = np.flatnonzero(sweep >= 0)
         return [(float(total[k]), (int(ia[k]), int(ib[k]), float(max(sweep[k], 0.0)), bool(inside[k])))
                 for k in keep]
-
-    def _arcs_clear(self, chain, rel_from, rel_to, sweep, clear=None) -> np.ndarray:
-        """(m,) bool: the arcs on ``chain`` (m,) from ``rel_from`` to ``rel_to`` the way it winds keep the
-        clearance; ``clear`` (m,) bool, if given: those known to (they lie in a clear piece of their chain)."""
-        circle = chain // 2
-        ok = np.ones(len(chain), dtype=bool)
-        unsure = (sweep > 0) & ~self._arc_free[circle]
-        if clear is not None:
-            unsure &= ~clear
-        check = np.flatnonzero(unsure)
-        if len(check):
-            # Counter-clockwise from where a side +1 path arrives, or a side -1 path leaves.
-            start = self._angle0[circle[check]] + np.where(chain[check] % 2 == 0, rel_from[check], rel_to[check])
-            ok[check] = self.cs.arc_clearance(circle[check], start, sweep[check]) >= -EPS
-        return ok
 
     def _route(self, start, goal, length: float, data: tuple, parent: dict, ins: "_Ends", outs: "_Ends") -> Route:
         """The path found walked back through ``parent``: points and contacts in travel order."""
@@ -358,11 +252,11 @@ class _Ends:
         self.piece, self.blocked = rm._piece_blocked(self.chain, self.u)
         s, e = rm._start[self.chain], rm._start[self.chain + 1]
         if into:  # on to the chain's next position
-            pos = np.searchsorted(rm._key, self.chain * _SPAN + self.u - EPS, side="left")
+            pos = np.searchsorted(rm._key, self.chain * SPAN + self.u - EPS, side="left")
             wrap = pos >= e
             pos = np.where(wrap, s, pos)
         else:  # from the chain's position before
-            pos = np.searchsorted(rm._key, self.chain * _SPAN + self.u + EPS, side="right") - 1
+            pos = np.searchsorted(rm._key, self.chain * SPAN + self.u + EPS, side="right") - 1
             wrap = pos < s
             pos = np.where(wrap, e - 1, pos)
         ok = (e > s) & (~wrap | rm._full[circle])

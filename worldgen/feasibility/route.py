@@ -53,7 +53,7 @@ def waypoints(cs, route: Route, spare: float) -> np.ndarray:
         ccw_start = np.array([c.start if c.side > 0 else c.start - c.sweep for c in contacts])
         measured = cs.arc_clearance(circle, ccw_start, np.array([c.sweep for c in contacts]))
         slack = dict(zip(arcs, measured.tolist()))
-    pts = [route.points[0]]
+    pts: list[np.ndarray] = [route.points[0]]
     for k, contact in enumerate(route.contacts):
         arrive, depart = route.points[1 + 2 * k], route.points[2 + 2 * k]
         pts.append(arrive)
@@ -68,6 +68,6 @@ def waypoints(cs, route: Route, spare: float) -> np.ndarray:
             pts.extend(c + out * np.stack([np.cos(ang), np.sin(ang)], axis=1))
         pts.append(depart)
     pts.append(route.points[-1])
-    pts = np.array(pts, dtype=float)
-    keep = np.r_[True, np.any(np.abs(np.diff(pts, axis=0)) > 1e-12, axis=1)]
-    return pts[keep]
+    dense = np.array(pts, dtype=float)
+    keep = np.r_[True, np.any(np.abs(np.diff(dense, axis=0)) > 1e-12, axis=1)]
+    return dense[keep]

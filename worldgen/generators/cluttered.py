@@ -21,7 +21,7 @@ from worldgen.generators.knob import Knob
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
 from worldgen.generators.tasks import TASK_PARAMS, check_task_params, sample_tasks
 from worldgen.params import Param
-from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene
+from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene, Shape
 from worldgen.scene.footprint import FootprintIndex, robot_footprints
 
 __all__ = ["SPEC", "KNOB", "build"]
@@ -132,9 +132,10 @@ def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
             if params["square_boxes"]:
                 sx = sy = round_float(rng.uniform(*params["box_size"]))
             else:
-                sx, sy = (round_float(v) for v in rng.uniform(*params["box_size"], size=2))
+                low, high = params["box_size"]
+                sx, sy = (round_float(v) for v in rng.uniform(low, high, size=2))
             yaw = round_float(rng.uniform(-math.pi, math.pi)) if params["random_yaw"] else 0.0
-            shape = Box((sx, sy, height))
+            shape: Shape = Box((sx, sy, height))
         else:
             yaw = 0.0
             shape = Cylinder(round_float(rng.uniform(*params["cylinder_radius"])), height)

@@ -212,11 +212,11 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
                                 f"{g:g} m from the others and from the corridor's ends, in {room:.3g} m of usable "
                                 f"corridor (the rest is kept free at the spawn and goal)")
         leg, a, b = spot
-        side = 1.0 if obstacle_rng.random() < 0.5 else -1.0
+        wall = 1.0 if obstacle_rng.random() < 0.5 else -1.0  # the side wall it stands against
         depth = round_float(obstacle_rng.uniform(min(0.1, w - g), w - g))
         h = round_float(obstacle_rng.uniform(*params["obstacle_height"]))
         along = round_float(b - a)
-        centre = lay.points[leg] + (a + b) / 2 * lay.u(leg) + side * (w / 2 - depth / 2) * lay.n(leg)
+        centre = lay.points[leg] + (a + b) / 2 * lay.u(leg) + wall * (w / 2 - depth / 2) * lay.n(leg)
         nodes.append(Node(f"obstacle_{j:0{width_of}d}", "obstacle", Box((along, depth, h)),
                           _pose(centre, h / 2, lay.heads[leg]),
                           mass=round_float(max(along * depth * h * OBSTACLE_DENSITY, 1e-3)), material=mat))

@@ -36,7 +36,7 @@ from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
 from worldgen.params import Param
-from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene, Task
+from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene, Shape, Task
 
 __all__ = ["SPEC", "build", "check", "margin", "TARGET_DEFAULTS", "target_layout"]
 
@@ -117,7 +117,8 @@ def _target_node(params, spawn_xy, direction, u, friction) -> Node:
     if kind == "cylinder":
         r = _size(params, "target_radius")
         centre = spawn_xy + (d + r) * u
-        shape, yaw = Cylinder(r, h), 0.0
+        shape: Shape = Cylinder(r, h)
+        yaw = 0.0
     else:
         depth, width = _size(params, "target_depth"), _size(params, "target_width")
         centre = spawn_xy + (d + depth / 2) * u

@@ -46,7 +46,7 @@ of path BARN's A* returns.
 from __future__ import annotations
 
 import math
-from typing import Optional
+from typing import Literal, Optional
 
 import numpy as np
 
@@ -179,8 +179,10 @@ def world_metrics(occupied, origin, resolution: float, robot_radius: float, path
     (polylines; None for a task without one), averaged over the paths; each None without a path
     (tortuosity also where every path starts and ends in one cell)."""
     found = [p for p in paths if p is not None]
-    grid, half = _grid(occupied, resolution, robot_radius, None) if found else (None, 0)  # one C-space for all
-    per = [barn_metrics(grid, _cells(grid, half, len(occupied), origin, resolution, p), disp_radius) for p in found]
+    per = []
+    if found:
+        grid, half = _grid(occupied, resolution, robot_radius, None)  # one C-space for all
+        per = [barn_metrics(grid, _cells(grid, half, len(occupied), origin, resolution, p), disp_radius) for p in found]
     out: dict[str, Optional[float]] = {}
     for name in NAMES:
         values = [v for m in per if (v := m[name]) is not None]
@@ -289,7 +291,7 @@ def _free_runs(occ, r, c) -> dict[tuple[int, int], np.ndarray]:
     return out
 
 
-def _to_wall(keys: np.ndarray, here: np.ndarray, limit: np.ndarray, side: str) -> np.ndarray:
+def _to_wall(keys: np.ndarray, here: np.ndarray, limit: np.ndarray, side: Literal["left", "right"]) -> np.ndarray:
     """Steps from each key ``here`` to the nearest of the sorted ``keys`` ahead (``side="left"``: at or
     after it) or behind (``"right"``: at or before it); ``limit`` (or more) where that is on another line."""
     if len(keys) == 0:

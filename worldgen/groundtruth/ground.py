@@ -93,13 +93,14 @@ def _on_leaf(scene, node, leaves) -> bool:
 
 def _entity_colliders(meta: dict, read: Callable[[str], bytes]):
     """The same Colliders the feasibility check uses, rebuilt from world.json's entities."""
-    from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere
+    from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Shape, Sphere
 
     nodes = []
     for e in meta["entities"]:
         if e["role"] in ("floor", "marker"):
             continue
         s = e["shape"]
+        shape: Shape
         if s["type"] == "box":
             shape = Box(tuple(s["size"]))
         elif s["type"] == "cylinder":
@@ -111,6 +112,7 @@ def _entity_colliders(meta: dict, read: Callable[[str], bytes]):
 
             import trimesh
             mesh = trimesh.load(io.BytesIO(read(s["uri"])), file_type=Path(s["uri"]).suffix.lstrip("."), force="mesh")
+            assert isinstance(mesh, trimesh.Trimesh), "force='mesh' loads one Trimesh"
             shape = Mesh(s["uri"], np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64),
                          tuple(s.get("scale", (1.0, 1.0, 1.0))))
         # world.json poses are world-frame, so every node becomes a root node here.

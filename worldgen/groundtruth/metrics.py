@@ -105,7 +105,7 @@ def ray_lengths(prints: list[Footprint], bounds, origins: np.ndarray, dirs: np.n
             t = -b - np.sqrt(disc)
         t = np.where((disc >= 0) & (t >= 0), t, np.where(cc <= 0, 0.0, np.inf))
         best = np.minimum(best, t.min(axis=2))
-    loops = [np.asarray(fp.polygon.exterior.coords) for fp in prints if not fp.is_disc]
+    loops = [np.asarray(fp.polygon.exterior.coords) for fp in prints if fp.polygon is not None]
     if loops:
         a = np.vstack([q[:-1] for q in loops])  # (m, 2) edge starts
         e = np.vstack([np.diff(q, axis=0) for q in loops])  # (m, 2) edge vectors

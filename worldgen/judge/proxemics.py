@@ -69,7 +69,7 @@ def social_split(trajectory, world, task: Optional[str] = None, zones: Sequence[
     for name in sorted(set(kinds)) + ["all"]:
         cols = [j for j, k in enumerate(kinds) if name in (k, "all")]
         near = np.maximum(gap[:, cols].min(axis=1), 0.0)
-        figures = {band: float(step[(near >= lo) & (near < hi)].sum())
+        figures: dict[str, Optional[float]] = {band: float(step[(near >= lo) & (near < hi)].sum())
                    for band, lo, hi in zip(("intimate", "personal", "social"), (-1.0, *zones[:2]), zones)}
         figures["robot_on_person"] = sum(1 for j, robot in hits if j in cols and robot)
         figures["person_on_robot"] = sum(1 for j, robot in hits if j in cols and not robot)

@@ -6,9 +6,9 @@
       report.md       the verdict, the criteria, the per-world summary where the report has one, every run
       runs/RUN.png    the run over the world as preview.png draws it: trajectory, contacts, who was where at each
 
-The folder is written beside its destination under a temporary name and renamed into place,
-so a reader never sees half a report; an earlier report in the same place is replaced, any
-other existing folder is refused.
+The folder is written beside its destination under a temporary name and renamed into place
+(:func:`worldgen.files.atomic_folder`), so a reader never sees half a report; an earlier report in the
+same place is replaced, any other existing folder is refused.
 """
 
 from __future__ import annotations
@@ -16,9 +16,7 @@ from __future__ import annotations
 import csv
 import io
 import json
-import os
 import re
-import shutil
 from pathlib import Path
 from typing import Any, Optional
 
@@ -26,6 +24,7 @@ import numpy as np
 
 from worldgen.errors import OutputError
 from worldgen.export.topdown import COLOURS as TOPDOWN_COLOURS
+from worldgen.files import REPORT_CSV_NAME, REPORT_JSON_NAME, REPORT_MD_NAME, REPORT_RUNS_DIR, atomic_folder
 
 __all__ = ["write_report", "RUN_COLUMNS", "draw_run", "COLOURS"]
 
@@ -155,13 +154,10 @@ def draw_run(world, task: Optional[str], trajectory: np.ndarray, row: dict, worl
 def write_report(result, out) -> Path:
     """Write the report folder of a :class:`~worldgen.judge.runs.JudgeResult` at ``out``; returns ``out``."""
     out = Path(out)
-    if out.exists() and not (out.is_dir() and ((out / "report.json").is_file() or not any(out.iterdir()))):
+    if out.exists() and not (out.is_dir() and ((out / REPORT_JSON_NAME).is_file() or not any(out.iterdir()))):
         raise OutputError(f"--out '{out}' exists and is not a report folder; give a new folder or an earlier report's")
-    tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}")
-    old = out.with_name(f".{out.name}.old-{os.getpid()}")
-    try:
-        shutil.rmtree(tmp, ignore_errors=True)
-        (tmp / "runs").mkdir(parents=True)
+    with atomic_folder(out.parent, out.name, "report folder") as tmp:
+        (tmp / REPORT_RUNS_DIR).mkdir()
         report = result.report
         worlds: dict = {}
         for k, (row, plot) in enumerate(zip(report["runs"], result.plots)):
@@ -170,19 +166,10 @@ def write_report(result, out) -> Path:
                 continue
             image = draw_run(plot["world"], plot["task"], result.trajectory(k), row, worlds)
             if image is not None:
-                name = f"runs/{_safe(str(row['run']))}.png"
+                name = f"{REPORT_RUNS_DIR}/{_safe(str(row['run']))}.png"
                 image.save(tmp / name, format="PNG")
                 row["picture"] = name
-        (tmp / "report.json").write_text(json.dumps(report, indent=2, sort_keys=True, default=str) + "\n")
-        (tmp / "report.csv").write_text(_csv(report))
-        (tmp / "report.md").write_text(_markdown(report))
-        if out.exists():
-            out.rename(old)
-        tmp.rename(out)
-    except OSError as exc:
-        shutil.rmtree(tmp, ignore_errors=True)
-        if old.exists() and not out.exists():
-            old.rename(out)
-        raise OutputError(f"cannot write the report to '{out}': {exc.strerror or exc}") from None
-    shutil.rmtree(old, ignore_errors=True)
+        (tmp / REPORT_JSON_NAME).write_text(json.dumps(report, indent=2, sort_keys=True, default=str) + "\n")
+        (tmp / REPORT_CSV_NAME).write_text(_csv(report))
+        (tmp / REPORT_MD_NAME).write_text(_markdown(report))
     return out

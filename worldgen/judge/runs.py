@@ -194,7 +194,6 @@ def _run_name(world_id: str, task: str, index: Optional[str], taken: set[str]) -
     return _unique(f"{world_id}__{task}__run{k}", taken)
 
 
-# long: reading each bag, judging it and assembling the rows share the per-world cache
 def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, runs=None,
           start: str = "command", read_options: Optional[dict] = None,
           progress: Optional[Callable[[int], None]] = None) -> JudgeResult:
@@ -208,82 +207,13 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
     too) or ``unjudged`` (the bag could not be read, or its world not found: no verdict at all).
     """
     from worldgen.judge.evaluate import evaluate, load_criteria
-    from worldgen.ros.reader import RunMismatchError, peek_metadata, read_run
 
     if criteria is None:
         criteria = DEFAULT_CRITERIA
     load_criteria(criteria)  # a mistake in the criteria stops before any bag is read
-    items = plan(bags, world=world, pack=pack, runs=runs)
-    packs: dict[str, dict[str, Path]] = {}
-    if pack is not None:  # a pack that is missing or holds no world is a usage mistake, not 20 unjudged bags
-        packs[str(pack)] = _index(pack)
-    options = dict(read_options or {})
-    grounds: OrderedDict[Any, Ground] = OrderedDict()
-    extra: list[dict] = []        # per bag: the judge's columns (judged ones also get evaluate's)
-    plots: list[Optional[dict]] = []
-    scratch = tempfile.TemporaryDirectory(prefix="worldgen-judge-")
-    if items and _archived(items[0].world):  # evaluate reads scenario.yaml from a folder: the world's, extracted
-        archived = items[0].world
-        folder = archived.pack.source.extract_folder(archived.folder, Path(scratch.name) / "world")
-        items = [replace(item, world=folder) for item in items]
-    names: set[str] = set()
-
-    def ground(world) -> Ground:
-        key = world.resolve() if isinstance(world, Path) else id(world)  # a World or pack world: the object itself
-        if key not in grounds:
-            grounds[key] = load(world)
-            if len(grounds) > _CACHE:
-                grounds.popitem(last=False)
-        grounds.move_to_end(key)
-        return grounds[key]
-
-    def judged() -> Iterator[Any]:
-        for k, item in enumerate(items):
-            row: dict[str, Any] = {"bag": str(item.bag), "run": None, "readable": True}
-            try:
-                named = peek_metadata(item.bag)
-                folder, task = item.world, item.task or named.get("worldgen.task")
-                if folder is None:
-                    if not named.get("worldgen.world_id"):
-                        raise ParameterError(f"bag '{item.bag}': names no world in its metadata (worldgen.world_id); "
-                                             "give --world DIR or --runs TABLE")
-                    folder = _pack_world(pack, named["worldgen.world_id"], packs)
-                g = ground(folder)
-                world_id, task_id = str(g.meta.get("world_id")), g.task(task)["id"]
-                row["run"] = _run_name(world_id, task_id, item.run or named.get("worldgen.run"), names)
-                # None where the world has no folder of its own: an unwritten World, an archive's world extracted
-                row["world_folder"] = None if g.path is None or Path(scratch.name) in g.path.parents else str(g.path)
-                try:
-                    _same_world(item.bag, named, world_id)
-                    got = read_run(item.bag, g, task=task, start=start, **options)
-                    _same_world(item.bag, got.metadata, world_id)  # a bare storage file carries its own
-                    if item.run is None and not named.get("worldgen.run") and got.metadata.get("worldgen.run"):
-                        names.discard(row["run"])
-                        row["run"] = _run_name(world_id, task_id, got.metadata["worldgen.run"], names)
-                except RunMismatchError as exc:  # read, and not this task's run: a failure, not missing data
-                    extra.append(row)
-                    plots.append(None)
-                    yield {"world": g, "task": task, "refused": str(exc)}
-                    continue
-                row.update(source=got.source, source_detail=got.source_detail, drift_bounded=got.drift_bounded,
-                           start=got.start, start_time=got.start_time)
-                extra.append(row)
-                points = Path(scratch.name) / f"{len(plots)}.npy"
-                np.save(points, _decimate(got.trajectory))
-                plots.append({"world": folder, "task": task, "points": points})
-                # evaluate reads the run's scenario from the world's folder, or builds it from an unwritten World
-                yield got.trajectory, g if g.path is not None else folder, task
-            except WorldgenError as exc:
-                row.update(run=row["run"] or _unique(_stem(item.bag), names), readable=False, outcome="unjudged",
-                           reason=str(exc), success=None, world_id=None, task=item.task)
-                extra.append(row)
-                plots.append(None)
-            finally:
-                if progress is not None:
-                    progress(k + 1)
-
+    batch = _Batch(plan(bags, world=world, pack=pack, runs=runs), pack, dict(read_options or {}), start, progress)
     report: Optional[dict] = None
-    runs_iter = judged()
+    runs_iter = batch.judged()
     try:
         first = next(runs_iter)
     except StopIteration:
@@ -293,7 +223,90 @@ def judge(bags: Sequence = (), criteria: Any = None, *, world=None, pack=None, r
             yield first
             yield from runs_iter
         report = evaluate(chained(), criteria).to_dict()
-    return JudgeResult(_assemble(report, extra), plots, scratch)
+    return JudgeResult(_assemble(report, batch.extra), batch.plots, batch.scratch)
+
+
+class _Batch:
+    """One call of :func:`judge` as it reads its bags: each world's ground truth (the last :data:`_CACHE` kept),
+    per bag its row of the judge's columns (``extra``; judged ones also get evaluate's) and its picture's data
+    (``plots``), and the run names taken."""
+
+    def __init__(self, items: list[Item], pack, options: dict, start: str, progress: Optional[Callable[[int], None]]):
+        self.items, self.pack, self.options, self.start, self.progress = items, pack, options, start, progress
+        self.packs: dict[str, dict[str, Path]] = {}
+        if pack is not None:  # a pack that is missing or holds no world is a usage mistake, not 20 unjudged bags
+            self.packs[str(pack)] = _index(pack)
+        self.grounds: OrderedDict[Any, Ground] = OrderedDict()
+        self.extra: list[dict] = []
+        self.plots: list[Optional[dict]] = []
+        self.scratch = tempfile.TemporaryDirectory(prefix="worldgen-judge-")
+        if items and _archived(items[0].world):  # evaluate reads scenario.yaml from a folder: the world's, extracted
+            archived = items[0].world
+            folder = archived.pack.source.extract_folder(archived.folder, Path(self.scratch.name) / "world")
+            self.items = [replace(item, world=folder) for item in items]
+        self.names: set[str] = set()
+
+    def ground(self, world) -> Ground:
+        key = world.resolve() if isinstance(world, Path) else id(world)  # a World or pack world: the object itself
+        if key not in self.grounds:
+            self.grounds[key] = load(world)
+            if len(self.grounds) > _CACHE:
+                self.grounds.popitem(last=False)
+        self.grounds.move_to_end(key)
+        return self.grounds[key]
+
+    def judged(self) -> Iterator[Any]:
+        """What evaluate judges, bag by bag: (trajectory, ground, task) of a run, or a refused run; a bag that
+        cannot be read, or whose world is not found, gets its unjudged row instead."""
+        for k, item in enumerate(self.items):
+            row: dict[str, Any] = {"bag": str(item.bag), "run": None, "readable": True}
+            try:
+                yield from self._read(item, row)
+            except WorldgenError as exc:
+                row.update(run=row["run"] or _unique(_stem(item.bag), self.names), readable=False, outcome="unjudged",
+                           reason=str(exc), success=None, world_id=None, task=item.task)
+                self.extra.append(row)
+                self.plots.append(None)
+            finally:
+                if self.progress is not None:
+                    self.progress(k + 1)
+
+    def _read(self, item: Item, row: dict[str, Any]) -> Iterator[Any]:
+        """One bag read in its world, its row filled in: the run, or a refused run (read, and not this task's)."""
+        from worldgen.ros.reader import RunMismatchError, peek_metadata, read_run
+
+        named = peek_metadata(item.bag)
+        folder, task = item.world, item.task or named.get("worldgen.task")
+        if folder is None:
+            if not named.get("worldgen.world_id"):
+                raise ParameterError(f"bag '{item.bag}': names no world in its metadata (worldgen.world_id); "
+                                     "give --world DIR or --runs TABLE")
+            folder = _pack_world(self.pack, named["worldgen.world_id"], self.packs)
+        g = self.ground(folder)
+        world_id, task_id = str(g.meta.get("world_id")), g.task(task)["id"]
+        row["run"] = _run_name(world_id, task_id, item.run or named.get("worldgen.run"), self.names)
+        # None where the world has no folder of its own: an unwritten World, an archive's world extracted
+        row["world_folder"] = None if g.path is None or Path(self.scratch.name) in g.path.parents else str(g.path)
+        try:
+            _same_world(item.bag, named, world_id)
+            got = read_run(item.bag, g, task=task, start=self.start, **self.options)
+            _same_world(item.bag, got.metadata, world_id)  # a bare storage file carries its own
+            if item.run is None and not named.get("worldgen.run") and got.metadata.get("worldgen.run"):
+                self.names.discard(row["run"])
+                row["run"] = _run_name(world_id, task_id, got.metadata["worldgen.run"], self.names)
+        except RunMismatchError as exc:  # read, and not this task's run: a failure, not missing data
+            self.extra.append(row)
+            self.plots.append(None)
+            yield {"world": g, "task": task, "refused": str(exc)}
+            return
+        row.update(source=got.source, source_detail=got.source_detail, drift_bounded=got.drift_bounded,
+                   start=got.start, start_time=got.start_time)
+        self.extra.append(row)
+        points = Path(self.scratch.name) / f"{len(self.plots)}.npy"
+        np.save(points, _decimate(got.trajectory))
+        self.plots.append({"world": folder, "task": task, "points": points})
+        # evaluate reads the run's scenario from the world's folder, or builds it from an unwritten World
+        yield got.trajectory, g if g.path is not None else folder, task
 
 
 def _archived(world) -> bool:
@@ -331,7 +344,7 @@ def _assemble(judged: Optional[dict], extra: list[dict]) -> dict:
             row["outcome"] = "success" if row.get("success") else "failure"
         rows.append(row)
     unjudged = sum(r["outcome"] == "unjudged" for r in rows)
-    report = dict(judged) if judged else {"passed": False, "failures": [], "summary": {"runs": 0, "successes": 0},
+    report: dict[str, Any] = dict(judged) if judged else {"passed": False, "failures": [], "summary": {"runs": 0, "successes": 0},
                                           "criteria": []}
     report["runs"] = rows
     report["summary"] = dict(report["summary"]) | {"bags": len(extra), "unjudged": unjudged}

@@ -41,7 +41,7 @@ import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Optional
+from typing import Any, NoReturn, Optional
 
 import yaml
 
@@ -184,7 +184,7 @@ class _Reader:
         self.source = source
         self._constructor = yaml.SafeLoader("")
 
-    def fail(self, node, key: str, message: str):
+    def fail(self, node, key: str, message: str) -> NoReturn:
         raise RecipeError(f"{self.source}:{node.start_mark.line + 1}: key '{key}': {message}")
 
     def value(self, node) -> Any:
@@ -212,7 +212,6 @@ class _Reader:
         return out
 
     def seeds(self, node) -> tuple[int, ...]:
-
         value = self.value(node)
         if _is_int(value):
             if not 1 <= value <= MAX_WORLDS:

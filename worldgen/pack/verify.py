@@ -43,7 +43,8 @@ def verify_pack(path, regenerate: bool = False) -> Iterator[tuple[bool, str]]:
 
 def _world(pack: Pack, world, validate, regenerate: bool) -> tuple[bool, str]:
     src = pack.source
-    if f"{world.folder}/{METADATA_NAME}" not in world.files:
+    meta_rel = f"{world.folder}/{METADATA_NAME}"
+    if meta_rel not in world.files:
         return False, f"FAIL {world.world_id}: files: {METADATA_NAME} is not listed in the manifest"
     for rel, digest in sorted(world.files.items()):
         if not rel.startswith(world.folder + "/"):

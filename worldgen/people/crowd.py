@@ -7,13 +7,8 @@ Each person ``a`` accelerates as
 
 - ``e_a``: the unit direction to the next waypoint of the shortest path for the person's disc (exact;
   a walk of many legs has them all answered by one tangent graph, :mod:`~worldgen.feasibility.roadmap`,
-  a short one asks :mod:`~worldgen.feasibility.planner` leg by leg); a waypoint is
-  passed when the next one is in sight (checked every :data:`LOOK` steps), and the path is planned
-  again from where the person stands when its waypoint has been out of sight for :data:`REPLAN`
-  checks (unless the waypoint before it is in sight: then the person walks back to that one, which
-  leads on); a person who has moved less than :data:`STUCK` m a look for ``2 x REPLAN`` looks in a row
-  (held by others or by a wall's push near a place) gives that place up and walks to the next; a place
-  in another pocket of the floor (:mod:`~worldgen.people.reach`) is given up without asking the planner;
+  a short one asks :mod:`~worldgen.feasibility.planner` leg by leg); which waypoint that is, and when
+  a path is planned again or a place given up, is :mod:`~worldgen.people.routing`'s;
 - ``f_ab = -grad V(b)``, ``V = V0 exp(-(b - 2 r) / sigma)``, ``b`` the semi-minor axis of the
   ellipse of the paper (``2 b = sqrt((|r_ab| + |r_ab - v_b dt_h|)^2 - |v_b dt_h|^2)``), less the two
   radii: the paper's pedestrians are points, ours discs;
@@ -26,9 +21,11 @@ Each person ``a`` accelerates as
 
 Integration is semi-implicit Euler at ``dt``, speeds capped at ``1.3 v0`` (the paper's v_max). A
 person before its departure time, or past its last place, stands still: an obstacle the others walk
-round. After each step the geometry is enforced, not hoped for: a step whose straight segment would bring the disc
-within ``radius + 2 SLACK`` of a footprint (exact segment distances) or the floor's edge is halved
-up to four times, else not taken, and the velocity set to the step actually made. So every
+round.
+
+After each step the geometry is enforced, not hoped for: a step whose straight segment would bring
+the disc within ``radius + 2 SLACK`` of a footprint (exact segment distances) or the floor's edge is
+halved up to four times, else not taken, and the velocity set to the step actually made. So every
 position, and every point between two rows of the written trajectory, keeps the person's disc off
 every obstacle. People may still touch each other: the model makes it rare, nothing forbids it.
 
@@ -53,7 +50,7 @@ from worldgen.floats import round_float
 from worldgen.people.behaviours import widest_tube
 from worldgen.people.groups import GroupForce, group_force
 from worldgen.people.places import PERSON_HEIGHT, SLACK, draw_people, people_footprints
-from worldgen.people.reach import Pockets
+from worldgen.people.routing import ARRIVE, LOOK, REPLAN, STUCK, Router
 from worldgen.scene import Mover, Robot, Scene, Task
 
 __all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF",
@@ -61,17 +58,9 @@ __all__ = ["SocialForce", "DT", "LOOK", "REPLAN", "ARRIVE", "STUCK", "CUTOFF",
 
 #: The integration step (s); the trajectories are written at it.
 DT = 0.1
-#: Steps between two looks ahead (is the next waypoint in sight?).
-LOOK = 5
-#: Looks with the waypoint out of sight before the path is planned again from where the person is.
-REPLAN = 4
-#: Distance (m) at which a waypoint counts as reached.
-ARRIVE = 0.2
 #: Distance (m) from a person's centre beyond which an obstacle's push is left out: U0 / R exp(-7.5),
 #: 0.03 m/s^2, a hundredth of what a person's own drive gives.
 CUTOFF = 1.5
-#: Least distance (m) a walking person covers between two looks before it counts as held up.
-STUCK = 0.1
 #: Exact route queries a walk asks per person and second walked (measured 0.119 in the benchmark's world:
 #: 143 for 20 people over 60 s); :func:`~worldgen.feasibility.exact.exact_planner` picks the planner by it.
 #: A power of two, so that the choice is the one made with the two figures below before (exactly so wherever
@@ -186,96 +175,6 @@ def _runs(who: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return first, who[first]
 
 
-class _Router:
-    """Each person's places and the planned path to the current one; ``target`` the waypoint steered to."""
-
-    def __init__(self, planner: ExactPlanner, sight: ConfigSpace, starts: np.ndarray, places: np.ndarray):
-        # Sight is tested in a configuration space SLACK thinner than the planner's (a waypoint on a planner's
-        # circle is then in sight, not touching); places in another pocket are skipped without a query.
-        self.planner, self.sight, self.places, self.pockets = planner, sight, places, Pockets(planner.cs)
-        n = len(starts)
-        self.place = np.full(n, -1)
-        self.route: list[np.ndarray] = [np.zeros((0, 2))] * n
-        self.way = np.zeros(n, dtype=np.int64)
-        self.unseen = np.zeros(n, dtype=np.int64)
-        self.held = np.zeros(n, dtype=np.int64)
-        self.last = starts.copy()
-        self.done = np.zeros(n, dtype=bool)
-        self.target = starts.copy()
-        for i in range(n):
-            self._next_place(i, starts[i])
-
-    def _next_place(self, i: int, at: np.ndarray) -> None:
-        """Plan from ``at`` to the next place that can be reached; done when none is left."""
-        while self.place[i] + 1 < self.places.shape[1] and not np.isnan(self.places[i, self.place[i] + 1, 0]):
-            self.place[i] += 1
-            if self._plan(i, at):
-                return
-        self.done[i] = True
-        self.target[i] = at
-
-    def _plan(self, i: int, at: np.ndarray) -> bool:
-        goal = self.places[i, self.place[i]]
-        route = None if self.pockets.apart(at, goal) else self.planner.shortest(at, goal)
-        if route is None:
-            return False
-        # The route keeps its start, so that the waypoint before the one steered at always exists.
-        self.route[i], self.way[i], self.unseen[i] = route.points, 1, 0
-        self.target[i] = self.route[i][1]
-        return True
-
-    def update(self, p: np.ndarray, step: int, waiting: np.ndarray) -> None:
-        """Pass reached waypoints; every LOOK steps, skip to a waypoint in sight or plan again
-        (``waiting``: those not yet set off, left alone)."""
-        reached = ~self.done & ~waiting & (np.hypot(*(self.target - p).T) < ARRIVE)
-        for i in np.flatnonzero(reached):
-            self._advance(i, p[i])
-        if step % LOOK:
-            return
-        live = np.flatnonzero(~self.done & ~waiting)
-        if not len(live):
-            return
-        moved = np.hypot(*(p - self.last).T) >= STUCK
-        self.held = np.where(moved | waiting, 0, self.held + 1)
-        self.last = p.copy()
-        for i in live[self.held[live] >= 2 * REPLAN]:
-            self.held[i] = 0
-            self._next_place(i, p[i])
-        live = live[~self.done[live]]
-        if not len(live):
-            return
-        cs = self.sight
-        routes, way = [self.route[i] for i in live], self.way[live]
-        ahead = np.array([r[min(w + 1, len(r) - 1)] for r, w in zip(routes, way)])
-        back = np.array([r[w - 1] for r, w in zip(routes, way)])
-        seen = cs.segments_clear(np.vstack([p[live]] * 3), np.vstack([ahead, self.target[live], back]))
-        m = len(live)
-        see_ahead, see_target, see_back = seen[:m], seen[m:2 * m], seen[2 * m:]
-        for k, i in enumerate(live):
-            if see_ahead[k] and self.way[i] + 1 < len(self.route[i]):
-                self.way[i] += 1
-                self.target[i] = self.route[i][self.way[i]]
-                see_target[k] = True
-        self.unseen[live[see_target]] = 0
-        blind = np.flatnonzero(~see_target)
-        self.unseen[live[blind]] += 1  # looks in a row with the waypoint out of sight
-        for k in blind[self.unseen[live[blind]] >= REPLAN]:
-            i = live[k]
-            self.unseen[i] = 0
-            if see_back[k]:  # pushed back round a corner: the waypoint before is in sight, and leads on
-                self.way[i] -= 1
-                self.target[i] = self.route[i][self.way[i]]
-            elif self.planner.cs.points_clearance(p[i][None])[0] > 0:
-                self._plan(i, p[i])
-
-    def _advance(self, i: int, at: np.ndarray) -> None:
-        if self.way[i] + 1 < len(self.route[i]):
-            self.way[i] += 1
-            self.target[i] = self.route[i][self.way[i]]
-        else:
-            self._next_place(i, at)
-
-
 def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndarray, speeds: np.ndarray,
              radius: float, duration: float, dt: float = DT, model: SocialForce = SocialForce(),
              depart: Optional[np.ndarray] = None, groups: Optional[np.ndarray] = None,
@@ -296,7 +195,7 @@ def simulate(obstacles: Obstacles2D, bounds, starts: np.ndarray, places: np.ndar
     if n == 0:
         return out
     walls = _Walls(obstacles, bounds)
-    router = _Router(_route_finder(ConfigSpace.build(obstacles, radius + SLACK, bounds), n, duration),
+    router = Router(_route_finder(ConfigSpace.build(obstacles, radius + SLACK, bounds), n, duration),
                      ConfigSpace.build(obstacles, radius, bounds), starts, places)
     keep = radius + 2 * SLACK
     leave = np.zeros(n) if depart is None else np.asarray(depart, dtype=float)
@@ -394,5 +293,7 @@ def walk_plan(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping
         still = np.all(xy[1:-1] == xy[:-2], axis=1) & np.all(xy[1:-1] == xy[2:], axis=1)
         keep = np.r_[True, ~still, True]
         rows = np.column_stack([times[keep], xy[keep]])
-        people.append(Mover(f"person_{i}", plan.radius, PERSON_HEIGHT, rows, False, params["friction"], person=True))
+        # Mover takes the (k, 3) array as it is and stores it as rows (its __post_init__), faster than tuples here.
+        people.append(Mover(f"person_{i}", plan.radius, PERSON_HEIGHT, rows, False,  # type: ignore[arg-type]
+                            params["friction"], person=True))
     return tuple(people)

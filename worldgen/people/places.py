@@ -136,8 +136,8 @@ def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
         scripted, reason = _scripted(scenario, scene, tasks[0], float(speeds[0]), params, pool.index, clear_r)
         if scripted is None:
             return None, reason
-        for j, (start, route, leave) in enumerate(scripted):
-            starts.append(start)
+        for j, (point, route, leave) in enumerate(scripted):
+            starts.append(point)
             places[j] = np.nan
             places[j, : len(route)] = route
             depart[j] = leave

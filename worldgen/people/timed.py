@@ -163,7 +163,7 @@ def certify(report: FeasibilityReport, scene, tasks, robot, max_speed: float,
     if missing:
         check = Check("timed_path", False, None, "no timed path among the people for " + "; ".join(missing))
     else:
-        latest = max(t.arrival for t in found)
+        latest = max(t.arrival for t in found if t is not None)  # none missing: all found
         check = Check("timed_path", True, latest,
                       f"{len(found)} timed path(s) among {len(people)} people, latest arrival {latest:.2f} s")
     return replace(report, checks=report.checks + (check,), timed_paths=tuple(found))

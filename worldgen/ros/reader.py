@@ -165,8 +165,8 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
         from worldgen.groundtruth.ground import load
         spawn = np.asarray(load(world).task(task)["spawn"], dtype=float)[[0, 1, 5]]
     try:
-        source, meta = storage(path)
-        with AnyReader([source], default_typestore=typestore(distro)) as reader:
+        store, meta = storage(path)
+        with AnyReader([store], default_typestore=typestore(distro)) as reader:
             meta = meta or bag_metadata(reader)
             topics = {c.topic: c.msgtype for c in reader.connections}
             st = None  # a bag without any pose topic is refused by its topic list: no message is read
@@ -184,7 +184,7 @@ def read_run(bag, world=None, *, task: Optional[str] = None, start: str = "comma
     found = ", ".join(f"{t} ({ty})" for t, ty in sorted(topics.items())) or "none"
     source, detail, traj = _pose(st, spawn, pose_topic, odom_topic, map_frame, odom_frame, base_frames) if st else \
         (None, "", None)
-    if traj is None:
+    if traj is None or source is None:  # _pose names a source with every trajectory
         need = f"{pose_topic}, /tf with {map_frame}->{odom_frame}->{'|'.join(base_frames)}, or {odom_topic}"
         has_odometry = st is not None and ((st["odom"] is not None and len(st["odom"].data))
                                            or any(len(b.data) for b in st["base"].values()))

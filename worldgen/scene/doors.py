@@ -153,6 +153,7 @@ def door_records(scene: Scene) -> list[dict]:
 def _leaf_width(leaf: Node) -> float:
     if isinstance(leaf.shape, Box):
         return leaf.shape.size[0]
+    assert leaf.shape is not None, "a door's leaf has a shape"
     lo, hi = leaf.shape.local_corners().min(axis=0), leaf.shape.local_corners().max(axis=0)
     return float(max(hi[0] - lo[0], hi[1] - lo[1]))
 
@@ -191,7 +192,7 @@ def leaves_in_the_way(scene: Scene, waypoints, radius: float, height: float) -> 
         fp = prints.get(name)
         if fp is None:  # a leaf entirely above the robot
             continue
-        shadow = fp.polygon if not fp.is_disc else shapely.Point(fp.centre).buffer(fp.radius, quad_segs=64)
+        shadow = fp.polygon if fp.polygon is not None else shapely.Point(fp.centre).buffer(fp.radius, quad_segs=64)
         if shadow.distance(path) < radius:
             out.append(name)
     return out

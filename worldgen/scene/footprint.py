@@ -17,6 +17,7 @@ import numpy as np
 import shapely
 
 from worldgen.scene.graph import Scene
+from worldgen.scene.shapes import Box, Cylinder, Mesh, Sphere
 
 __all__ = ["Footprint", "FootprintIndex", "scene_footprints", "robot_footprints", "SAFETY"]
 
@@ -45,7 +46,8 @@ class Footprint:
 
     def bounds(self) -> tuple[float, float, float, float]:
         """(minx, miny, maxx, maxy)."""
-        if self.is_disc:
+        if self.polygon is None:
+            assert self.centre is not None, "a disc footprint has a centre"
             cx, cy = self.centre
             return (cx - self.radius, cy - self.radius, cx + self.radius, cy + self.radius)
         return tuple(self.polygon.bounds)
@@ -81,26 +83,28 @@ def _footprints(scene: Scene, height: float) -> list[Footprint]:
     for node in scene.colliders():
         m = scene.world_matrix(node.name)
         shape = node.shape
+        if shape is None:  # colliders() gives only nodes with a shape
+            continue
         upright = abs(abs(m[2, 2]) - 1.0) < _VERTICAL
-        if shape.kind == "box" and upright:
+        if isinstance(shape, Box) and upright:
             boxes.append((len(out), node, m))
             out.append(None)
             continue
-        if shape.kind == "sphere" or (shape.kind == "cylinder" and upright):
+        if isinstance(shape, Sphere) or (isinstance(shape, Cylinder) and upright):
             zc = m[2, 3]
-            half = shape.radius if shape.kind == "sphere" else shape.length / 2
+            half = shape.radius if isinstance(shape, Sphere) else shape.length / 2
             if zc + half <= 1e-9 or zc - half >= height:
                 continue
             radius = shape.radius
-            if shape.kind == "sphere":
+            if isinstance(shape, Sphere):
                 # The widest slice inside the slab: the equator, unless it lies outside it.
                 dz = 0.0 if 0.0 <= zc <= height else min(abs(zc), abs(zc - height))
                 radius = float(np.sqrt(max(shape.radius**2 - dz**2, 0.0)))
             out.append(Footprint(node.name, node.role, centre=(float(m[0, 3]), float(m[1, 3])), radius=radius))
             continue
-        if shape.kind == "mesh":
+        if isinstance(shape, Mesh):
             pts = shape.scaled_vertices() @ m[:3, :3].T + m[:3, 3]
-        elif shape.kind == "cylinder":
+        elif isinstance(shape, Cylinder):
             # A tilted cylinder: the hull of its two end circles, sampled finely and pushed out
             # so the polygon contains the true shadow.
             ang = np.linspace(0, 2 * np.pi, 64, endpoint=False)

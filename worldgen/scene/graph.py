@@ -21,14 +21,12 @@ from worldgen.floats import round_float
 from worldgen.scene.mover import Mover
 from worldgen.scene.names import NAME_PATTERN
 from worldgen.scene.pose import Pose
-from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, unit_inertia
+from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, Sphere, canonical_shape, unit_inertia
 
 __all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN", "Mover"]
 
 #: Every role a node may have. Markers carry no collision geometry.
 ROLES = ("floor", "wall", "obstacle", "door", "door_frame", "marker")
-
-#: Names become element names in three formats and file names of meshes: keep them plain.
 
 
 @dataclass(frozen=True)
@@ -83,7 +81,8 @@ class Node:
         """Principal moments (ixx, iyy, izz) about the centre, kg m^2."""
         if self.shape is None:
             return (1e-6, 1e-6, 1e-6)
-        return tuple(self.mass * i for i in unit_inertia(self.shape))
+        ixx, iyy, izz = unit_inertia(self.shape)
+        return (self.mass * ixx, self.mass * iyy, self.mass * izz)
 
 
 @dataclass(frozen=True)
@@ -272,19 +271,20 @@ class Scene:
     def _fill_aabbs(self, names) -> None:
         """Remember the world boxes of ``names``: boxes and cylinders each in one vectorised pass (tight:
         a box's half extents through |R|, a cylinder's |a_i| h/2 + r sqrt(1 - a_i^2) along world axis i)."""
-        boxes = [name for name in names if isinstance(self._by_name[name].shape, Box)]
+        shapes = {name: self._by_name[name].shape for name in names}
+        boxes = {name: s for name, s in shapes.items() if isinstance(s, Box)}
         if boxes:
             m = np.stack([self.world_matrix(name) for name in boxes])
-            half = np.array([self._by_name[name].shape.size for name in boxes], dtype=float) / 2.0
-            self._cache_boxes(boxes, m[:, :3, 3], np.einsum("kij,kj->ki", np.abs(m[:, :3, :3]), half))
-        cylinders = [name for name in names if isinstance(self._by_name[name].shape, Cylinder)]
+            half = np.array([s.size for s in boxes.values()], dtype=np.float64) / 2.0
+            self._cache_boxes(list(boxes), m[:, :3, 3], np.einsum("kij,kj->ki", np.abs(m[:, :3, :3]), half))
+        cylinders = {name: s for name, s in shapes.items() if isinstance(s, Cylinder)}
         if cylinders:
             m = np.stack([self.world_matrix(name) for name in cylinders])
-            length = np.array([self._by_name[name].shape.length for name in cylinders], dtype=float)
-            radius = np.array([self._by_name[name].shape.radius for name in cylinders], dtype=float)
+            length = np.array([s.length for s in cylinders.values()], dtype=np.float64)
+            radius = np.array([s.radius for s in cylinders.values()], dtype=np.float64)
             axis = m[:, :3, 2]
             reach = np.abs(axis) * length[:, None] / 2 + radius[:, None] * np.sqrt(np.clip(1 - axis**2, 0, 1))
-            self._cache_boxes(cylinders, m[:, :3, 3], reach)
+            self._cache_boxes(list(cylinders), m[:, :3, 3], reach)
         for name in names:
             if name in self._aabb_cache:
                 continue
@@ -294,7 +294,7 @@ class Scene:
             elif isinstance(node.shape, Mesh):  # tight: the turned vertices, not a turned box
                 pts = node.shape.scaled_vertices() @ m[:3, :3].T + m[:3, 3]
                 self._remember(name, pts.min(axis=0), pts.max(axis=0))
-            else:  # a sphere
+            elif isinstance(node.shape, Sphere):  # boxes and cylinders were cached above
                 self._cache_boxes([name], m[None, :3, 3], np.full((1, 3), node.shape.radius))
 
     def _cache_boxes(self, names, centres: np.ndarray, reaches: np.ndarray) -> None:
@@ -340,25 +340,13 @@ class Scene:
         return Scene(self.nodes, self.joints, self.bounds, self.physics, tuple(movers))
 
 
-def _canonical_shape(shape) -> Optional[dict]:
-    if shape is None:
-        return None
-    d = {k: ([round_float(x) for x in v] if isinstance(v, (list, tuple)) else (round_float(v) if isinstance(v, float) else v))
-         for k, v in shape.describe().items()}
-    if isinstance(shape, Mesh):
-        d["geometry_sha256"] = hashlib.sha256(
-            np.round(shape.vertices, 6).astype("<f8").tobytes() + shape.faces.astype("<i8").tobytes()
-        ).hexdigest()
-    return d
-
-
 def _canonical_node(n: Node) -> dict:
     return {
         "name": n.name,
         "role": n.role,
         "parent": n.parent,
         "pose": [round_float(v) for v in n.pose.as_list()],
-        "shape": _canonical_shape(n.shape),
+        "shape": canonical_shape(n.shape),
         "static": n.static,
         "mass": round_float(n.mass),
         "collision": n.collision,

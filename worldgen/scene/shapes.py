@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+import hashlib
 import math
 from dataclasses import dataclass, field
-from typing import Union
+from typing import Optional, Union
 
 import numpy as np
 
 from worldgen.errors import SceneError
+from worldgen.floats import round_float
 
-__all__ = ["Box", "Cylinder", "Sphere", "Mesh", "Shape", "unit_inertia"]
+__all__ = ["Box", "Cylinder", "Sphere", "Mesh", "Shape", "unit_inertia", "canonical_shape"]
 
 
 def _positive(kind: str, name: str, value: float) -> float:
@@ -180,3 +182,17 @@ def unit_inertia(shape: Shape) -> tuple[float, float, float]:
         i = 0.4 * shape.radius**2
         return (i, i, i)
     raise SceneError(f"unknown shape {shape!r}")
+
+
+def canonical_shape(shape: Optional[Shape]) -> Optional[dict]:
+    """The shape's part of a scene's canonical description (what its content hash is taken of): its
+    :meth:`describe` with floats rounded, and for a mesh the SHA-256 of its rounded geometry."""
+    if shape is None:
+        return None
+    d = {k: ([round_float(x) for x in v] if isinstance(v, (list, tuple)) else (round_float(v) if isinstance(v, float) else v))
+         for k, v in shape.describe().items()}
+    if isinstance(shape, Mesh):
+        d["geometry_sha256"] = hashlib.sha256(
+            np.round(shape.vertices, 6).astype("<f8").tobytes() + shape.faces.astype("<i8").tobytes()
+        ).hexdigest()
+    return d

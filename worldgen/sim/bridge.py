@@ -19,6 +19,7 @@ import subprocess
 import tempfile
 from importlib import resources
 from pathlib import Path
+from typing import IO
 
 from lxml import etree
 
@@ -26,6 +27,7 @@ from worldgen.errors import OutputError
 from worldgen.export.contract import CMD_VEL, GROUND_TRUTH
 from worldgen.export.robot import DEFAULT_NAME
 from worldgen.export.xml import safe_parser
+from worldgen.files import move_into_place
 from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate, user_cache
 
 __all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "GazeboBackend", "world_step"]
@@ -64,7 +66,7 @@ def build_bridge(env: dict[str, str] | None = None) -> Path:
             built = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
             if built.returncode != 0:
                 raise GazeboError(f"building the Gazebo drive bridge failed: {built.stderr.strip()[:500]}")
-            os.replace(out, exe)  # a rename: a parallel run never starts half a binary
+            move_into_place(out, exe)  # a rename: a parallel run never starts half a binary
     except OSError as exc:
         raise OutputError(f"cannot build the Gazebo drive bridge in '{exe.parent}' ({exc.strerror or exc}); "
                           "set XDG_CACHE_HOME to a writable folder") from None
@@ -91,7 +93,7 @@ class GazeboBackend:
         self._robot_sdf, self._robot_name = robot_sdf, DEFAULT_NAME  # robot_sdf's model name
         self._server: GazeboServer | None = None
         self._bridge: subprocess.Popen | None = None
-        self._model = None
+        self._model: IO[str] | None = None  # the robot's SDF, a file the bridge reads
 
     def start(self, spawn: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
         """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
@@ -100,12 +102,12 @@ class GazeboBackend:
         self._server = GazeboServer(self.world_sdf, install=install).start()
         # The server's environment carries its own IGN_PARTITION: the bridge must share it.
         env = self._server.env
-        self._model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
-        self._model.write(self._robot_sdf)
-        self._model.flush()
+        self._model = model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
+        model.write(self._robot_sdf)
+        model.flush()
         self._bridge = subprocess.Popen(
             [str(exe), self._server.world, CMD_VEL.gazebo_topic, GROUND_TRUTH.gazebo_topic, str(round(self.dt * 1e9)),
-             self._model.name, self._robot_name, *(repr(float(v)) for v in spawn)],
+             model.name, self._robot_name, *(repr(float(v)) for v in spawn)],
             env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
         first = self._read()
         if first != "ready":

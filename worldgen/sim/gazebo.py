@@ -14,6 +14,7 @@ The API (stable; the robot-driving loop builds on it)::
 
 - :func:`locate` finds an install (``WORLDGEN_GAZEBO_SETUP``, else ``/opt/gz-fortress2/setup.sh``) and reads its
   setup script's exports into an environment (no shell runs it); :class:`GazeboMissingError` says how to install.
+  Both live in :mod:`worldgen.sim.gazebo_install` and are importable from here too.
 - The server is a direct child (an argument list, never a shell) in its own process group; leaving the block
   stops it (SIGINT, SIGTERM, then SIGKILL 3 s later: with a render engine it may ignore the polite signals) and
   checks that no process of its group survives.
@@ -27,23 +28,24 @@ import re
 import subprocess
 import tempfile
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
-from worldgen.errors import SimulatorError, SimulatorMissingError
+from worldgen.errors import SimulatorError
 from worldgen.sim import textproto
+from worldgen.sim.gazebo_install import (
+    DEFAULT_SETUP,
+    INSTALL_HINT,
+    SETUP_ENV,
+    GazeboInstall,
+    GazeboMissingError,
+    locate,
+    user_cache,
+)
 from worldgen.sim.procs import group_members, run_tool, stop_group
 from worldgen.sim.topics import Subscription
 
 __all__ = ["GazeboMissingError", "GazeboError", "GazeboInstall", "GazeboServer", "locate", "SETUP_ENV",
            "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name", "user_cache"]
-
-#: The environment variable naming an install's setup script, and the script used without it.
-SETUP_ENV = "WORLDGEN_GAZEBO_SETUP"
-DEFAULT_SETUP = Path("/opt/gz-fortress2/setup.sh")
-INSTALL_HINT = ("install Gazebo Fortress (on Debian 12: apt-get install libsdformat-dev libignition-fuel-tools-dev "
-                "libignition-msgs-dev libignition-plugin-dev libignition-transport-dev, then bash shared/gazebo/install.sh; "
-                "see docs/gazebo.md) or point WORLDGEN_GAZEBO_SETUP at its setup.sh")
 
 #: Lines Gazebo prints that say nothing about the world, each with why it is harmless.
 HARMLESS: dict[str, str] = {
@@ -60,58 +62,8 @@ _DART_DEFAULT = "libignition-physics-dartsim-plugin.so"
 _DART_DEBIAN = Path("/usr/lib/x86_64-linux-gnu/ign-physics-5/engine-plugins/libignition-physics5-dartsim-plugin.so.5")
 
 
-class GazeboMissingError(SimulatorMissingError):
-    """No usable Gazebo install: the message names where it looked and how to install one."""
-
-
 class GazeboError(SimulatorError):
     """Gazebo ran but did not do what was asked (the world did not come up, a service did not answer)."""
-
-
-@dataclass(frozen=True)
-class GazeboInstall:
-    """One Gazebo install: its setup script, the environment that script builds, its ``ign gazebo`` version."""
-
-    setup: Path
-    env: dict[str, str] = field(repr=False)
-    version: str
-
-
-def _exports(setup: Path, base: dict[str, str]) -> dict[str, str]:
-    """The environment after ``export NAME=value`` lines of ``setup`` (``$VAR``/``${VAR:-}`` expanded)."""
-    env = dict(base)
-
-    def expand(value: str) -> str:
-        value = value.strip().strip('"').strip("'")
-        return re.sub(r"\$\{(\w+)(?::-[^}]*)?\}|\$(\w+)", lambda m: env.get(m.group(1) or m.group(2), ""), value)
-
-    for line in setup.read_text().splitlines():
-        m = re.match(r"\s*export\s+(\w+)=(.*)$", line)
-        if m:
-            env[m.group(1)] = expand(m.group(2)).rstrip(":")
-    return env
-
-
-def locate(setup: str | Path | None = None) -> GazeboInstall:
-    """The Gazebo install to use; the one place the tool-missing policy lives (raises :class:`GazeboMissingError`)."""
-    setup = Path(setup or os.environ.get(SETUP_ENV) or DEFAULT_SETUP)
-    if not setup.is_file():
-        raise GazeboMissingError(f"Gazebo not found: no setup script at {setup}; {INSTALL_HINT}")
-    env = _exports(setup, {k: v for k, v in os.environ.items()})
-    try:
-        out = run_tool(["ign", "gazebo", "--versions"], env, timeout=30)
-    except FileNotFoundError:
-        raise GazeboMissingError(f"Gazebo's 'ign' command is not on the PATH {setup} sets; {INSTALL_HINT}") from None
-    versions = [v for v in out.split() if re.fullmatch(r"\d+\.\d+\.\d+", v)]
-    if not versions:
-        raise GazeboMissingError(f"'ign gazebo --versions' with {setup} names no Gazebo ({out.strip()[:200]!r}); "
-                                 f"{INSTALL_HINT}")
-    return GazeboInstall(setup, env, versions[-1])
-
-
-def user_cache() -> Path:
-    """The user's cache folder: ``$XDG_CACHE_HOME``, else ``~/.cache``."""
-    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache")
 
 
 def _physics_args(env: dict[str, str]) -> list[str]:
@@ -272,8 +224,9 @@ class GazeboServer:
     def log(self) -> tuple[str, str]:
         """The server's (stdout, stderr) so far, colour codes removed."""
         logdir = Path(self._logdir.name)
-        return tuple(_ANSI.sub("", (logdir / s).read_text(errors="replace")) if (logdir / s).exists() else ""
-                     for s in ("stdout", "stderr"))  # type: ignore[return-value]
+        out, err = (_ANSI.sub("", (logdir / s).read_text(errors="replace")) if (logdir / s).exists() else ""
+                    for s in ("stdout", "stderr"))
+        return out, err
 
     def problems(self) -> list[str]:
         """Gazebo's error and warning lines so far (stdout and stderr), without the known harmless ones (those

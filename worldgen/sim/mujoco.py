@@ -15,7 +15,7 @@ import numpy as np
 from lxml import etree
 
 from worldgen.envs.movers import MoverScript
-from worldgen.envs.robot import add_robot, compile_world
+from worldgen.envs.robot import RobotModel, add_robot, compile_world
 from worldgen.export.xml import safe_parser
 from worldgen.groundtruth.folder import robot_of
 
@@ -39,19 +39,19 @@ class MujocoBackend:
         self._floor = sorted(e["name"] for e in meta["entities"] if e["role"] == "floor")
         self._movers = [m["name"] for m in meta.get("dynamic_obstacles", [])]
         self._script = MoverScript(meta.get("dynamic_obstacles", []))
-        self._sim = None
+        self._sim: RobotModel | None = None
         self.dt = 0.0
 
     def start(self, spawn: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
         import mujoco
 
         x, y, _, yaw = spawn
-        self._sim = compile_world(self._root, (x, y, yaw), self._floor, self._movers)
-        self.dt = float(self._sim.model.opt.timestep)
+        self._sim = sim = compile_world(self._root, (x, y, yaw), self._floor, self._movers)
+        self.dt = float(sim.model.opt.timestep)
         if len(self._script):
-            self._script.place(self._sim.data, self._sim.mocap, self._script.positions(np.zeros(1))[0])
-        mujoco.mj_forward(self._sim.model, self._sim.data)
-        return (float(self._sim.data.time), *self._sim.pose())
+            self._script.place(sim.data, sim.mocap, self._script.positions(np.zeros(1))[0])
+        mujoco.mj_forward(sim.model, sim.data)
+        return (float(sim.data.time), *sim.pose())
 
     def step(self, v: float, w: float, n: int) -> tuple[float, float, float, float]:
         import mujoco

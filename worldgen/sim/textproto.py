@@ -71,7 +71,9 @@ def parse(text: str) -> dict:
 
 def split_messages(text: str) -> list[str]:
     """``ign topic -e`` prints messages separated by blank lines; nested braces never hold a blank line."""
-    out, depth, current = [], 0, []
+    out: list[str] = []
+    current: list[str] = []
+    depth = 0
     for line in text.splitlines():
         if not line.strip() and depth == 0:
             if any(x.strip() for x in current):

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import pytest
 
+from worldgen.errors import ParameterError
+
 __all__ = ["pytest_addoption", "pytest_configure", "pytest_generate_tests", "worldgen_world", "world"]
 
 MARKER = "worldgen"
@@ -56,8 +58,9 @@ def pytest_configure(config):
 MARKER_ARGS = ("seeds", "allow_infeasible", "difficulty")
 
 
-class _MarkerError(Exception):
-    """A mistake in a marker's arguments: the test fails with this one line, the run goes on."""
+class _MarkerError(ParameterError):
+    """A mistake in a marker's arguments: the test fails with this one line, the run goes on. A ParameterError,
+    as the same mistake in a call of ``generate`` would be; importing worldgen.errors loads nothing else."""
 
 
 def pytest_generate_tests(metafunc):

@@ -80,6 +80,7 @@ class EditedWorld(World):
 
     @cached_property
     def content_hash(self) -> str:
+        # The generated world's own hash, through the cached_property on World (mypy reads it as the value).
         identity = {"world": World.content_hash.func(self),  # type: ignore[attr-defined]
                     "tasks": [_task_dict(t) for t in self.tasks], "edits": list(self.edits)}
         text = json.dumps(identity, sort_keys=True, separators=(",", ":"))
@@ -221,7 +222,8 @@ def _propose(world: World, op: str, rng: np.random.Generator) -> Optional[dict]:
         ranges = {k: tuple(world.params.get(k) or v) for k, v in _DEFAULT_RANGES.items()}
         height = round_float(rng.uniform(*ranges["obstacle_height"]))
         if rng.random() < 0.5:
-            sx, sy = (round_float(v) for v in rng.uniform(*ranges["box_size"], size=2))
+            low, high = ranges["box_size"]
+            sx, sy = (round_float(v) for v in rng.uniform(low, high, size=2))
             shape: dict = {"type": "box", "size": [sx, sy, height]}
             material = ("obstacle_box", (0.80, 0.52, 0.25, 1.0), float(world.params.get("friction", 1.0)))
         else:
@@ -266,7 +268,8 @@ def _shape_dict(shape) -> dict:
 
 def _node(name: str, shape: dict, x: float, y: float, yaw: float, material: Material) -> Node:
     if shape["type"] == "box":
-        made: Any = Box(tuple(float(v) for v in shape["size"]))
+        sx, sy, sz = (float(v) for v in shape["size"])
+        made: Any = Box((sx, sy, sz))
         height = made.size[2]
     else:
         made = Cylinder(float(shape["radius"]), float(shape["length"]))

@@ -47,6 +47,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from worldgen.errors import WorldgenError
 from worldgen.files import METADATA_NAME
 
 __all__ = ["CHECKS", "Outcome", "check_folder", "load_world", "LENGTH_TOLERANCE"]
@@ -75,7 +76,9 @@ class Outcome:
         return f"FAIL {self.folder}: {self.check}: {self.detail}"
 
 
-class _Fail(Exception):
+class _Fail(WorldgenError):
+    """The first check that fails; caught in check_folder, which turns it into the Outcome it returns."""
+
     def __init__(self, check: str, detail: str):
         super().__init__(detail)
         self.check, self.detail = check, " ".join(str(detail).split())
@@ -181,7 +184,6 @@ def _schema(meta: dict) -> None:
 
 def _regenerate(meta: dict):
     import worldgen
-    from worldgen.errors import WorldgenError
 
     try:
         world = worldgen.generate(meta["generator"], seed=meta["seed"],

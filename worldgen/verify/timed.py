@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from worldgen.errors import EXIT_FAILED, WorldgenError
+
 __all__ = ["TIMED_STEP", "ON_PATH", "TimedPathError", "check_timed"]
 
 #: Time step (s) at which a timed path is sampled against every person (docs/people.md: 2 ms).
@@ -32,8 +34,11 @@ TIMED_STEP = 0.002
 ON_PATH = 1e-5
 
 
-class TimedPathError(Exception):
-    """A timed path that does not hold: the message is the one line ``worldgen check`` prints."""
+class TimedPathError(WorldgenError):
+    """A timed path that does not hold: the message is the one line ``worldgen check`` prints. The world a user
+    received fails its check, which is no usage mistake: the command's exit status is that of a failed check."""
+
+    exit_status = EXIT_FAILED
 
 
 def check_timed(meta: dict, world) -> None:
