@@ -11,7 +11,7 @@ import worldgen
 from worldgen.errors import ParameterError
 from worldgen.export import metadata
 from worldgen.generators.registry import all_specs
-from worldgen.leveling import KNOBS, NO_LEVELS, reachable
+from worldgen.leveling import reachable
 from worldgen.seeding import level_seed
 
 
@@ -120,7 +120,7 @@ def test_other_generators_land_in_the_level_with_what_the_level_sets(generator, 
 
 def test_every_generator_has_its_levels_or_says_why_not():
     for spec in all_specs():
-        assert (spec.name in KNOBS) != (spec.name in NO_LEVELS), spec.name
+        assert (spec.knob is not None) != bool(spec.no_levels), spec.name
     assert reachable("cluttered") == tuple(range(1, 11)) and reachable("door") == tuple(range(2, 11))
     assert reachable("minimal") == ()
 
