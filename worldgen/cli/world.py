@@ -194,6 +194,8 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         if not allow_infeasible:
             raise
     require_formats(chosen := normalise_formats(formats))  # a missing extra (usd): before any world is drawn
+    if "osc" in chosen and not ros:  # its scenarios start the bundle's launch file
+        raise ParameterError("--formats osc writes scenarios that start the world's ROS 2 bundle: add --ros")
     if gz_release is not None and not ros:
         raise ParameterError(f"--gz-release {gz_release} names the Gazebo release of the ROS 2 bundle: add --ros")
     if seed + count - 1 > MAX_SEED:
