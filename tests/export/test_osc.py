@@ -189,6 +189,17 @@ def test_osc_without_the_bundle_is_refused_on_the_command_line(tmp_path, capsys)
     assert list(tmp_path.iterdir()) == []
 
 
+def test_osc_without_the_bundle_is_refused_in_a_pack_recipe():
+    from worldgen.pack.recipe import RecipeError, parse_recipe
+
+    worlds = "seeds: 1\nworlds:\n  - generator: minimal\n"
+    with pytest.raises(RecipeError) as caught:
+        parse_recipe("formats: [sdf, osc]\n" + worlds, "r.yaml")
+    assert str(caught.value) == ("r.yaml:1: key 'formats': osc writes scenarios that start each world's ROS 2 bundle: "
+                                 "add 'ros: true'")
+    assert parse_recipe("formats: [sdf, osc]\nros: true\n" + worlds, "r.yaml").formats == ("sdf", "osc")
+
+
 def test_worldgen_check_knows_world_osc(tmp_path, capsys):
     world = worldgen.generate("door", seed=2, n_movers=1)
     folder = world.write(tmp_path, formats=["sdf", "mjcf", "urdf", "osc"], ros=True)
