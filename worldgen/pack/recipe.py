@@ -163,8 +163,7 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
         except ParameterError:
             r.fail(top["ros"], "ros", f"must be true, false or a Gazebo release among {', '.join(GZ_RELEASES)}, "
                                       f"got {quoted(value)}")
-    if "osc" in formats and not ros:  # world.osc's scenarios start each world's bundle (docs/osc.md)
-        r.fail(top["formats"], "formats", "osc writes scenarios that start each world's ROS 2 bundle: add 'ros: true'")
+    _osc_needs_ros(r, top, formats, ros)
     default_seeds = r.seeds(top["seeds"]) if "seeds" in top else None
     worlds = top["worlds"]
     if not isinstance(worlds, yaml.SequenceNode) or not worlds.value:
@@ -177,6 +176,12 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
             if len(jobs) > MAX_WORLDS:
                 r.fail(worlds, "worlds", f"describes more than {MAX_WORLDS} worlds")
     return Recipe(name, tuple(formats), sdf_version, preview, tuple(jobs), r.value(root), ros)
+
+
+def _osc_needs_ros(r, top, formats, ros) -> None:
+    """world.osc's scenarios start each world's ROS 2 bundle (docs/osc.md): osc without ``ros`` is refused."""
+    if "osc" in formats and not ros:
+        r.fail(top["formats"], "formats", "osc writes scenarios that start each world's ROS 2 bundle: add 'ros: true'")
 
 
 class _Reader:
