@@ -233,3 +233,24 @@ def test_the_default_formats_are_unchanged_and_osc_is_the_same_bytes_in_another_
             "n_tasks=2); print(hashlib.sha256(w.export_bytes('osc')).hexdigest())")
     other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.strip()
     assert other == hashlib.sha256(world.export_bytes("osc")).hexdigest()
+
+
+def test_worldgen_judge_judges_the_bag_a_scenario_records(tmp_path):
+    """A run of world.osc leaves a bag `rosbag2_<date-time>` in the scenario's output folder, with the topics its
+    bag_record lists and no worldgen metadata; a runs table names the world and the task (docs/osc.md)."""
+    pytest.importorskip("rosbags")
+    from support.runs import along, write_bag
+
+    from worldgen.judge import judge
+
+    folder = worldgen.generate("cluttered", seed=0, size=[8, 8], n_obstacles=6).write(
+        tmp_path / "worlds", formats=["sdf", "osc"], ros=True)
+    text = (folder / FILE_NAMES["osc"]).read_text()
+    words = ("clock", "ground_truth", "cmd_vel", "odom", "tf")  # what the test writer can write, each recorded
+    assert all(f"'/{w}'" in re.search(r"bag_record\(topics: \[(.*?)\]", text).group(1) for w in words)
+    [name] = re.findall(r"^scenario (\w+):$", text, re.M)
+    bag = write_bag(tmp_path / "results" / name / "rosbag2_2026_11_29-03_40_00", folder, along(folder),
+                    topics=words, world_id=None, task=None)
+    (tmp_path / "runs.csv").write_text(f"bag,world,task\nresults/{name}/{bag.name},worlds/{folder.name},task_0\n")
+    [row] = judge(runs=tmp_path / "runs.csv").report["runs"]
+    assert row["outcome"] == "success" and row["source"] == "ground_truth", row
