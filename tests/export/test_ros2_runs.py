@@ -427,3 +427,28 @@ def test_an_interrupted_loop_lets_launch_stop_what_it_started(folder, tmp_path, 
     _, err = loop.communicate(timeout=30)
     assert loop.returncode == 130 and "run the same command again to resume" in err
     assert Path(str(scenario) + ".stopped").read_text() == "clean"  # launch finished its own shutdown
+
+
+# -- goal:=false: the simulation and nav2 for a driver that sends the goal itself (world.osc) --
+
+def test_without_the_goal_a_run_starts_the_simulation_and_nav2_only(world, description, tmp_path):
+    """scenario_execution's world.osc starts the launch with goal:=false, then records and navigates itself:
+    the launch starts neither the recorder nor the goal sender, writes the nav2 parameters, refuses no
+    earlier result, and leaves the result file to the driver whatever ends the run."""
+    _, described = description
+    bags = tmp_path / "bags"
+    bags.mkdir()
+    earlier = bags / f"{world.folder_name}__task_1__run2.result.yaml"
+    earlier.write_text("outcome: succeeded\n")
+    context, started = launch_run(described, _configs(tmp_path, goal="false", robot_state_publisher="true"))
+    names = {e.kwargs.get("name") or e.kwargs.get("executable") for e, _ in started}
+    assert names == {"gazebo", "create", "robot_state_publisher", "parameter_bridge"}
+    assert (bags / f"{world.folder_name}__task_1__run2.nav2_params.yaml").exists()
+    [on_gazebo] = _handler(described, "gazebo")
+    earlier.unlink()
+    on_gazebo(types.SimpleNamespace(returncode=134), context)
+    timer = next(e for e in described.args[0] if type(e).__name__ == "TimerAction")
+    timer.kwargs["actions"][0].kwargs["function"](context)
+    assert not earlier.exists()
+    with pytest.raises(ValueError, match="goal must be true or false, got 'no'"):
+        launch_run(described, _configs(tmp_path, goal="no"))

@@ -148,7 +148,7 @@ def parameter_tables(specs) -> str:
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Folder to write DIR/<world_id>/ (DIR/<preset>--<world_id>/ with --preset) into (created if missing).")
 @click.option("--formats", default=",".join(FORMATS), show_default=True,
-              help=f"Comma-separated formats among {', '.join(ALL_FORMATS)} (usd needs its extra); world.json always.")
+              help=f"Comma-separated formats among {', '.join(ALL_FORMATS)} (usd needs its extra, osc --ros); world.json always.")
 @click.option("--sdf-version", type=click.Choice(SDF_VERSIONS), default=SDF_VERSIONS[0], show_default=True,
               help="SDFormat version: 1.9 (Gazebo Fortress to Harmonic) or 1.6 (Gazebo classic).")
 @click.option("--count", type=click.IntRange(1, 100000), default=1, show_default=True,
@@ -194,6 +194,8 @@ def generate_command(generator: Optional[str], seed: int, settings: Sequence[str
         if not allow_infeasible:
             raise
     require_formats(chosen := normalise_formats(formats))  # a missing extra (usd): before any world is drawn
+    if "osc" in chosen and not ros:  # its scenarios start the bundle's launch file
+        raise ParameterError("--formats osc writes scenarios that start the world's ROS 2 bundle: add --ros")
     if gz_release is not None and not ros:
         raise ParameterError(f"--gz-release {gz_release} names the Gazebo release of the ROS 2 bundle: add --ros")
     if seed + count - 1 > MAX_SEED:

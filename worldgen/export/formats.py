@@ -70,6 +70,10 @@ TABLE: dict[str, Format] = {f.name: f for f in (
     Format("usdc", USDC_NAME, "worldgen.export.usd:to_usdc", "kinematic_body", optional=True,
            requires="worldgen.export.usd_prims:require_pxr",
            world_args="worldgen.export.usd_motion:writer_args", binary=True),
+    # OpenSCENARIO 2 for scenario_execution: one scenario per task over the --ros bundle (docs/osc.md). Its
+    # movers are osc_actor fields; world.sdf's <actor>s walk them, so without those (sdf_actors) it has none.
+    Format("osc", "world.osc", "worldgen.export.osc:to_osc", "osc_actor", "sdf_actors", optional=True,
+           world_args="worldgen.export.osc:writer_args"),
 )}
 #: The formats written when none are named; :data:`ALL_FORMATS` adds the optional ones.
 FORMATS = tuple(f.name for f in TABLE.values() if not f.optional)

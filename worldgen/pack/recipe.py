@@ -5,7 +5,7 @@ beyond YAML's safe scalars), so every value keeps the line it came from and
 every mistake is one line ``RECIPE:LINE: key 'K': what is wrong``::
 
     name: small-clutter            # optional; default: the file's stem
-    formats: [sdf, mjcf, urdf]     # optional; default: sdf, mjcf, urdf (usd only when listed)
+    formats: [sdf, mjcf, urdf]     # optional; default: sdf, mjcf, urdf (usd, osc only when listed; osc needs ros)
     sdf_version: "1.9"             # optional
     preview: false                 # optional; default false (preview.png costs ~40 ms a world)
     ros: false                     # optional; true (or a Gazebo release: fortress, harmonic, ...) adds ros2/
@@ -163,6 +163,7 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
         except ParameterError:
             r.fail(top["ros"], "ros", f"must be true, false or a Gazebo release among {', '.join(GZ_RELEASES)}, "
                                       f"got {quoted(value)}")
+    _osc_needs_ros(r, top, formats, ros)
     default_seeds = r.seeds(top["seeds"]) if "seeds" in top else None
     worlds = top["worlds"]
     if not isinstance(worlds, yaml.SequenceNode) or not worlds.value:
@@ -175,6 +176,12 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
             if len(jobs) > MAX_WORLDS:
                 r.fail(worlds, "worlds", f"describes more than {MAX_WORLDS} worlds")
     return Recipe(name, tuple(formats), sdf_version, preview, tuple(jobs), r.value(root), ros)
+
+
+def _osc_needs_ros(r, top, formats, ros) -> None:
+    """world.osc's scenarios start each world's ROS 2 bundle (docs/osc.md): osc without ``ros`` is refused."""
+    if "osc" in formats and not ros:
+        r.fail(top["formats"], "formats", "osc writes scenarios that start each world's ROS 2 bundle: add 'ros: true'")
 
 
 class _Reader:
