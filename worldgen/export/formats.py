@@ -69,6 +69,12 @@ TABLE: dict[str, Format] = {f.name: f for f in (
     Format("usdc", "world.usdc", "worldgen.export.usd:to_usdc", "kinematic_body", optional=True,
            requires="worldgen.export.usd_prims:require_pxr",
            world_args="worldgen.export.usd_motion:writer_args", binary=True),
+    # A world's crowd for the social-navigation simulators (docs/pedsim.md, docs/hunav.md): each person and
+    # scripted mover an agent walking the corners of its world.json walk; refused for a world without people.
+    Format("pedsim", "pedsim.xml", "worldgen.export.pedsim:to_pedsim", "agent", optional=True,
+           world_args="worldgen.export.pedsim:writer_args"),
+    Format("hunav", "hunav_agents.yaml", "worldgen.export.hunav:to_hunav", "agent", optional=True,
+           world_args="worldgen.export.hunav:writer_args"),
 )}
 #: The formats written when none are named; :data:`ALL_FORMATS` adds the optional ones.
 FORMATS = tuple(f.name for f in TABLE.values() if not f.optional)
