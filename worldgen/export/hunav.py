@@ -60,7 +60,7 @@ def _heading(a, b) -> float:
 def to_hunav(scene: Scene, name: str = "default", behaviours: Sequence[str] = ()) -> bytes:
     """HuNavSim's agents file for ``scene``'s people and movers (UTF-8 bytes); see the module docstring.
     A scene without people is a ParameterError."""
-    crowd = agents(scene.movers, behaviours, "hunav")
+    crowd = agents(scene, behaviours, "hunav")
     out = [f"# worldgen world {name}: its people and movers for HuNavSim (docs/hunav.md)",
            f"{NODE}:", "  ros__parameters:", f"    map: {MAP_YAML_NAME}", "    publish_people: true", "    agents:"]
     out += [f"      - {agent.name}" for agent in crowd]

@@ -73,7 +73,7 @@ def to_pedsim(scene: Scene, name: str = "default", behaviours: Sequence[str] = (
 
     ``behaviours`` are not written (pedsim has none); they are taken so the call reads as HuNavSim's. A
     scene without people is a ParameterError."""
-    crowd = agents(scene.movers, behaviours, "pedsim")
+    crowd = agents(scene, behaviours, "pedsim")
     lines = ['<?xml version="1.0" encoding="UTF-8"?>',
              f"<!-- worldgen world {name.replace('--', '-')}: its people and movers for pedsim_simulator "
              "(docs/pedsim.md) -->",
