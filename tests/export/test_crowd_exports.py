@@ -202,3 +202,22 @@ def test_asking_for_them_changes_world_json_only_by_their_files_and_notes():
         for entry in with_crowd["people"]:
             assert entry["formats"].pop(key) == "agent"
     assert json.dumps(with_crowd, sort_keys=True) == json.dumps(default, sort_keys=True)
+
+
+def test_corners_of_hand_made_walks():
+    from worldgen.export.crowd import route, routes, walking_speed
+
+    straight = [(0.1 * k, 0.1 * k, 0.0) for k in range(11)]
+    assert route(straight).tolist() == [[0.0, 0.0], [1.0, 0.0]]
+    standing = [(0.0, 2.0, 3.0), (5.0, 2.0, 3.0)]
+    assert route(standing).tolist() == [[2.0, 3.0]] and walking_speed(standing) == 0.0
+    # an L walked at 1 m/s with a 2 s stay at the corner: the corner is kept once, the pace is the walking
+    ell = [(0.0, 0.0, 0.0), (1.0, 1.0, 0.0), (3.0, 1.0, 0.0), (4.0, 1.0, 1.0)]
+    assert route(ell).tolist() == [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0]] and walking_speed(ell) == 1.0
+    # a closed loop (a scripted mover): the far corner splits it, then each half keeps its corners
+    square = [(0, 0, 0), (1, 2, 0), (2, 2, 2), (3, 0, 2), (4, 0, 0)]
+    assert route(square).tolist() == [[0, 0], [2, 0], [2, 2], [0, 2], [0, 0]]
+    # a bump of 4 cm stays inside the tolerance, one of 6 cm is a corner; walks apart do not share legs
+    low, high = [(0, 0, 0), (1, 1, 0.04), (2, 2, 0)], [(0, 0, 0), (1, 1, 0.06), (2, 2, 0)]
+    assert [r.tolist() for r in routes([low, high, straight])] == \
+        [[[0, 0], [2, 0]], [[0, 0], [1, 0.06], [2, 0]], [[0.0, 0.0], [1.0, 0.0]]]
