@@ -221,3 +221,12 @@ def test_corners_of_hand_made_walks():
     low, high = [(0, 0, 0), (1, 1, 0.04), (2, 2, 0)], [(0, 0, 0), (1, 1, 0.06), (2, 2, 0)]
     assert [r.tolist() for r in routes([low, high, straight])] == \
         [[[0, 0], [2, 0]], [[0, 0], [1, 0.06], [2, 0]], [[0.0, 0.0], [1.0, 0.0]]]
+
+
+def test_every_behaviour_has_hunavs_number():
+    """worldgen's behaviours are HuNavSim's names: each is written as the number hunav_msgs gives that name."""
+    from worldgen.export.hunav import BEHAVIOR
+    from worldgen.people.behaviours import BEHAVIOURS
+
+    assert set(BEHAVIOR) == set(BEHAVIOURS)
+    assert all(HUNAV_BEHAVIORS[name] == number for name, number in BEHAVIOR.items())
