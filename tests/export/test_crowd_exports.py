@@ -230,3 +230,23 @@ def test_every_behaviour_has_hunavs_number():
 
     assert set(BEHAVIOR) == set(BEHAVIOURS)
     assert all(HUNAV_BEHAVIORS[name] == number for name, number in BEHAVIOR.items())
+
+
+def test_groups_are_hunavs_group_ids_and_walk_together():
+    """The group_passing group of group_in_corridor, and the random crowd's pairs (its mover alone), share a
+    group_id; members walked together in world.json (within 2 m of each other, median over the first 10 s)."""
+    for name, expected in (("group_in_corridor", [0, 0, 0]), ("random_crowd", [0, 0, 2, 2, 4, 4, -1])):
+        world = WORLDS[name]()
+        read = read_hunav(world.export("hunav"))
+        assert [a["group_id"] for a in read["agents"]] == expected, name
+        people = world.metadata["people"]
+        t = np.arange(0.0, 10.0, 0.1)
+
+        def at(entry):
+            rows = np.asarray(entry["trajectory"])
+            return np.column_stack([np.interp(t, rows[:, 0], rows[:, 1]), np.interp(t, rows[:, 0], rows[:, 2])])
+
+        for group in set(expected) - {-1}:
+            members = [at(people[i]) for i, g in enumerate(expected) if g == group]
+            for a, b in zip(members, members[1:]):
+                assert np.median(np.hypot(*(a - b).T)) < 2.0, (name, group)

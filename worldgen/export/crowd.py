@@ -25,7 +25,7 @@ from worldgen.floats import round_float
 from worldgen.scene.graph import Scene
 from worldgen.scene.mover import Mover
 
-__all__ = ["ROUTE_TOLERANCE", "MOVING", "Agent", "route", "routes", "walking_speed", "agents", "behaviours_args"]
+__all__ = ["ROUTE_TOLERANCE", "MOVING", "Agent", "route", "routes", "walking_speed", "agents", "people_args"]
 
 #: How far (m) a walk may stray from the straight legs between the corners kept as goals: well under a
 #: person's radius (0.25 m), so the legs keep about the clearance the walk kept, and the agents' own forces
@@ -39,7 +39,7 @@ MOVING = 0.05
 class Agent:
     """One agent: ``start`` (x, y) m, ``heading`` rad (of its first leg; 0 for one that never moves),
     ``goals`` (k, 2) m, ``speed`` m/s, ``behaviour`` (worldgen's name), ``loop`` (a scripted mover: its
-    goals repeat)."""
+    goals repeat), ``group`` (the index of its group's first member; -1: alone)."""
 
     name: str
     radius: float
@@ -50,6 +50,7 @@ class Agent:
     behaviour: str
     loop: bool
     person: bool
+    group: int = -1
 
 
 def _positions(trajectory) -> np.ndarray:
@@ -118,13 +119,13 @@ def walking_speed(trajectory) -> float:
     return round_float(float(speed[order][int(np.searchsorted(cumulative, cumulative[-1] / 2))]))
 
 
-def _agent(mover: Mover, corners: np.ndarray, speed: float, behaviour: str) -> Agent:
+def _agent(mover: Mover, corners: np.ndarray, speed: float, behaviour: str, group: int) -> Agent:
     start = corners[0]
     goals = corners[1:] if len(corners) > 1 else corners
     step = goals[0] - start
     heading = round_float(math.atan2(step[1], step[0])) if np.any(step != 0) else 0.0
     return Agent(mover.name, mover.radius, (float(start[0]), float(start[1])), heading, goals, speed, behaviour,
-                 mover.loop and not mover.person, mover.person)
+                 mover.loop and not mover.person, mover.person, group)
 
 
 #: Each scene's walkers, their corners and their paces, found once for both files (a Scene never changes).
@@ -132,12 +133,13 @@ _ROUTES: "weakref.WeakKeyDictionary[Scene, tuple[list[Mover], list[np.ndarray], 
     weakref.WeakKeyDictionary()
 
 
-def agents(scene: Scene, behaviours: Sequence[str], fmt: str) -> list[Agent]:
+def agents(scene: Scene, fmt: str, behaviours: Sequence[str] = (), groups: Sequence[int] = ()) -> list[Agent]:
     """Every person, then every scripted mover, of ``scene`` as an agent; a ParameterError (one line) where
     there is no person: a crowd file of a world without people is a mistake, not an empty file.
 
-    ``behaviours``: each person's, by its index (``person_<i>``), as world.json gives them; a person past
-    the list, and every scripted mover, is ``impassive`` (it walks its script whatever the robot does)."""
+    ``behaviours``, ``groups``: each person's, by its index (``person_<i>``), as world.json and the params
+    give them; a person past a list, and every scripted mover, is ``impassive`` (it walks its script whatever
+    the robot does) and alone."""
     people = [m for m in scene.movers if m.person]
     if not people:
         raise ParameterError(f"format {fmt!r} writes a world's people, and this world has none: set n_people "
@@ -148,17 +150,17 @@ def agents(scene: Scene, behaviours: Sequence[str], fmt: str) -> list[Agent]:
         _ROUTES[scene] = (walkers, routes(tracks), [walking_speed(t) for t in tracks])
     walkers, corners, speeds = _ROUTES[scene]
 
-    def behaviour(m: Mover) -> str:
-        if not m.person:
-            return "impassive"
-        index = int(m.name.rsplit("_", 1)[1])
-        return behaviours[index] if index < len(behaviours) else "impassive"
+    def of(m: Mover, values: Sequence, alone):
+        index = int(m.name.rsplit("_", 1)[1]) if m.person else len(values)
+        return values[index] if index < len(values) else alone
 
-    return [_agent(m, c, v, behaviour(m)) for m, c, v in zip(walkers, corners, speeds)]
+    return [_agent(m, c, v, of(m, behaviours, "impassive"), of(m, groups, -1)) for m, c, v in zip(walkers, corners, speeds)]
 
 
-def behaviours_args(world) -> dict:
-    """The writers' arguments read off a World besides its scene: each person's behaviour."""
+def people_args(world) -> dict:
+    """What the writers read off a World besides its scene: each person's behaviour and group."""
     from worldgen.people.behaviours import behaviours_of
+    from worldgen.people.places import group_ids
 
-    return {"behaviours": tuple(behaviours_of(world.params))}
+    groups = group_ids(world.params)
+    return {"behaviours": tuple(behaviours_of(world.params)), "groups": () if groups is None else tuple(groups.tolist())}

@@ -71,8 +71,7 @@ TABLE: dict[str, Format] = {f.name: f for f in (
            world_args="worldgen.export.usd_motion:writer_args", binary=True),
     # A world's crowd for the social-navigation simulators (docs/pedsim.md, docs/hunav.md): each person and
     # scripted mover an agent walking the corners of its world.json walk; refused for a world without people.
-    Format("pedsim", "pedsim.xml", "worldgen.export.pedsim:to_pedsim", "agent", optional=True,
-           world_args="worldgen.export.pedsim:writer_args"),
+    Format("pedsim", "pedsim.xml", "worldgen.export.pedsim:to_pedsim", "agent", optional=True),
     Format("hunav", "hunav_agents.yaml", "worldgen.export.hunav:to_hunav", "agent", optional=True,
            world_args="worldgen.export.hunav:writer_args"),
 )}

@@ -8,8 +8,8 @@ wrapper's ``WorldGenerator`` reads them back from that node and needs every one)
   the walls); ``publish_people``: true, so its agents are also on ``/people``; ``agents``: the names.
 * per agent: ``id`` (1, 2, ... in order), ``skin`` (one of its five Gazebo models, in turn), ``behavior``
   (:data:`BEHAVIOR`: HuNavSim's number for the person's behaviour, world.json's ``people[].behaviour``,
-  impassive where absent), ``group_id`` (-1: HuNavSim's group force would pull together people that
-  world.json walks apart, so nobody is grouped), ``max_vel`` (m/s, the walk's pace,
+  impassive where absent), ``group_id`` (the index of the first member of the person's group, which
+  walked together under a group force as HuNavSim's groups do; -1 alone), ``max_vel`` (m/s, the walk's pace,
   :func:`worldgen.export.crowd.walking_speed`), ``radius`` (m), ``init_pose`` (x, y at the first row, z
   :data:`SKIN_Z`, h the heading of the first leg, rad), ``goal_radius`` (the radius, m), ``cyclic_goals``
   (false for a person, who walks once and stands; true for a scripted mover, which loops) and ``goals``,
@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-from worldgen.export.crowd import agents, behaviours_args
+from worldgen.export.crowd import agents, people_args
 from worldgen.files import MAP_YAML_NAME
 from worldgen.floats import fmt
 from worldgen.scene import Scene
@@ -45,7 +45,7 @@ NODE = "hunav_loader"
 
 def writer_args(world) -> dict:
     """What :func:`to_hunav` reads off a World besides its scene."""
-    return behaviours_args(world)
+    return people_args(world)
 
 
 def _double(x: float) -> str:
@@ -57,16 +57,17 @@ def _heading(a, b) -> float:
     return math.atan2(b[1] - a[1], b[0] - a[0]) if (a[0], a[1]) != (b[0], b[1]) else 0.0
 
 
-def to_hunav(scene: Scene, name: str = "default", behaviours: Sequence[str] = ()) -> bytes:
+def to_hunav(scene: Scene, name: str = "default", behaviours: Sequence[str] = (), groups: Sequence[int] = ()) -> bytes:
     """HuNavSim's agents file for ``scene``'s people and movers (UTF-8 bytes); see the module docstring.
-    A scene without people is a ParameterError."""
-    crowd = agents(scene, behaviours, "hunav")
+    ``behaviours``, ``groups``: each person's (world.json's ``people[].behaviour``; the params' groups,
+    :func:`worldgen.people.places.group_ids`). A scene without people is a ParameterError."""
+    crowd = agents(scene, "hunav", behaviours, groups)
     out = [f"# worldgen world {name}: its people and movers for HuNavSim (docs/hunav.md)",
            f"{NODE}:", "  ros__parameters:", f"    map: {MAP_YAML_NAME}", "    publish_people: true", "    agents:"]
     out += [f"      - {agent.name}" for agent in crowd]
     for k, agent in enumerate(crowd):
         out += [f"    {agent.name}:", f"      id: {k + 1}", f"      skin: {k % SKINS}",
-                f"      behavior: {BEHAVIOR[agent.behaviour]}", "      group_id: -1",
+                f"      behavior: {BEHAVIOR[agent.behaviour]}", f"      group_id: {agent.group}",
                 f"      max_vel: {_double(agent.speed)}", f"      radius: {_double(agent.radius)}",
                 "      init_pose:", f"        x: {_double(agent.start[0])}", f"        y: {_double(agent.start[1])}",
                 f"        z: {_double(SKIN_Z)}", f"        h: {_double(agent.heading)}",

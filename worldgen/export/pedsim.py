@@ -21,15 +21,14 @@ ignc-research's (where 2 is ``ELDER``), and both simulators run without one.
 from __future__ import annotations
 
 import math
-from typing import Sequence
 
 import numpy as np
 
-from worldgen.export.crowd import agents, behaviours_args
+from worldgen.export.crowd import agents
 from worldgen.floats import fmt
 from worldgen.scene import Scene
 
-__all__ = ["to_pedsim", "writer_args", "DISC_SIDES", "ADULT", "SIMPLE"]
+__all__ = ["to_pedsim", "DISC_SIDES", "ADULT", "SIMPLE"]
 
 #: Sides of the polygon written round a disc-shaped footprint (its corners on a circle of r / cos(pi / n),
 #: so the polygon holds the disc, 2 % wider at most).
@@ -37,11 +36,6 @@ DISC_SIDES = 16
 #: pedsim's Ped::Tagent::AgentType ADULT and Ped::Twaypoint::Behavior SIMPLE.
 ADULT = 0
 SIMPLE = 0
-
-
-def writer_args(world) -> dict:
-    """What :func:`to_pedsim` reads off a World besides its scene."""
-    return behaviours_args(world)
 
 
 def _outline(footprint) -> np.ndarray:
@@ -68,12 +62,11 @@ def _obstacles(scene: Scene) -> list[str]:
     return lines
 
 
-def to_pedsim(scene: Scene, name: str = "default", behaviours: Sequence[str] = ()) -> bytes:
-    """The pedsim scenario of ``scene``'s people and movers (UTF-8 bytes); see the module docstring.
-
-    ``behaviours`` are not written (pedsim has none); they are taken so the call reads as HuNavSim's. A
-    scene without people is a ParameterError."""
-    crowd = agents(scene, behaviours, "pedsim")
+def to_pedsim(scene: Scene, name: str = "default") -> bytes:
+    """The pedsim scenario of ``scene``'s people and movers (UTF-8 bytes); see the module docstring. Nothing
+    but the scene is read: pedsim has no behaviours, and forms its own groups. A scene without people is a
+    ParameterError."""
+    crowd = agents(scene, "pedsim")
     lines = ['<?xml version="1.0" encoding="UTF-8"?>',
              f"<!-- worldgen world {name.replace('--', '-')}: its people and movers for pedsim_simulator "
              "(docs/pedsim.md) -->",
