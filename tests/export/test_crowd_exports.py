@@ -250,3 +250,16 @@ def test_groups_are_hunavs_group_ids_and_walk_together():
             members = [at(people[i]) for i, g in enumerate(expected) if g == group]
             for a, b in zip(members, members[1:]):
                 assert np.median(np.hypot(*(a - b).T)) < 2.0, (name, group)
+
+
+def test_the_same_bytes_in_another_process():
+    import hashlib
+    import subprocess
+    import sys
+
+    code = ("import hashlib, sys, worldgen\n"
+            f"w = worldgen.generate('cluttered', seed=5, **{CROWD!r})\n"
+            "sys.stdout.write(' '.join(hashlib.sha256(w.export_bytes(f)).hexdigest() for f in ('pedsim', 'hunav')))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True).stdout
+    world = WORLDS["random_crowd"]()
+    assert out.split() == [hashlib.sha256(world.export_bytes(f)).hexdigest() for f in ("pedsim", "hunav")]
