@@ -163,7 +163,7 @@ def test_unknown_generator():
 def test_export_option_mistakes(world, tmp_path):
     with pytest.raises(ParameterError, match=r"^parameter 'sdf_version' must be one of 1\.9, 1\.6, got '2\.0'$"):
         world.to_sdf("2.0")
-    with pytest.raises(ParameterError, match=r"^parameter 'formats' must name formats among sdf, mjcf, urdf, usd, usdc, osc, got 'obj'$"):
+    with pytest.raises(ParameterError, match=r"^parameter 'formats' must name formats among sdf, mjcf, urdf, usd, usdc, osc, pedsim, hunav, got 'obj'$"):
         world.write(tmp_path, formats="sdf,obj")
     assert list(tmp_path.iterdir()) == []
     blocker = tmp_path / "file"

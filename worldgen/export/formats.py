@@ -74,6 +74,11 @@ TABLE: dict[str, Format] = {f.name: f for f in (
     # movers are osc_actor fields; world.sdf's <actor>s walk them, so without those (sdf_actors) it has none.
     Format("osc", "world.osc", "worldgen.export.osc:to_osc", "osc_actor", "sdf_actors", optional=True,
            world_args="worldgen.export.osc:writer_args"),
+    # A world's crowd for the social-navigation simulators (docs/pedsim.md, docs/hunav.md): each person and
+    # scripted mover an agent walking the corners of its world.json walk; refused for a world without people.
+    Format("pedsim", "pedsim.xml", "worldgen.export.pedsim:to_pedsim", "agent", optional=True),
+    Format("hunav", "hunav_agents.yaml", "worldgen.export.hunav:to_hunav", "agent", optional=True,
+           world_args="worldgen.export.hunav:writer_args"),
 )}
 #: The formats written when none are named; :data:`ALL_FORMATS` adds the optional ones.
 FORMATS = tuple(f.name for f in TABLE.values() if not f.optional)

@@ -38,7 +38,7 @@ from worldgen.scene import Robot, Scene, Task
 from worldgen.scene.doors import door_records
 from worldgen.scene.footprint import Footprint, FootprintIndex, scene_footprints
 
-__all__ = ["PeoplePlan", "draw_people", "people_footprints", "PERSON_HEIGHT", "SLACK", "KEEP_OUT", "LEG_MIN",
+__all__ = ["PeoplePlan", "draw_people", "group_ids", "people_footprints", "PERSON_HEIGHT", "SLACK", "KEEP_OUT", "LEG_MIN",
            "LEG_MAX", "HEAD_ON_SHORT", "HEAD_ON_BEHIND", "CROSSING_HALF", "LAG", "GROUP_SPACING", "GROUP_START",
            "OVERTAKE_BEHIND", "OVERTAKE_SIDE", "OVERTAKE_BEYOND", "GROUP_SHORT", "GROUP_SIDE", "GROUP_BEHIND", "DOOR_WAIT",
            "ASIDE_AHEAD", "ASIDE_SIDE"]
@@ -111,6 +111,27 @@ def people_footprints(scene: Scene, tasks: Sequence[Task], robot: Robot, reach: 
     return prints + keep_out
 
 
+def group_ids(params: Mapping[str, Any]) -> Optional[np.ndarray]:
+    """(n,) each person's group, the index of its first member (-1: alone), or None when nobody walks in one.
+
+    A pure function of the parameters, so a world's groups can be read off its ``params`` (the HuNavSim
+    export does): a scenario's scripted people come first (``group_passing``: ``group_size`` of them, one
+    group, 0; another scenario: one person), then the rest in consecutive groups of ``group_size``, the last
+    one smaller, a group of one alone."""
+    n, size = int(params.get("n_people") or 0), params.get("group_size", 1)
+    scenario = params.get("people_scenario", "walk")
+    if not (size > 1 or scenario == "group_passing"):
+        return None
+    groups = np.full(n, -1)
+    first = 0 if scenario == "walk" else size if scenario == "group_passing" else 1
+    groups[:first] = 0 if scenario == "group_passing" else -1
+    for i in range(first, n):
+        lead = first + (i - first) // size * size
+        if size > 1 and min(lead + size, n) - lead > 1:
+            groups[i] = lead
+    return groups
+
+
 # long: each person's start, goal and stay drawn in turn from one stream; the order is the stream's
 def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mapping[str, Any],
                 rng: np.random.Generator) -> tuple[Optional[PeoplePlan], Optional[str]]:
@@ -130,7 +151,7 @@ def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
     places = np.zeros((n, k, 2))
     depart = np.zeros(n)
     size = params.get("group_size", 1)
-    groups = np.full(n, -1) if size > 1 or params.get("people_scenario") == "group_passing" else None
+    groups = group_ids(params)
     scenario = params.get("people_scenario", "walk")
     if scenario != "walk":
         scripted, reason = _scripted(scenario, scene, tasks[0], float(speeds[0]), params, pool.index, clear_r)
@@ -141,14 +162,11 @@ def draw_people(scene: Scene, tasks: Sequence[Task], robot: Robot, params: Mappi
             places[j] = np.nan
             places[j, : len(route)] = route
             depart[j] = leave
-        if scenario == "group_passing" and groups is not None:
-            groups[: len(scripted)] = 0
+        if scenario == "group_passing":
             speeds[: len(scripted)] = speeds[0]
     first = len(starts)
     for i in range(first, n):
         lead = first + (i - first) // size * size  # the first member of i's group
-        if groups is not None and size > 1 and min(lead + size, n) - lead > 1:
-            groups[i] = lead
         def apart(q):
             return np.all(np.hypot(*(q[:, None] - np.array(starts).reshape(1, -1, 2)).transpose(2, 0, 1))
                           >= 2 * r + SLACK, axis=1)
