@@ -138,7 +138,7 @@ def test_tests_mirror_the_package_and_share_helpers_only_through_support():
 FLOW = [
     {"errors"}, {"floats", "files", "seeding", "schema"}, {"params"}, {"scene"}, {"generators"}, {"feasibility"},
     {"groundtruth"}, {"people"}, {"export"}, {"ros"}, {"world"}, {"leveling"}, {"api"}, {"presets"},
-    {"verify"}, {"testing"}, {"pack"}, {"judge"}, {"envs"}, {"sim"}, {"cli"}, {"__main__"},
+    {"verify"}, {"testing"}, {"pack"}, {"judge"}, {"envs"}, {"sim"}, {"campaign"}, {"cli"}, {"__main__"},
 ]
 MAX_TOP_LEVEL = 10
 
@@ -281,3 +281,19 @@ def test_random_streams_are_made_only_in_seeding_py():
              if path.name != "seeding.py"
              for i, line in enumerate(path.read_text().splitlines(), 1) if made.search(line)]
     assert not found, "random streams made outside seeding.py:\n" + "\n".join(found)
+
+
+# -- campaigns --------------------------------------------------------------------------------------------
+
+BUILTIN_RAISES_ALLOWED[("campaign/__init__.py", "AttributeError")] = \
+    "a module's __getattr__ protocol (names loaded on first use)"
+
+
+def test_the_campaign_package_loads_its_modules_on_first_use():
+    """``import worldgen.campaign`` imports none of its modules (nor Optuna): a campaign's name is loaded when used."""
+    import subprocess
+    import sys
+
+    code = ("import sys, worldgen.campaign as c; assert not [m for m in sys.modules if m.startswith('worldgen.campaign.')"
+            " or m == 'optuna'], sorted(sys.modules); c.run; assert 'worldgen.campaign.runner' in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=PACKAGE.parent)

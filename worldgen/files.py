@@ -19,7 +19,9 @@ from worldgen.errors import OutputError
 
 __all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "MAP_YAML_NAME", "MANIFEST_NAME",
            "INDEX_NAME", "WORLDS_DIR", "BUILD_STATE_DIR", "creation_mode", "safe_relative", "write_atomically",
-           "write_folder_atomically", "refuse_other_world", "recorded_content_hash"]
+           "write_folder_atomically", "refuse_other_world", "recorded_content_hash", "CAMPAIGN_RECIPE_NAME", "VERDICTS_NAME",
+           "FAILURES_NAME", "STRATEGY_NAME", "FAILURE_MAP_NAME", "REPORT_NAME", "CAMPAIGN_STATE_DIR", "RUNS_DIR",
+           "SHRUNK_DIR", "PLOTS_DIR"]
 
 #: A world folder: its ground truth, scenario, picture and nav2 map (the formats' files are named in
 #: worldgen.export.formats).
@@ -34,6 +36,20 @@ INDEX_NAME = "index.csv"
 WORLDS_DIR = "worlds"
 #: A pack build's records of finished jobs, kept until the manifest is written (a resume reads them).
 BUILD_STATE_DIR = ".build"
+#: A campaign folder (worldgen.campaign): the recipe as given, every run's verdict, the failed ones, the search's
+#: state, the failure map (a table and plots), the report a reviewer reads first; the worlds are in WORLDS_DIR,
+#: what each run's system wrote in RUNS_DIR, each distinct failure shrunk in SHRUNK_DIR, and the records of
+#: finished points (what a resume reads) in CAMPAIGN_STATE_DIR.
+CAMPAIGN_RECIPE_NAME = "campaign.yaml"
+VERDICTS_NAME = "verdicts.csv"
+FAILURES_NAME = "failures.csv"
+STRATEGY_NAME = "strategy.json"
+FAILURE_MAP_NAME = "failure_map.csv"
+REPORT_NAME = "report.md"
+CAMPAIGN_STATE_DIR = ".campaign"
+RUNS_DIR = "runs"
+SHRUNK_DIR = "shrunk"
+PLOTS_DIR = "plots"
 
 
 def creation_mode(full: int) -> int:

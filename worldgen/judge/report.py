@@ -26,6 +26,7 @@ import numpy as np
 
 from worldgen.errors import OutputError
 from worldgen.export.topdown import COLOURS as TOPDOWN_COLOURS
+from worldgen.files import REPORT_NAME
 
 __all__ = ["write_report", "RUN_COLUMNS", "draw_run", "COLOURS"]
 
@@ -174,7 +175,7 @@ def write_report(result, out) -> Path:
                 row["picture"] = name
         (tmp / "report.json").write_text(json.dumps(report, indent=2, sort_keys=True, default=str) + "\n")
         (tmp / "report.csv").write_text(_csv(report))
-        (tmp / "report.md").write_text(_markdown(report))
+        (tmp / REPORT_NAME).write_text(_markdown(report))
         if out.exists():
             out.rename(old)
         tmp.rename(out)
