@@ -1,0 +1,210 @@
+"""A campaign's report: the failure map (a table and plots), each distinct failure shrunk, and report.md.
+
+``write_report(out)`` redraws everything from the records in the output folder (``worldgen campaign report
+DIR``); with the ``system`` under test it also shrinks each distinct failure (:func:`worldgen.shrink`: the
+fewest obstacles and movers, and people where shrink removes them, that still make the system fail) into
+``shrunk/<k>-<world_id>/``, with the run's picture from the judge's drawing beside it. A failure's kind is its
+reason with the numbers and the names' indices taken out (``collision with person_# at # s``); two failures
+are distinct when their kind, generator, level, people and door state differ. Without the system (a redraw),
+the shrunk folders already there are listed again.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any, Mapping, Optional, Sequence
+
+import numpy as np
+
+from worldgen.campaign.failuremap import CONFIDENCE, failure_map, map_rows_csv, plot_map
+from worldgen.campaign.output import load_records, run_rows
+from worldgen.campaign.recipe import CampaignRecipe, parse_campaign
+from worldgen.campaign.space import Point, make_world
+from worldgen.errors import ParameterError, WorldgenError
+from worldgen.files import CAMPAIGN_RECIPE_NAME, FAILURE_MAP_NAME, PLOTS_DIR, REPORT_NAME, SHRUNK_DIR, write_atomically
+
+__all__ = ["write_report", "distinct_failures", "failure_kind", "MAX_SHRINK_CALLS"]
+
+#: Runs of the system one failure's shrinking may make.
+MAX_SHRINK_CALLS = 40
+
+
+def failure_kind(reason: str) -> str:
+    """``reason`` with its numbers and the indices of names taken out: what kind of failure it is."""
+    return re.sub(r"\d+(\.\d+)?", "#", reason or "failed").strip()
+
+
+def distinct_failures(records: Sequence[Mapping[str, Any]]) -> list[dict[str, Any]]:
+    """One entry per distinct failure: its key, how many runs showed it, and the smallest world that did."""
+    found: dict[tuple, dict[str, Any]] = {}
+    for rec in records:
+        d = rec["descriptors"]
+        for r in rec.get("runs", ()):
+            if r["verdict"] != "failed":
+                continue
+            key = (failure_kind(r["reason"]), d["generator"], d["level"], d["people"], d["door_state"])
+            size = (d.get("obstacles") or 0, d["people"], rec["point"]["index"])
+            got = found.get(key)
+            if got is None or size < got["size"]:
+                found[key] = {"key": key, "size": size, "count": (got or {}).get("count", 0), "record": rec, "run": r}
+            found[key]["count"] += 1
+    return [found[k] for k in sorted(found, key=lambda k: (-found[k]["count"], [str(x) for x in k]))]
+
+
+def _recipe(out: Path) -> CampaignRecipe:
+    path = out / CAMPAIGN_RECIPE_NAME
+    return parse_campaign(path.read_text(encoding="utf-8"), str(path), out.name, base=out)
+
+
+def write_report(out, records: Optional[list] = None, system: Any = None) -> Path:
+    """Write failure_map.csv, plots/, report.md (and shrunk/ with ``system``) in campaign folder ``out``."""
+    out = Path(out)
+    if not (out / CAMPAIGN_RECIPE_NAME).is_file():
+        raise ParameterError(f"'{out}' is not a campaign folder (it has no {CAMPAIGN_RECIPE_NAME})")
+    recipe = _recipe(out)
+    records = load_records(out) if records is None else records
+    rows = failure_map(records, recipe.entries)
+    write_atomically(out / FAILURE_MAP_NAME, map_rows_csv(rows))
+    plots = plot_map(rows, out / PLOTS_DIR, recipe.name)
+    failures = distinct_failures(records)
+    shrunk = [_shrink(out, k, f, system) if system is not None else _shrunk_before(out, k, f)
+              for k, f in enumerate(failures)]
+    write_atomically(out / REPORT_NAME, _markdown(recipe, records, rows, plots, failures, shrunk, out).encode())
+    return out / REPORT_NAME
+
+
+def _slot(out: Path, k: int, failure: Mapping[str, Any]) -> Path:
+    return out / SHRUNK_DIR / f"{k + 1:02d}-{failure['record']['world_id']}"
+
+
+def _shrunk_before(out: Path, k: int, failure: Mapping[str, Any]) -> dict[str, Any]:
+    slot = _slot(out, k, failure)
+    note = slot.with_suffix(".json")
+    if note.is_file():
+        return json.loads(note.read_text(encoding="utf-8"))
+    return {"shrunk": False, "why": "not shrunk (the report was redrawn without the system under test)"}
+
+
+# long: regenerate, shrink with the system as the judge, write the smallest world, its run and its picture
+def _shrink(out: Path, k: int, failure: Mapping[str, Any], system: Any) -> dict[str, Any]:
+    from worldgen.testing.shrink import shrink
+
+    rec, run = failure["record"], failure["run"]
+    slot = _slot(out, k, failure)
+    world, why = make_world(Point.from_dict(rec["point"]))
+    info: dict[str, Any] = {"shrunk": False, "why": why, "original": rec["folder"], "task": run["task"]}
+    if world is None:
+        return _note(slot, info)
+    work = Path(tempfile.mkdtemp(prefix=".shrink.", suffix=".tmp", dir=out))
+    last: dict[str, Any] = {}
+
+    def still_fails(candidate) -> bool:
+        folder = candidate.write(work / "worlds", preview=False, overwrite=True)
+        name = f"shrink{len(last.setdefault('calls', []))}"
+        workdir = work / f"{folder.name}__{run['task']}__{name}"
+        workdir.mkdir(parents=True, exist_ok=True)
+        got = system.run(folder, run["task"], name, workdir)
+        last["calls"].append(got.verdict)
+        if got.verdict == "failed":
+            last.update(row=dict(got.row), reason=got.reason)
+        return got.verdict == "failed"
+
+    try:
+        result = shrink(world, still_fails, slot, max_calls=MAX_SHRINK_CALLS)
+    except (ParameterError, WorldgenError) as exc:
+        info["why"] = f"not shrunk: {' '.join(str(exc).split())}"
+        shutil.rmtree(work, ignore_errors=True)
+        return _note(slot, info)
+    shutil.rmtree(work, ignore_errors=True)
+    folder = Path(result.path)
+    row = dict(run.get("row") or {}, run=f"shrunk {k + 1:02d}", success=False,
+               reason=last.get("reason", run["reason"]))
+    picture = slot / f"{folder.name}.png"
+    try:
+        _picture(folder, run["task"], row).save(picture)
+    except (WorldgenError, OSError, KeyError) as exc:
+        info["picture_error"] = " ".join(str(exc).split())
+        picture = None
+    info.update(shrunk=True, why="", folder=str(folder.relative_to(out)), removed=list(result.removed),
+                calls=result.calls, picture=str(picture.relative_to(out)) if picture else None,
+                obstacles=(result.world.metadata.get("metrics") or {}).get("obstacle_count"),
+                people=len(result.world.metadata.get("people") or []))
+    return _note(slot, info)
+
+
+def _picture(folder: Path, task: str, row: dict):
+    """The judge's picture of the shrunk world with the failed run's verdict. No trajectory is drawn: what the
+    System protocol returns is the judge's row, and the bags of shrinking's runs go with its temporary folder."""
+    from worldgen.judge.report import draw_run
+
+    return draw_run(folder, task, np.zeros((0, 3)), dict(row, collisions=[]))
+
+
+def _note(slot: Path, info: dict[str, Any]) -> dict[str, Any]:
+    slot.parent.mkdir(parents=True, exist_ok=True)
+    write_atomically(slot.with_suffix(".json"), (json.dumps(info, sort_keys=True, indent=1) + "\n").encode())
+    return info
+
+
+def _pct(x: float) -> str:
+    return f"{100 * x:.0f} %"
+
+
+# long: the report's sections in the order a reviewer reads them
+def _markdown(recipe: CampaignRecipe, records, rows, plots, failures, shrunk, out: Path) -> str:
+    runs = run_rows(records)
+    judged = [r for r in runs if r["verdict"] in ("passed", "failed")]
+    failed = sum(r["verdict"] == "failed" for r in runs)
+    unjudged = len(runs) - len(judged)
+    no_world = sum(r.get("world_id") is None for r in records)
+    lines = [f"# Campaign {recipe.name}", "",
+             f"Strategy `{recipe.strategy}` (seed {recipe.seed}); {len(records)} points, {no_world} of them without a "
+             f"world (the generator refused them; never counted as runs); {len(runs)} runs: **{failed} failed**, "
+             f"{len(judged) - failed} passed, {unjudged} unjudged (neither: the system could not be run or judged).", ""]
+    if judged:
+        from worldgen.testing.stats import clopper_pearson_interval
+
+        lo, hi = clopper_pearson_interval(failed, len(judged), CONFIDENCE)
+        lines += [f"Failure rate over the judged runs: {_pct(failed / len(judged))} "
+                  f"({int(CONFIDENCE * 100)} % Clopper-Pearson interval {_pct(lo)} to {_pct(hi)}). The runs were "
+                  "placed by the strategy, not drawn uniformly: rates per bin say where it fails, not how often "
+                  "a uniform user would see it.", ""]
+    worst = sorted((r for r in rows if r["failed"]), key=lambda r: (-r["low"], -r["rate"], r["dimension"], r["bin"]))[:8]
+    lines += ["## Where it fails", ""]
+    if worst:
+        lines += ["The bins with the highest lower bound on the failure rate:", "",
+                  "| dimension | bin | failed / judged | rate | 95 % interval |", "|---|---|---|---|---|"]
+        lines += [f"| {r['dimension']} | {r['bin']} | {r['failed']} / {r['judged']} | {_pct(r['rate'])} | "
+                  f"{_pct(r['low'])} to {_pct(r['high'])} |" for r in worst]
+    else:
+        lines += ["No run failed."]
+    lines += ["", "## The smallest worlds that show it", ""]
+    if not failures:
+        lines += ["No failure to show."]
+    for k, (f, s) in enumerate(zip(failures, shrunk)):
+        kind, generator, level, people, door = f["key"]
+        lines.append(f"{k + 1}. **{kind}**: {generator}, level {level}, {people} people, doors {door}; "
+                     f"{f['count']} failed run(s); first seen in `{f['record']['folder']}` "
+                     f"(point {f['record']['point']['index']})")
+        if s.get("shrunk"):
+            lines.append(f"   - shrunk to `{s['folder']}` ({s.get('obstacles')} obstacles, {s.get('people')} people left; "
+                         f"removed {len(s['removed'])}; {s['calls']} runs of the system)"
+                         + (f"; picture: ![]({s['picture']})" if s.get("picture") else ""))
+        else:
+            lines.append(f"   - {s.get('why') or 'not shrunk'}")
+    lines += ["", "## Failure map", "", f"Every bin of every dimension: `{FAILURE_MAP_NAME}`. Per level and per people "
+              "count:", ""]
+    for dim in ("level", "people", "door_state"):
+        mine = [r for r in rows if r["dimension"] == dim]
+        if len(mine) < 2:
+            continue
+        lines += [f"| {dim} | failed / judged | rate | 95 % interval |", "|---|---|---|---|"]
+        lines += [f"| {r['bin']} | {r['failed']} / {r['judged']} | {_pct(r['rate'])} | {_pct(r['low'])} to "
+                  f"{_pct(r['high'])} |" for r in mine] + [""]
+    if plots:
+        lines += ["Plots:", ""] + [f"![{p.stem}]({p.relative_to(out).as_posix()})" for p in plots] + [""]
+    return "\n".join(lines) + "\n"
