@@ -39,7 +39,7 @@ from worldgen.files import (
     write_atomically,
 )
 
-__all__ = ["claim_folder", "load_records", "save_record", "save_asked", "asked_points", "write_tables",
+__all__ = ["claim_folder", "refuse_other", "load_records", "save_record", "save_asked", "asked_points", "write_tables",
            "write_manifest", "run_rows", "VERDICT_COLUMNS"]
 
 #: The first columns of verdicts.csv and failures.csv; the judge's row's other columns follow, sorted.
@@ -49,6 +49,17 @@ VERDICT_COLUMNS = ["point", "world_id", "task", "run", "verdict", "reason", "sec
 
 def claim_folder(out: Path, recipe: CampaignRecipe) -> None:
     """Refuse ``out`` when it holds anything but this campaign (nothing is written then); write campaign.yaml."""
+    refuse_other(out, recipe)
+    try:
+        (out / CAMPAIGN_STATE_DIR).mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot write campaign folder '{out}': {exc.strerror or exc}") from None
+    text = yaml.safe_dump(recipe.document, sort_keys=False, allow_unicode=True)
+    write_atomically(out / CAMPAIGN_RECIPE_NAME, text.encode())
+
+
+def refuse_other(out: Path, recipe: CampaignRecipe) -> None:
+    """A one-line ParameterError when ``out`` exists and holds anything but a campaign of ``recipe``."""
     if out.exists():
         if not out.is_dir():
             raise ParameterError(f"--out '{out}' is not a folder")
@@ -64,12 +75,6 @@ def claim_folder(out: Path, recipe: CampaignRecipe) -> None:
                                      "give a new folder, or the same recipe to resume it")
         elif any(out.iterdir()):
             raise ParameterError(f"--out '{out}' exists and is not a campaign folder; give a new or empty folder")
-    try:
-        (out / CAMPAIGN_STATE_DIR).mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"cannot write campaign folder '{out}': {exc.strerror or exc}") from None
-    text = yaml.safe_dump(recipe.document, sort_keys=False, allow_unicode=True)
-    write_atomically(out / CAMPAIGN_RECIPE_NAME, text.encode())
 
 
 def _state(out: Path) -> Path:

@@ -26,6 +26,7 @@ from worldgen.campaign.output import (
     asked_points,
     claim_folder,
     load_records,
+    refuse_other,
     save_asked,
     save_record,
     write_manifest,
@@ -120,9 +121,10 @@ def run(recipe: Union[CampaignRecipe, str, Path], out, *, jobs: int = 1, schedul
     recipe = recipe if isinstance(recipe, CampaignRecipe) else load_campaign(recipe)
     if isinstance(jobs, bool) or not isinstance(jobs, int) or not 1 <= jobs <= MAX_JOBS:
         raise ParameterError(f"parameter 'jobs' must be an integer in [1, {MAX_JOBS}], got {jobs!r}")
+    out = Path(out)
+    refuse_other(out, recipe)
     system = system if system is not None else _system(recipe)
     strategy = Strategy(recipe.strategy, recipe.seed, recipe.entries)
-    out = Path(out)
     claim_folder(out, recipe)
     loop = _Loop(recipe, out, strategy, system)
     try:
