@@ -109,8 +109,8 @@ def _shrink(out: Path, k: int, failure: Mapping[str, Any], system: Any) -> dict[
         workdir.mkdir(parents=True, exist_ok=True)
         got = system.run(folder, run["task"], name, workdir)
         last["calls"].append(got.verdict)
-        if got.verdict == "failed":
-            last.update(row=dict(got.row), reason=got.reason)
+        if got.verdict == "failed":  # the last failing call is on the smallest world shrink keeps
+            last.update(row=dict(got.row), reason=got.reason, trajectory=_trajectory(got.row, folder, run["task"]))
         return got.verdict == "failed"
 
     try:
@@ -121,11 +121,11 @@ def _shrink(out: Path, k: int, failure: Mapping[str, Any], system: Any) -> dict[
         return _note(slot, info)
     shutil.rmtree(work, ignore_errors=True)
     folder = Path(result.path)
-    row = dict(run.get("row") or {}, run=f"shrunk {k + 1:02d}", success=False,
+    row = dict(last.get("row") or run.get("row") or {}, run=f"shrunk {k + 1:02d}", success=False,
                reason=last.get("reason", run["reason"]))
     picture = slot / f"{folder.name}.png"
     try:
-        _picture(folder, run["task"], row).save(picture)
+        _picture(folder, run["task"], row, last.get("trajectory")).save(picture)
     except (WorldgenError, OSError, KeyError) as exc:
         info["picture_error"] = " ".join(str(exc).split())
         picture = None
@@ -136,12 +136,26 @@ def _shrink(out: Path, k: int, failure: Mapping[str, Any], system: Any) -> dict[
     return _note(slot, info)
 
 
-def _picture(folder: Path, task: str, row: dict):
-    """The judge's picture of the shrunk world with the failed run's verdict. No trajectory is drawn: what the
-    System protocol returns is the judge's row, and the bags of shrinking's runs go with its temporary folder."""
+def _trajectory(row: Mapping[str, Any], world: Path, task: str) -> Optional[np.ndarray]:
+    """The run's trajectory from the bag its judge's row names (read before shrinking's folder goes), or None."""
+    if not row.get("bag"):
+        return None
+    from worldgen.ros.reader import read_run
+
+    try:
+        return read_run(row["bag"], world, task=task).trajectory
+    except (WorldgenError, OSError):
+        return None
+
+
+def _picture(folder: Path, task: str, row: dict, trajectory: Optional[np.ndarray]):
+    """The judge's picture of the run on the shrunk world: its trajectory and contacts where the system left a
+    readable bag, else the world with the run's verdict alone."""
     from worldgen.judge.report import draw_run
 
-    return draw_run(folder, task, np.zeros((0, 3)), dict(row, collisions=[]))
+    if trajectory is None or len(trajectory) < 2:
+        return draw_run(folder, task, np.zeros((0, 4)), dict(row, collisions=[]))
+    return draw_run(folder, task, trajectory, row)
 
 
 def _note(slot: Path, info: dict[str, Any]) -> dict[str, Any]:
