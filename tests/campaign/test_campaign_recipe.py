@@ -86,3 +86,14 @@ def test_a_bad_recipe_is_one_line_naming_what_is_wrong(what, text, message):
         parse_campaign(text, "c.yaml")
     line = str(info.value)
     assert "\n" not in line and line.startswith("c.yaml") and message in line, line
+
+
+def test_the_shipped_campaign_recipe_reads():
+    from pathlib import Path
+
+    from worldgen.campaign.recipe import load_campaign
+
+    r = load_campaign(Path(__file__).resolve().parents[2] / "examples" / "recipes" / "campaign_gap_heuristic.yaml")
+    assert r.name == "gap-heuristic" and r.strategy == "adaptive" and r.runs == 200
+    assert r.entries[0].levels == tuple(range(1, 11)) and dict(r.entries[0].choices)["n_people"] == (0, 2)
+    assert r.system == {"policy": "worldgen.envs.policies:GapHeuristic.for_env"}
