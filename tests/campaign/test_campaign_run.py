@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 from support.campaign import PlantedWeakness
 
-from worldgen.campaign import parse_campaign, run, write_report
+from worldgen.campaign import expect_no_failures, parse_campaign, run, write_report
 from worldgen.errors import ParameterError
 from worldgen.files import (
     CAMPAIGN_STATE_DIR,
@@ -207,3 +207,17 @@ def test_each_distinct_failure_is_shrunk_to_a_world_that_still_fails_and_passes_
     (tmp_path / "s" / REPORT_NAME).unlink()
     write_report(tmp_path / "s")
     assert info["folder"] in (tmp_path / "s" / REPORT_NAME).read_text()
+    # The pytest helper fails a test naming each shrunk world.
+    with pytest.raises(pytest.fail.Exception) as failed:
+        expect_no_failures(tmp_path / "s")
+    message = str(failed.value)
+    assert f"found {len(notes)} distinct failure(s)" in message
+    for note in notes:
+        assert str(tmp_path / "s" / json.loads(note.read_text())["folder"]) in message and "shrunk to" in message
+
+
+def test_the_pytest_helper_passes_a_campaign_without_failures(tmp_path):
+    run(parse_campaign(SHRINKABLE), tmp_path / "ok", system=PlantedWeakness(min_obstacles=99), report=False)
+    expect_no_failures(tmp_path / "ok")
+    with pytest.raises(ParameterError, match="is not a campaign folder"):
+        expect_no_failures(tmp_path)

@@ -10,10 +10,11 @@ from __future__ import annotations
 
 from typing import Any
 
-__all__ = ["run", "load_campaign", "parse_campaign", "write_report", "CampaignSummary", "CampaignInterrupted"]
+__all__ = ["run", "load_campaign", "parse_campaign", "write_report", "expect_no_failures", "CampaignSummary",
+           "CampaignInterrupted"]
 
 _HOMES = {"run": "runner", "CampaignSummary": "runner", "CampaignInterrupted": "runner", "load_campaign": "recipe",
-          "parse_campaign": "recipe", "write_report": "report"}
+          "parse_campaign": "recipe", "write_report": "report", "expect_no_failures": "expect"}
 
 
 def __getattr__(name: str) -> Any:

@@ -118,7 +118,7 @@ def plot_map(rows: Sequence[Mapping[str, Any]], folder: Path, title: str) -> lis
         mine = [r for r in rows if r["dimension"] == dim]
         if len(mine) < 2:
             continue
-        fig, ax = plt.subplots(figsize=(max(4.0, 0.7 * len(mine) + 2), 3.2), dpi=100)
+        fig, ax = plt.subplots(figsize=(max(5.6, 0.7 * len(mine) + 2), 3.2), dpi=100)
         xs = range(len(mine))
         rates = [r["rate"] for r in mine]
         err = [[r["rate"] - r["low"] for r in mine], [r["high"] - r["rate"] for r in mine]]

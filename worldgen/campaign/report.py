@@ -27,10 +27,12 @@ from worldgen.campaign.space import Point, make_world
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.files import CAMPAIGN_RECIPE_NAME, FAILURE_MAP_NAME, PLOTS_DIR, REPORT_NAME, SHRUNK_DIR, write_atomically
 
-__all__ = ["write_report", "distinct_failures", "failure_kind", "MAX_SHRINK_CALLS"]
+__all__ = ["write_report", "distinct_failures", "failure_kind", "slot_of", "MAX_SHRINK_CALLS", "MAX_SHRUNK"]
 
 #: Runs of the system one failure's shrinking may make.
 MAX_SHRINK_CALLS = 40
+#: Distinct failures shrunk, the most frequent first (each costs up to MAX_SHRINK_CALLS runs of the system).
+MAX_SHRUNK = 10
 
 
 def failure_kind(reason: str) -> str:
@@ -71,22 +73,25 @@ def write_report(out, records: Optional[list] = None, system: Any = None) -> Pat
     write_atomically(out / FAILURE_MAP_NAME, map_rows_csv(rows))
     plots = plot_map(rows, out / PLOTS_DIR, recipe.name)
     failures = distinct_failures(records)
-    shrunk = [_shrink(out, k, f, system) if system is not None else _shrunk_before(out, k, f)
+    shrunk = [_shrink(out, k, f, system) if system is not None and k < MAX_SHRUNK else _shrunk_before(out, k, f)
               for k, f in enumerate(failures)]
     write_atomically(out / REPORT_NAME, _markdown(recipe, records, rows, plots, failures, shrunk, out).encode())
     return out / REPORT_NAME
 
 
-def _slot(out: Path, k: int, failure: Mapping[str, Any]) -> Path:
+def slot_of(out: Path, k: int, failure: Mapping[str, Any]) -> Path:
+    """Where distinct failure number ``k`` is shrunk (its note beside it, ``.json``)."""
     return out / SHRUNK_DIR / f"{k + 1:02d}-{failure['record']['world_id']}"
 
 
 def _shrunk_before(out: Path, k: int, failure: Mapping[str, Any]) -> dict[str, Any]:
-    slot = _slot(out, k, failure)
+    slot = slot_of(out, k, failure)
     note = slot.with_suffix(".json")
     if note.is_file():
         return json.loads(note.read_text(encoding="utf-8"))
-    return {"shrunk": False, "why": "not shrunk (the report was redrawn without the system under test)"}
+    if k >= MAX_SHRUNK:
+        return {"shrunk": False, "why": f"not shrunk: only the {MAX_SHRUNK} most frequent distinct failures are"}
+    return {"shrunk": False, "why": "not shrunk: the report was drawn without running the system (--no-shrink, or a redraw)"}
 
 
 # long: regenerate, shrink with the system as the judge, write the smallest world, its run and its picture
@@ -94,7 +99,7 @@ def _shrink(out: Path, k: int, failure: Mapping[str, Any], system: Any) -> dict[
     from worldgen.testing.shrink import shrink
 
     rec, run = failure["record"], failure["run"]
-    slot = _slot(out, k, failure)
+    slot = slot_of(out, k, failure)
     world, why = make_world(Point.from_dict(rec["point"]))
     info: dict[str, Any] = {"shrunk": False, "why": why, "original": rec["folder"], "task": run["task"]}
     if world is None:
