@@ -55,3 +55,28 @@ def test_report_redraws_the_failure_map_and_report_from_the_records(tmp_path):
     assert got.returncode == 0, got.stderr
     assert got.stdout.strip() == f"report: {tmp_path / 'out' / REPORT_NAME}"
     assert (tmp_path / "out" / FAILURE_MAP_NAME).is_file() and "# Campaign cli" in (tmp_path / "out" / REPORT_NAME).read_text()
+
+
+SYSTEMS = [
+    ("unimportable policy", "system: {policy: 'no_such_module_here:make'}", "no_such_module_here"),
+    ("template without {bag}", "system: {command: 'my_stack {world} {task}'}", "{bag}"),
+    ("two kinds", "system: {drive: {sim: mujoco}, command: 'x {bag}'}", "system"),
+]
+
+
+@pytest.mark.parametrize("what, block, message", SYSTEMS, ids=[s[0] for s in SYSTEMS])
+def test_a_bad_system_is_one_line_exit_2_and_nothing_written(tmp_path, what, block, message):
+    pytest.importorskip("worldgen.campaign.systems")  # the systems under test come from their own branch (issue 36)
+    (tmp_path / "cli.yaml").write_text(RECIPE.replace("budget:", f"{block}\nbudget:"))
+    got = worldgen("campaign", tmp_path / "cli.yaml", "--out", tmp_path / "out")
+    assert got.returncode == 2 and got.stderr.count("\n") == 1 and message in got.stderr, got.stderr
+    assert "Traceback" not in got.stderr and not (tmp_path / "out").exists()
+
+
+def test_the_worked_example_runs_a_shipped_policy_end_to_end(tmp_path):
+    pytest.importorskip("worldgen.campaign.systems")
+    (tmp_path / "gap.yaml").write_text(RECIPE.replace("budget: {runs: 3}", "system: {policy: 'worldgen.envs.policies:PathFollower.for_env'}\n"
+                                                      "budget: {runs: 2}"))
+    got = worldgen("campaign", tmp_path / "gap.yaml", "--out", tmp_path / "out")
+    assert got.returncode in (0, 1), got.stderr
+    assert "runs: 2:" in got.stdout and (tmp_path / "out" / REPORT_NAME).is_file()
