@@ -128,7 +128,7 @@ def parse_campaign(text: str, source: str = "<campaign>", default_name: str = "c
     space = top["space"]
     if not isinstance(space, yaml.SequenceNode) or not space.value:
         r.fail(space, "space", "must be a non-empty list of entries (each with 'generator' or 'preset')")
-    entries = tuple(r.entry(node, e) for e, node in enumerate(space.value))
+    entries = tuple(r.space_entry(node, e) for e, node in enumerate(space.value))
     system = None
     if "system" in top:
         system = r.value(top["system"])
@@ -146,7 +146,7 @@ class _Reader(_PackReader):
     """The pack recipe's reader (mapping, value, fail, difficulty, _check, _check_level) with the campaign's keys."""
 
     # long: one space entry's keys checked in order, each with its own message (as a pack entry's)
-    def entry(self, node, e: int) -> Entry:
+    def space_entry(self, node, e: int) -> Entry:
         from worldgen.generators import get
 
         where = f"space[{e}]"

@@ -128,16 +128,16 @@ def _shrink(out: Path, k: int, failure: Mapping[str, Any], system: Any) -> dict[
     folder = Path(result.path)
     row = dict(last.get("row") or run.get("row") or {}, run=f"shrunk {k + 1:02d}", success=False,
                reason=last.get("reason", run["reason"]))
-    picture = slot / f"{folder.name}.png"
+    picture: Optional[Path] = slot / f"{folder.name}.png"
+    meta: Mapping[str, Any] = getattr(result.world, "metadata")  # ShrinkResult.world is typed object: a World
     try:
-        _picture(folder, run["task"], row, last.get("trajectory")).save(picture)
+        _picture(folder, run["task"], row, last.get("trajectory")).save(slot / f"{folder.name}.png")
     except (WorldgenError, OSError, KeyError) as exc:
         info["picture_error"] = " ".join(str(exc).split())
         picture = None
     info.update(shrunk=True, why="", folder=str(folder.relative_to(out)), removed=list(result.removed),
                 calls=result.calls, picture=str(picture.relative_to(out)) if picture else None,
-                obstacles=(result.world.metadata.get("metrics") or {}).get("obstacle_count"),
-                people=len(result.world.metadata.get("people") or []))
+                obstacles=(meta.get("metrics") or {}).get("obstacle_count"), people=len(meta.get("people") or []))
     return _note(slot, info)
 
 
