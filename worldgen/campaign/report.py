@@ -169,6 +169,28 @@ def _note(slot: Path, info: dict[str, Any]) -> dict[str, Any]:
     return info
 
 
+def _crossed(records) -> list[str]:
+    """Level by people: failed / judged in each cell, where both vary (how people change the level curve)."""
+    cells: dict[tuple, list[int]] = {}
+    for rec in records:
+        d = rec["descriptors"]
+        for r in rec.get("runs", ()):
+            if r["verdict"] in ("passed", "failed"):
+                c = cells.setdefault((d["level"], d["people"]), [0, 0])
+                c[0] += 1
+                c[1] += r["verdict"] == "failed"
+    levels = sorted({k[0] for k in cells if k[0] is not None})
+    people = sorted({k[1] for k in cells})
+    if len(levels) < 2 or len(people) < 2:
+        return []
+    out = ["Failed / judged runs by level and people:", "",
+           "| level | " + " | ".join(f"{p} people" for p in people) + " |", "|---" * (len(people) + 1) + "|"]
+    for lv in levels:
+        out.append(f"| {lv} | " + " | ".join(f"{cells[(lv, p)][1]} / {cells[(lv, p)][0]}" if (lv, p) in cells else "-"
+                                              for p in people) + " |")
+    return out + [""]
+
+
 def _pct(x: float) -> str:
     return f"{100 * x:.0f} %"
 
@@ -189,9 +211,11 @@ def _markdown(recipe: CampaignRecipe, records, rows, plots, failures, shrunk, ou
 
         lo, hi = clopper_pearson_interval(failed, len(judged), CONFIDENCE)
         lines += [f"Failure rate over the judged runs: {_pct(failed / len(judged))} "
-                  f"({int(CONFIDENCE * 100)} % Clopper-Pearson interval {_pct(lo)} to {_pct(hi)}). The runs were "
-                  "placed by the strategy, not drawn uniformly: rates per bin say where it fails, not how often "
-                  "a uniform user would see it.", ""]
+                  f"({int(CONFIDENCE * 100)} % Clopper-Pearson interval {_pct(lo)} to {_pct(hi)}). "
+                  + ("The runs were drawn uniformly over the space, so the rates are what a uniform draw of "
+                     "worlds would see." if recipe.strategy == "random" else
+                     "The runs were placed by the strategy, not drawn uniformly: rates per bin say where it "
+                     "fails, not how often a uniform draw of worlds would see it."), ""]
     worst = sorted((r for r in rows if r["failed"]), key=lambda r: (-r["low"], -r["rate"], r["dimension"], r["bin"]))[:8]
     lines += ["## Where it fails", ""]
     if worst:
@@ -224,6 +248,7 @@ def _markdown(recipe: CampaignRecipe, records, rows, plots, failures, shrunk, ou
         lines += [f"| {dim} | failed / judged | rate | 95 % interval |", "|---|---|---|---|"]
         lines += [f"| {r['bin']} | {r['failed']} / {r['judged']} | {_pct(r['rate'])} | {_pct(r['low'])} to "
                   f"{_pct(r['high'])} |" for r in mine] + [""]
+    lines += _crossed(records)
     if plots:
         lines += ["Plots:", ""] + [f"![{p.stem}]({p.relative_to(out).as_posix()})" for p in plots] + [""]
     return "\n".join(lines) + "\n"

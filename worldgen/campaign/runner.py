@@ -221,7 +221,8 @@ class _Loop:
         cluster = None
         try:
             if scheduler is None:
-                cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None)
+                cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None,
+                                       silence_logs=logging.ERROR)
             client = Client(scheduler or cluster, timeout="10s")
         except (OSError, TimeoutError) as exc:
             if cluster is not None:
