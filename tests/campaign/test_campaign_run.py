@@ -221,3 +221,44 @@ def test_the_pytest_helper_passes_a_campaign_without_failures(tmp_path):
     expect_no_failures(tmp_path / "ok")
     with pytest.raises(ParameterError, match="is not a campaign folder"):
         expect_no_failures(tmp_path)
+
+
+_INTERRUPTED = """\
+import sys
+sys.path.insert(0, {tests!r})
+from support.campaign import PlantedWeakness
+from worldgen.campaign import CampaignInterrupted, parse_campaign, run
+try:
+    run(parse_campaign({recipe!r}), {out!r}, system=PlantedWeakness(min_obstacles=24, min_people=1, slow=0.3))
+except CampaignInterrupted as exc:
+    print(exc.line())
+    sys.exit(130)
+"""
+
+
+def test_ctrl_c_keeps_every_finished_run_and_the_rerun_goes_on(tmp_path):
+    recipe = CORNER.replace("runs: 24", "runs: 40")
+    tests = str(Path(__file__).resolve().parent.parent)
+    out = tmp_path / "int"
+    proc = subprocess.Popen([sys.executable, "-c", _INTERRUPTED.format(tests=tests, recipe=recipe, out=str(out))],
+                            stdout=subprocess.PIPE, text=True)
+    state = out / CAMPAIGN_STATE_DIR
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and len(list(state.glob("[0-9]*[0-9].json"))) < 3 and proc.poll() is None:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGINT)
+    stdout, _ = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "rerun the same command" in stdout, stdout
+    done = len(list(state.glob("[0-9]*[0-9].json")))
+    rows = _rows(out / VERDICTS_NAME)
+    assert done >= 3 and len(rows) == done  # every finished run is in the tables
+    manifest = json.loads((out / MANIFEST_NAME).read_text())
+    assert manifest["complete"] is False and manifest["runs"] == done
+    s = run(parse_campaign(recipe.replace("runs: 40", f"runs: {done + 2}")), out, system=WEAK, report=False)
+    assert s.runs == done + 2 and json.loads((out / MANIFEST_NAME).read_text())["complete"]
+
+
+def test_a_budget_of_seconds_stops_asking_when_it_is_spent(tmp_path):
+    recipe = parse_campaign(CORNER.replace("budget: {runs: 24}", "budget: {seconds: 1}"))
+    s = run(recipe, tmp_path / "t", system=PlantedWeakness(slow=0.4), report=False)
+    assert 1 <= s.runs <= 4 and s.stopped == "the budget's 1 s", s.lines()
