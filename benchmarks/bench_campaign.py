@@ -1,6 +1,6 @@
 """Campaigns (issue 36): how fast each strategy finds distinct failures, and what a campaign costs per run.
 
-    .venv/bin/python benchmarks/bench_campaign.py [--seeds 10] [--cap 600] [--runs 200] [--episodes 5]
+    .venv/bin/python benchmarks/bench_campaign.py [--seeds 10] [--cap 600] [--runs 200] [--episodes 5] [--ribs]
 
 Part 1, the search: a planted weakness that fails only in one corner of a five-dimension space (cluttered
 8 x 8 m rooms, n_obstacles 0-30, n_people 0-2, robot_radius 0.15-0.3 m, obstacle_shapes box, cylinder or
@@ -9,6 +9,9 @@ the space). The failure is decided from the point itself (no world is built: wha
 runs each strategy spends), and two failures are distinct when their cells differ: obstacle band of 2,
 people count, radius band of 0.01 m. For each strategy, runs until the 10th distinct failure (--cap when it
 never gets there), over --seeds seeds; median. Target: adaptive or coverage at most a third of random's.
+With --ribs (pip install ribs), the quality-diversity alternative the coverage strategy was chosen against:
+pyribs' MAP-Elites (a GridArchive over the cells, two GaussianEmitters of 8 in [0, 1]^4, sigma 0.3, the best
+of 0.1 / 0.2 / 0.3 measured) asked and told the same way, the objective 1 for a failure, 0 for a pass.
 
 Part 2, the campaign's own cost per run: a sequential campaign's loop without the world and the system
 (Strategy.ask and tell, the point's two records written atomically, the progress log), per run over --runs
@@ -75,6 +78,37 @@ def runs_to_distinct(name: str, seed: int, cap: int, entries) -> int:
     return cap
 
 
+def ribs_runs_to_distinct(seed: int, cap: int, sigma: float = 0.3) -> int:
+    """Runs pyribs' MAP-Elites spends until DISTINCT distinct failures on the same corner."""
+    import numpy as np
+    from ribs.archives import GridArchive
+    from ribs.emitters import GaussianEmitter
+    from ribs.schedulers import Scheduler
+
+    archive = GridArchive(solution_dim=4, dims=[16, 3, 16], ranges=[(0, 31), (0, 3), (15, 31)], seed=seed)
+    emitters = [GaussianEmitter(archive, sigma=sigma, x0=np.full(4, 0.5), batch_size=8, seed=seed + 1000 * k,
+                                bounds=[(0, 1)] * 4) for k in range(2)]
+    scheduler = Scheduler(archive, emitters)
+    found: set = set()
+    spent = 0
+    while spent < cap:
+        objectives, measures = [], []
+        for x in scheduler.ask():
+            x = np.clip(x, 0, 1)
+            params = {"n_obstacles": int(round(x[0] * 30)), "n_people": int(round(x[1] * 2)),
+                      "robot_radius": 0.15 + 0.15 * float(x[2])}
+            spent += 1
+            failed = _fails(params)
+            if failed:
+                found.add(_cell(params))
+            if len(found) >= DISTINCT:
+                return spent
+            objectives.append(1.0 if failed else 0.0)
+            measures.append([params["n_obstacles"], params["n_people"], 100 * params["robot_radius"]])
+        scheduler.tell(np.array(objectives), np.array(measures))
+    return cap
+
+
 def loop_cost(runs: int, entries) -> float:
     """Seconds per run of the campaign's own loop (no world, no system)."""
     log = logging.getLogger("worldgen.progress")
@@ -120,6 +154,7 @@ def main() -> None:
     ap.add_argument("--cap", type=int, default=600)
     ap.add_argument("--runs", type=int, default=200)
     ap.add_argument("--episodes", type=int, default=5)
+    ap.add_argument("--ribs", action="store_true", help="also measure pyribs' MAP-Elites on the same corner")
     args = ap.parse_args()
     entries = parse_campaign(SPACE).entries
     search = {}
@@ -128,6 +163,10 @@ def main() -> None:
         search[name] = {"runs": spent, "median": statistics.median(spent)}
         print(f"{name:9s} runs to {DISTINCT} distinct failures: median {statistics.median(spent):g} "
               f"(seeds 0-{args.seeds - 1}: {spent}; cap {args.cap})", flush=True)
+    if args.ribs:
+        spent = [ribs_runs_to_distinct(seed, args.cap) for seed in range(args.seeds)]
+        search["ribs_map_elites"] = {"runs": spent, "median": statistics.median(spent)}
+        print(f"ribs MAP-Elites runs to {DISTINCT} distinct failures: median {statistics.median(spent):g} ({spent})")
     best = min(search["adaptive"]["median"], search["coverage"]["median"])
     ratio = best / search["random"]["median"]
     cost = loop_cost(args.runs, entries)
