@@ -81,6 +81,9 @@ def test_a_sequential_campaign_is_the_same_bytes_and_puts_the_corner_in_its_bins
     assert (tmp_path / "a" / "plots" / "people.png").is_file()
     manifest = json.loads((tmp_path / "a" / MANIFEST_NAME).read_text())
     assert manifest["complete"] and manifest["runs"] == 24 and manifest["failed"] == first.failed
+    # Uniform sampling with the same budget and seed finds far fewer.
+    uniform = run(parse_campaign(CORNER.replace("adaptive", "random")), tmp_path / "u", system=WEAK, report=False)
+    assert uniform.runs == 24 and 2 * uniform.failed < first.failed, (uniform.lines(), first.lines())
 
 
 MIXED = """\
@@ -214,6 +217,18 @@ def test_each_distinct_failure_is_shrunk_to_a_world_that_still_fails_and_passes_
     assert f"found {len(notes)} distinct failure(s)" in message
     for note in notes:
         assert str(tmp_path / "s" / json.loads(note.read_text())["folder"]) in message and "shrunk to" in message
+
+
+def test_a_relative_verdict_path_is_read_beside_the_recipe_and_the_report_redraws_without_it(tmp_path):
+    (tmp_path / "recipes").mkdir()
+    (tmp_path / "recipes" / "criteria.yaml").write_text("navigation:\n  success_rate: 1.0\n")
+    (tmp_path / "recipes" / "c.yaml").write_text(SHRINKABLE.replace("budget:", "verdict: criteria.yaml\nbudget:"))
+    from worldgen.campaign import load_campaign
+
+    recipe = load_campaign(tmp_path / "recipes" / "c.yaml")
+    assert recipe.verdict == str(tmp_path / "recipes" / "criteria.yaml")
+    run(recipe, tmp_path / "out", system=PlantedWeakness(min_obstacles=99), report=False)
+    assert write_report(tmp_path / "out").is_file()
 
 
 def test_the_pytest_helper_passes_a_campaign_without_failures(tmp_path):

@@ -58,8 +58,15 @@ def distinct_failures(records: Sequence[Mapping[str, Any]]) -> list[dict[str, An
 
 
 def _recipe(out: Path) -> CampaignRecipe:
+    """The campaign's recipe as stored; its verdict left out: the report needs none, and a criteria path
+    relative to where the recipe was is not relative to the campaign folder."""
+    import yaml
+
     path = out / CAMPAIGN_RECIPE_NAME
-    return parse_campaign(path.read_text(encoding="utf-8"), str(path), out.name, base=out)
+    document = yaml.safe_load(path.read_text(encoding="utf-8"))
+    if isinstance(document, dict):
+        document.pop("verdict", None)
+    return parse_campaign(yaml.safe_dump(document, sort_keys=False), str(path), out.name)
 
 
 def write_report(out, records: Optional[list] = None, system: Any = None) -> Path:
