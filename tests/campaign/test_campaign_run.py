@@ -277,3 +277,10 @@ def test_a_budget_of_seconds_stops_asking_when_it_is_spent(tmp_path):
     recipe = parse_campaign(CORNER.replace("budget: {runs: 24}", "budget: {seconds: 1}"))
     s = run(recipe, tmp_path / "t", system=PlantedWeakness(slow=0.4), report=False)
     assert 1 <= s.runs <= 4 and s.stopped == "the budget's 1 s", s.lines()
+
+
+def test_a_scheduler_out_of_reach_is_one_line_and_leaves_nothing_written(tmp_path):
+    pytest.importorskip("distributed")
+    with pytest.raises(ParameterError, match="cannot reach the dask scheduler"):
+        run(parse_campaign(SHRINKABLE), tmp_path / "new" / "out", scheduler="tcp://127.0.0.1:9", system=WEAK)
+    assert not (tmp_path / "new").exists()

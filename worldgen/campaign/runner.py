@@ -17,6 +17,7 @@ running then, and a rerun of the same recipe runs those again and goes on to the
 from __future__ import annotations
 
 import logging
+import shutil
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -125,6 +126,7 @@ def run(recipe: Union[CampaignRecipe, str, Path], out, *, jobs: int = 1, schedul
     refuse_other(out, recipe)
     system = system if system is not None else _system(recipe)
     strategy = Strategy(recipe.strategy, recipe.seed, recipe.entries)
+    created = _first_missing(out)
     claim_folder(out, recipe)
     loop = _Loop(recipe, out, strategy, system)
     try:
@@ -132,6 +134,12 @@ def run(recipe: Union[CampaignRecipe, str, Path], out, *, jobs: int = 1, schedul
             loop.in_process()
         else:
             loop.on_dask(jobs, scheduler)
+    except WorldgenError:
+        # A scheduler out of reach, a missing extra: a folder this call created and nothing finished in it goes
+        # again, so a mistake leaves nothing written. Finished runs are never removed.
+        if created is not None and not loop.summary.points:
+            shutil.rmtree(created, ignore_errors=True)
+        raise
     except KeyboardInterrupt as exc:
         loop.finish(worldgen.__version__, complete=False)
         raise CampaignInterrupted(loop.summary) from exc
@@ -144,6 +152,14 @@ def run(recipe: Union[CampaignRecipe, str, Path], out, *, jobs: int = 1, schedul
 
         write_report(out, records, system=system if shrink else None)
     return loop.summary
+
+
+def _first_missing(path: Path) -> Optional[Path]:
+    """The outermost folder on the way to ``path`` that does not exist yet (None: ``path`` exists)."""
+    missing = None
+    while not path.exists() and path.parent != path:
+        missing, path = path, path.parent
+    return missing
 
 
 def _system(recipe: CampaignRecipe):
