@@ -772,3 +772,19 @@ def test_every_type_ignore_names_its_error_and_says_why():
             if not m.group(1) or not reason:
                 found.append(f"{path.relative_to(PACKAGE.parent)}:{i + 1} {line.strip()}")
     assert not found, "type: ignore without an error code or a reason:\n" + "\n".join(found)
+
+
+# -- campaigns --------------------------------------------------------------------------------------------
+
+BUILTIN_RAISES_ALLOWED[("campaign/__init__.py", "AttributeError")] = \
+    "a module's __getattr__ protocol (names loaded on first use)"
+
+
+def test_the_campaign_package_loads_its_modules_on_first_use():
+    """``import worldgen.campaign`` imports none of its modules (nor Optuna): a campaign's name is loaded when used."""
+    import subprocess
+    import sys
+
+    code = ("import sys, worldgen.campaign as c; assert not [m for m in sys.modules if m.startswith('worldgen.campaign.')"
+            " or m == 'optuna'], sorted(sys.modules); c.run; assert 'worldgen.campaign.runner' in sys.modules")
+    subprocess.run([sys.executable, "-c", code], check=True, cwd=PACKAGE.parent)

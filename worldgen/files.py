@@ -21,9 +21,10 @@ from worldgen.errors import OutputError
 
 __all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "MAP_YAML_NAME", "SDF_NAME", "MJCF_NAME",
            "URDF_NAME", "USDA_NAME", "USDC_NAME", "MANIFEST_NAME", "INDEX_NAME", "WORLDS_DIR", "BUILD_STATE_DIR",
-           "REPORT_JSON_NAME", "REPORT_CSV_NAME", "REPORT_MD_NAME", "REPORT_RUNS_DIR", "creation_mode", "safe_relative",
-           "write_atomically", "atomic_folder", "write_folder_atomically", "move_into_place", "refuse_other_world",
-           "recorded_content_hash"]
+           "REPORT_JSON_NAME", "REPORT_CSV_NAME", "REPORT_MD_NAME", "REPORT_RUNS_DIR", "CAMPAIGN_RECIPE_NAME",
+           "VERDICTS_NAME", "FAILURES_NAME", "STRATEGY_NAME", "FAILURE_MAP_NAME", "CAMPAIGN_STATE_DIR", "RUNS_DIR",
+           "SHRUNK_DIR", "PLOTS_DIR", "creation_mode", "safe_relative", "write_atomically", "atomic_folder",
+           "write_folder_atomically", "move_into_place", "refuse_other_world", "recorded_content_hash"]
 
 #: A world folder: its ground truth, scenario, picture and nav2 map.
 METADATA_NAME = "world.json"
@@ -49,6 +50,20 @@ REPORT_JSON_NAME = "report.json"
 REPORT_CSV_NAME = "report.csv"
 REPORT_MD_NAME = "report.md"
 REPORT_RUNS_DIR = "runs"
+#: A campaign folder (worldgen.campaign): the recipe as given, every run's verdict, the failed ones, the
+#: search's state, the failure map (a table and plots), the report a reviewer reads first (REPORT_MD_NAME, as
+#: a judge's report names it); the worlds are in WORLDS_DIR, what each run's system wrote in RUNS_DIR, each
+#: distinct failure shrunk in SHRUNK_DIR, and the records of finished points (what a resume reads) in
+#: CAMPAIGN_STATE_DIR.
+CAMPAIGN_RECIPE_NAME = "campaign.yaml"
+VERDICTS_NAME = "verdicts.csv"
+FAILURES_NAME = "failures.csv"
+STRATEGY_NAME = "strategy.json"
+FAILURE_MAP_NAME = "failure_map.csv"
+CAMPAIGN_STATE_DIR = ".campaign"
+RUNS_DIR = "runs"
+SHRUNK_DIR = "shrunk"
+PLOTS_DIR = "plots"
 
 
 def creation_mode(full: int) -> int:

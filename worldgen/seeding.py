@@ -16,6 +16,7 @@ an environment's curriculum     ``(CURRICULUM_STREAM,)``      ``envs.curriculum`
 an edit of a level              ``(EDIT_STREAM,)``            ``verify.edits`` (the edit's own seed)
 a recipe's sampled parameter    ``[seed, entry, tag(name)]``  ``pack.recipe`` (entropy, no key)
 a baseline policy's actions     ``()``                        ``envs.policies`` (the policy's seed)
+point ``k`` of a campaign       ``(CAMPAIGN_STREAM, k)``      ``campaign.strategies`` (the strategy's seed)
 ==============================  ============================  =====================================
 
 >>> float(attempt_rng(7, 0).random()) == float(attempt_rng(7, 0).random())
@@ -36,7 +37,7 @@ import numpy as np
 from worldgen.errors import ParameterError
 
 __all__ = ["MAX_SEED", "MOVER_STREAM", "PEOPLE_STREAM", "WORLD_STREAM", "NOISE_STREAM", "LEVEL_STREAM", "CURRICULUM_STREAM",
-           "EDIT_STREAM", "level_seed", "curriculum_rng", "edit_rng", "policy_rng",
+           "EDIT_STREAM", "CAMPAIGN_STREAM", "level_seed", "campaign_seeds", "curriculum_rng", "edit_rng", "policy_rng",
            "check_seed", "attempt_rng", "mover_rng", "people_rng", "env_rngs", "draw_seed", "recipe_rng"]
 
 #: The largest seed anywhere (numpy's ``integers`` draws below 2**63 without overflow).
@@ -55,6 +56,8 @@ LEVEL_STREAM = 0x6C766C
 CURRICULUM_STREAM = 2
 #: Key of an edit's stream ("edt"), beside the edit's own seed (worldgen.verify.edits).
 EDIT_STREAM = 0x656474
+#: Key of a campaign's points ("cam"), beside the point's number: its world's seed and its sampler's seed.
+CAMPAIGN_STREAM = 0x63616D
 
 
 def check_seed(seed: Any, what: str = "parameter 'seed'") -> int:
@@ -108,6 +111,13 @@ def edit_rng(seed: int) -> np.random.Generator:
 def level_seed(seed: int, draw: int) -> int:
     """The world seed of draw ``draw`` of a request for a level with ``seed`` (worldgen.leveling)."""
     return draw_seed(_stream(seed, LEVEL_STREAM, draw))
+
+
+def campaign_seeds(seed: int, point: int) -> tuple[int, int]:
+    """(world seed, sampler seed) of point number ``point`` of a campaign whose strategy has ``seed``: a point's
+    world and its proposal never depend on how many points came before it, only on its number."""
+    rng = _stream(seed, CAMPAIGN_STREAM, point)
+    return draw_seed(rng), int(rng.integers(0, 2**32))
 
 
 def draw_seed(rng: np.random.Generator) -> int:

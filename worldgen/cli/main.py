@@ -17,6 +17,7 @@ from typing import Optional, Sequence
 import click
 
 import worldgen
+from worldgen.cli.campaign import campaign_command
 from worldgen.cli.compare import compare_command
 from worldgen.cli.context import CONTEXT
 from worldgen.cli.drive import drive_command
@@ -40,7 +41,7 @@ def cli() -> None:
 
 
 for _command in (list_command, generate_command, preview_command, check_command, presets_command, pack_group,
-                 compare_command, judge_command, drive_command):
+                 compare_command, judge_command, drive_command, campaign_command):
     cli.add_command(_command)
 
 
