@@ -216,9 +216,9 @@ def _timed(folder: Path, rows) -> None:
 def test_driving_the_line_through_the_person_fails_timed(head_on, capsys):
     """On the path and under max_speed (0.4995 of 0.5 m/s), but straight through the person walking it."""
     task = json.loads((head_on / "world.json").read_text())["tasks"][0]
-    assert task["arrival_time"] == 23.65  # the certificate waits: 9 m at 0.5 m/s would take 18 s
+    assert task["arrival_time"] == 24.0  # the certificate waits: 9 m at 0.5 m/s would take 18 s
     _timed(head_on, [[0.0, *task["spawn"][:2]], [round(9.0 / 0.4995, 6), *task["goal"][:2]]])
-    _fails(capsys, head_on, "timed", "task_0 timed_path at t = ", "from person_0's centre", "0.5000 m")
+    _fails(capsys, head_on, "timed", "task_0 timed_path at t = ", "from person_0's centre", "0.5500 m")
 
 
 def test_a_timed_path_faster_than_max_speed_fails_timed(head_on, capsys):
@@ -238,8 +238,8 @@ def test_a_timed_path_that_cuts_a_corner_fails_timed(among_people, tmp_path, cap
     folder = Path(shutil.copytree(among_people[1], tmp_path / among_people[1].name))
     task = json.loads((folder / "world.json").read_text())["tasks"][0]
     corner = task["path"]["waypoints"][3]
-    rows = [r for r in task["timed_path"] if r[1:] != corner]  # the row at the path's third corner dropped
-    assert len(rows) == len(task["timed_path"]) - 1
+    rows = [r for r in task["timed_path"] if r[1:] != corner]  # the rows at the path's third corner dropped
+    assert len(task["timed_path"]) - 3 <= len(rows) < len(task["timed_path"])  # come, (turn,) leave
     _timed(folder, rows)
     _fails(capsys, folder, "timed", "leaves the recorded path", "cuts a corner")
 
