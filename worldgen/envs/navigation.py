@@ -202,8 +202,7 @@ class NavigationEnv(gym.Env):
             self._time_limit = float(world.task["time_limit"])
         else:
             v_max, w_max = float(self._act_hi[0]), float(self._act_hi[1])
-            # Never shorter than the certified schedule among people (a slower robot's than the env's).
-            optimal = max(world.reference_path_length / v_max, float(world.task.get("arrival_time") or 0.0))
+            optimal = max(world.reference_path_length / v_max, world.task.get("arrival_time") or 0.0)  # among people
             self._time_limit = cfg.time_limit_factor * optimal + math.pi / w_max
         self._lidar_height = cfg.lidar_height if cfg.lidar_height is not None else world.lidar_height
         self._last_action = np.zeros(2)
