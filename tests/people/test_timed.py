@@ -286,3 +286,15 @@ def test_a_spawn_facing_away_from_the_path_turns_first_and_the_unicycle_keeps_up
     # falls behind by more than the margin (what the turn at the spawn is for).
     late, _ = _tracking_error(ahead.rows, math.pi, lim)
     assert late > TRACKING
+
+
+@pytest.mark.parametrize("behaviour", ["impassive", "regular", "surprised", "scared", "curious"])
+def test_person_head_on_is_made_with_every_behaviour_on_its_first_draw(behaviour):
+    """A reacting person starts where its tube fits (farther from the goal) and walks round the robot."""
+    world = worldgen.generate_preset("person_head_on", people_behaviour=behaviour)
+    meta = world.metadata
+    metadata.validate(meta)
+    assert world.attempts == 1 and meta["feasibility"]["feasible"] and _verify(meta) == 1
+    start = np.array(meta["people"][0]["trajectory"][0][1:])
+    short = float(np.hypot(*(start - meta["tasks"][0]["goal"][:2])))
+    assert (short == pytest.approx(1.0)) == (behaviour in ("impassive", "surprised")), short

@@ -293,3 +293,30 @@ def test_a_timed_path_into_a_tube_fails_timed(reacting, tmp_path, capsys):
     _timed(folder, rows)
     line = _fails(capsys, folder, "timed", "recorded positions within", "its tube's d")
     assert goal == rows[-1][1:] and "\n" not in line
+
+
+# -- timed within the robot's limits: the turns and the speed changes ---------------------------------------
+
+@pytest.mark.parametrize("field, value, words", [
+    ("max_turn_rate", 0.5, ("timed_path turns", "faster than robot.max_turn_rate 0.5 rad/s")),
+    ("max_acceleration", 0.5, ("timed_path changes speed", "faster than robot.max_acceleration 0.5 m/s^2")),
+])
+def test_a_timed_path_beyond_the_stated_limits_fails_timed(among_people, tmp_path, capsys, field, value, words):
+    """The world's schedule, against a robot stated slower to turn or to speed up than the one it was made for."""
+    folder = Path(shutil.copytree(among_people[1], tmp_path / among_people[1].name))
+    meta = json.loads((folder / "world.json").read_text())
+    assert meta["robot"][field] == 1.0
+    _edit_json(folder, lambda m: m["robot"].__setitem__(field, value))
+    _fails(capsys, folder, "timed", *words)
+
+
+def test_a_timed_path_that_sets_off_before_turning_from_the_spawn_fails_timed(among_people, tmp_path, capsys):
+    """The world's schedule with its first stand (the turn from the spawn's yaw) cut short by one step."""
+    folder = Path(shutil.copytree(among_people[1], tmp_path / among_people[1].name))
+    task = json.loads((folder / "world.json").read_text())["tasks"][0]
+    rows = task["timed_path"]
+    assert rows[1][1:] == rows[0][1:] and rows[1][0] >= 0.1  # it stands at the spawn first, turning
+    rows[1][0] = round(rows[1][0] - 0.05, 6)
+    rows[2:] = [[round(t - 0.05, 6), x, y] for t, x, y in rows[2:]]
+    _timed(folder, rows)
+    _fails(capsys, folder, "timed", "timed_path turns", "after standing", "faster than robot.max_turn_rate 1 rad/s")
