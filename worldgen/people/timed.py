@@ -156,11 +156,12 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     free = np.zeros((0, n_cells + 1), dtype=bool)
     moving, turning = [], []  # per step: (cell, speed) states, and (spot, steps turned) states
     k_goal = None
+    ok_t = np.ascontiguousarray(ok.T)  # the sweep works speed by speed: each speed's cells in a row
     for k in range(steps + 1):
         if k == len(free):
             free = np.concatenate([free, _free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], window)])
         here = free[k]
-        cell = np.zeros((n_cells + 1, levels + 1), dtype=bool)
+        cell = np.zeros((levels + 1, n_cells + 1), dtype=bool)
         turn = np.zeros((len(spot), span), dtype=bool)
         if k == 0:
             if len(spot) and spot[0] == 0:
@@ -168,24 +169,24 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
             else:
                 cell[0, 0] = here[0]
         else:
-            prev, was = moving[-1], turning[-1]
+            prev, was = moving[-1].T, turning[-1]
             near = prev.copy()  # the speeds one level or less away from each next speed
-            near[:, 1:] |= prev[:, :-1]
-            near[:, :-1] |= prev[:, 1:]
+            near[1:] |= prev[:-1]
+            near[:-1] |= prev[1:]
             for c, fits in passes.items():
-                near[c] = (prev[c][:, None] & fits).any(axis=0)
-            near &= ok
+                near[:, c] = (prev[:, c][:, None] & fits).any(axis=0)
+            near &= ok_t
             for u in range(levels + 1):
-                cell[u:, u] = near[:n_cells + 1 - u, u]
+                cell[u, u:] = near[u, :n_cells + 1 - u]
             turn[:, 1:] = was[:, :-1] & live[:, 1:]
-            turn[:, 0] = cell[spot, 1]  # come to a corner at one cell a step, and stop there to turn
-            cell[spot, 1:] = False
-            cell[spot, 0] |= was[np.arange(len(spot)), spot_steps - 1]
-            cell &= here[:, None]
+            turn[:, 0] = cell[1, spot]  # come to a corner at one cell a step, and stop there to turn
+            cell[1:, spot] = False
+            cell[0, spot] |= was[np.arange(len(spot)), spot_steps - 1]
+            cell &= here[None, :]
             turn &= here[spot][:, None]
-        moving.append(cell)
+        moving.append(cell.T)  # read back as (cell, speed)
         turning.append(turn)
-        if cell[n_cells, :2].any():
+        if cell[:2, n_cells].any():
             k_goal = k
             break
         if not (cell.any() or turn.any()):
