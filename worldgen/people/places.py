@@ -277,7 +277,8 @@ def _scripted(scenario: str, scene: Scene, task: Task, speed: float, params: Map
     return out, None
 
 
-def _head_on(s, g, u, n, length: float, index: FootprintIndex, radius: float):
+def _head_on(s, g, u, n, length: float, index: FootprintIndex,
+             radius: float) -> tuple[np.ndarray, list[np.ndarray], float]:
     """(start, places, departure) of the head-on person (:func:`_scripted`)."""
     # As near the goal as the person fits: farther back where a reacting person's tube, kept off the
     # goal, would not let it stand HEAD_ON_SHORT short of it.

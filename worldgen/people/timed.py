@@ -137,8 +137,8 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     # A corner passed without a turn joins legs of slightly different cells: which speed (in cells a step)
     # may follow which there, for the change in m/s to stay within one cell a step of the finest legs.
     leg_ds = np.diff(s[corner])
-    u = np.arange(levels + 1)
-    passes = {int(corner[j]): np.abs(u[None, :] * leg_ds[j] - u[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
+    lv = np.arange(levels + 1)
+    passes = {int(corner[j]): np.abs(lv[None, :] * leg_ds[j] - lv[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
               for j in range(1, len(corner) - 1) if turns[j] == 0}
     # A move of u cells from cell c may not cross a corner: c + u <= the first corner after c.
     nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
@@ -154,7 +154,8 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     span = int(spot_steps.max(initial=1))
     live = np.arange(span)[None, :] < spot_steps[:, None]
     free = np.zeros((0, n_cells + 1), dtype=bool)
-    moving, turning = [], []  # per step: (cell, speed) states, and (spot, steps turned) states
+    moving: list[np.ndarray] = []  # per step: (cell, speed) states, and (spot, steps turned) states
+    turning: list[np.ndarray] = []
     k_goal = None
     ok_t = np.ascontiguousarray(ok.T)  # the sweep works speed by speed: each speed's cells in a row
     for k in range(steps + 1):
@@ -216,9 +217,9 @@ def _read_back(moving, turning, spot, spot_steps, ok, passes, goal: int, levels:
                 state = ("cell", c, u)
         else:
             c, u = state[1], state[2]
-            j = where.get(c)
-            if j is not None and u == 0 and was[j, spot_steps[j] - 1]:
-                state = ("turn", j, int(spot_steps[j]) - 1)
+            at = where.get(c)
+            if at is not None and u == 0 and was[at, spot_steps[at] - 1]:
+                state = ("turn", at, int(spot_steps[at]) - 1)
             else:
                 src = c - u
                 fits = passes.get(src)
@@ -270,7 +271,7 @@ def certify(report: FeasibilityReport, scene, tasks, robot, limits,
     if missing:
         check = Check("timed_path", False, None, "no timed path among the people for " + "; ".join(missing))
     else:
-        latest = max(t.arrival for t in found)
+        latest = max(t.arrival for t in found if t is not None)
         check = Check("timed_path", True, latest,
                       f"{len(found)} timed path(s) among {len(people)} people, latest arrival {latest:.2f} s")
     return replace(report, checks=report.checks + (check,), timed_paths=tuple(found))
