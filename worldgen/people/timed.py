@@ -48,7 +48,7 @@ DT = 0.05
 MARGIN = 0.01
 #: Distance (m) a follower may be off its schedule, kept beyond MARGIN: three times the shipped
 #: TimedFollower's largest measured tracking error in the environment at its defaults (0.0099 m over 42
-#: episodes, docs/people.md), and above tests/support/unicycle.py's (0.021 m on the presets).
+#: episodes, docs/people.md), and above tests/support/unicycle.py's (0.018 m on the presets).
 TRACKING = 0.03
 #: Share of the top speed and of the acceleration the cells leave spare, for the rounding of the rows.
 SPARE = 1e-3
