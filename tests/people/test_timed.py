@@ -298,3 +298,16 @@ def test_person_head_on_is_made_with_every_behaviour_on_its_first_draw(behaviour
     start = np.array(meta["people"][0]["trajectory"][0][1:])
     short = float(np.hypot(*(start - meta["tasks"][0]["goal"][:2])))
     assert (short == pytest.approx(1.0)) == (behaviour in ("impassive", "surprised")), short
+
+
+def test_a_path_of_many_corners_is_given_time_to_stop_and_turn_at_each():
+    """29 legs at right angles, nobody in the way: each corner costs a stop, a quarter turn and a start,
+    more than the sweep's slack after the drive at full speed, and the schedule still arrives."""
+    waypoints = np.array([[i * 0.5, (i % 2) * 0.5] for i in range(30)])
+    far = np.array([[0.0, 50.0, 50.0], [1.0, 50.0, 50.0]])
+    lim = Limits(0.5, 1.0, 1.0)
+    found = timed_path(waypoints, [far], [0.25], 0.25, lim, heading=0.0)
+    length = float(np.sum(np.hypot(*np.diff(waypoints, axis=0).T)))
+    turning = sum(math.ceil(a / (lim.turn_rate * DT) - 1e-9) * DT for a in turn_angles(waypoints, 0.0))
+    assert found is not None and found.arrival > length / lim.max_speed + turning + 5.0
+    _assert_drivable(found.rows, 0.0, lim.turn_rate, lim.acceleration)

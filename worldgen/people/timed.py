@@ -144,7 +144,9 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
     ok = np.arange(n_cells + 1)[:, None] + np.arange(levels + 1)[None, :] <= nxt[:, None]
     end = max((float(t[-1, 0]) for t in tracks), default=0.0)
-    steps = math.ceil((end + length / lim.max_speed + float(spot_steps.sum()) * DT + AFTER) / DT) + 2 * levels
+    # Beyond the drive at full speed: the stands to turn, and slowing to a stop and speeding up again at
+    # every corner (V steps each way at most).
+    steps = math.ceil((end + length / lim.max_speed + float(spot_steps.sum()) * DT + AFTER) / DT) + levels * len(corner)
     times = np.arange(steps + 1) * DT
     reach = (np.asarray(radii, dtype=float) + inflation + MARGIN + tracking
              + (lim.max_speed + person_speed(tracks)) * DT / 2)
