@@ -156,15 +156,18 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     span = int(spot_steps.max(initial=1))
     live = np.arange(span)[None, :] < spot_steps[:, None]
     free = np.zeros((0, n_cells + 1), dtype=bool)
-    moving: list[np.ndarray] = []  # per step: (cell, speed) states, and (spot, steps turned) states
+    # Per step: the (speed, cell) states, bit-packed (a long path holds some 10^4 cells at 11 speeds for
+    # 10^3 steps), and the (spot, steps turned) states; ``cell`` is the last step's, unpacked.
+    moving: list[np.ndarray] = []
     turning: list[np.ndarray] = []
     k_goal = None
     ok_t = np.ascontiguousarray(ok.T)  # the sweep works speed by speed: each speed's cells in a row
+    cell = np.zeros((levels + 1, n_cells + 1), dtype=bool)
     for k in range(steps + 1):
         if k == len(free):
             free = np.concatenate([free, _free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], window)])
         here = free[k]
-        cell = np.zeros((levels + 1, n_cells + 1), dtype=bool)
+        prev, cell = cell, np.zeros((levels + 1, n_cells + 1), dtype=bool)
         turn = np.zeros((len(spot), span), dtype=bool)
         if k == 0:
             if len(spot) and spot[0] == 0:
@@ -172,7 +175,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
             else:
                 cell[0, 0] = here[0]
         else:
-            prev, was = moving[-1].T, turning[-1]
+            was = turning[-1]
             near = prev.copy()  # the speeds one level or less away from each next speed
             near[1:] |= prev[:-1]
             near[:-1] |= prev[1:]
@@ -187,7 +190,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
             cell[0, spot] |= was[np.arange(len(spot)), spot_steps - 1]
             cell &= here[None, :]
             turn &= here[spot][:, None]
-        moving.append(cell.T)  # read back as (cell, speed)
+        moving.append(np.packbits(cell))
         turning.append(turn)
         if cell[:2, n_cells].any():
             k_goal = k
@@ -196,19 +199,23 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
             return None
     if k_goal is None:
         return None
-    cells = _read_back(moving, turning, spot, spot_steps, ok, passes, n_cells, levels)
+    def states(step: int) -> np.ndarray:
+        """(cell, speed) bool: the states of ``step``, unpacked one step at a time."""
+        return np.unpackbits(moving[step], count=(levels + 1) * (n_cells + 1)).reshape(levels + 1, -1).T.astype(bool)
+
+    cells = _read_back(states, len(moving), turning, spot, spot_steps, ok, passes, n_cells, levels)
     return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)]), k_goal * DT)
 
 
-def _read_back(moving, turning, spot, spot_steps, ok, passes, goal: int, levels: int) -> list[int]:
+def _read_back(states, n_steps: int, turning, spot, spot_steps, ok, passes, goal: int, levels: int) -> list[int]:
     """The cell of every step, from 0 to the arrival, of one schedule the sweep's stored sets allow: from
     the goal back, each step's predecessor the first the sets hold (standing before moving, slower first)."""
-    k = len(moving) - 1
-    state = ("cell", goal, int(np.flatnonzero(moving[k][goal, :2])[0]))
+    k = n_steps - 1
+    state = ("cell", goal, int(np.flatnonzero(states(k)[goal, :2])[0]))
     cells = [goal]
     where = {int(c): j for j, c in enumerate(spot)}
     while k > 0:
-        prev, was = moving[k - 1], turning[k - 1]
+        prev, was = states(k - 1), turning[k - 1]
         if state[0] == "turn":
             j, m = state[1], state[2]
             if m > 0:
