@@ -4,8 +4,9 @@ what reactions cost an environment step, and what the tube costs the certificate
     .venv/bin/python benchmarks/bench_reacting.py [--episodes N] [--steps N] [--worlds N] [--all-cores]
 
 - ``episodes``: N episodes (default 1,000) of the timed path's follower (worldgen.envs.policies.drive_timed,
-  turn rate 20 rad/s) among reacting people: four presets made reacting (person_crossing, person_overtaking,
-  group_in_corridor, person_in_doorway) and random crowds (cluttered 8 x 8 m, 4 obstacles, 5 people, 12 s),
+  at the environment's defaults: the timed path turns within robot.max_turn_rate) among reacting people:
+  four presets made reacting (person_crossing, person_overtaking, group_in_corridor, person_in_doorway)
+  and random crowds (cluttered 8 x 8 m, 4 obstacles, 5 people, 12 s),
   the behaviour cycling through regular, surprised, scared, curious and a mix of all five; a new world seed
   each episode. Counted: contacts with people (the target: 0), steps at which a reacting person was
   outside its tube (by the exact distance to its recorded positions within tau; the target: 0), the
@@ -54,7 +55,7 @@ def episodes(n: int) -> dict:
         kind, where = KINDS[k % len(KINDS)], (PRESETS + ("crowd",))[(k // len(KINDS)) % (len(PRESETS) + 1)]
         key = (kind, where)
         if key not in envs:
-            settings = dict(angular_velocity=20.0, time_limit_factor=None)
+            settings: dict = {}  # the environment's defaults: the timed path is drivable within them
             if where == "crowd":
                 envs[key] = gymnasium.make("worldgen/Navigation-v0", generator="cluttered",
                                            params=dict(CROWD, people_behaviour=kind), **settings)

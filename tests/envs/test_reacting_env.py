@@ -1,5 +1,6 @@
 """Reacting people in the environment: the robot's pose feeds them every step, the timed path's follower
-touches none of them whatever they do, each stays inside its tube, and the same seed gives the same run."""
+(at the environment's defaults) touches none of them whatever they do and reaches the goal in every
+preset with people, each stays inside its tube, and the same seed gives the same run."""
 
 from __future__ import annotations
 
@@ -10,12 +11,14 @@ from support.envs import ENV_ID, gymnasium
 from worldgen.envs.policies import drive_timed
 from worldgen.people.behaviours import BEHAVIOURS, tube_distance
 
-#: Turn rates well above the timed path's (it turns its corners on the spot), as TimedFollower asks.
-FAST_TURNS = dict(angular_velocity=20.0, time_limit_factor=None)
+#: Every preset whose world has people.
+PEOPLE_PRESETS = ["person_head_on", "person_crossing", "person_in_doorway", "person_overtaking", "group_in_corridor",
+                  "crowd_reacting"]
 
 
 def _env(**params):
-    return gymnasium.make(ENV_ID, generator="cluttered", params=params, **FAST_TURNS)
+    """The environment at its defaults (turn rate, speeds, time limit) in a cluttered world of ``params``."""
+    return gymnasium.make(ENV_ID, generator="cluttered", params=params)
 
 
 def _outside(info: dict, env) -> float:
@@ -47,13 +50,33 @@ def test_the_timed_follower_touches_no_reacting_person(behaviour):
 
 def test_people_react_to_the_robot_in_a_preset():
     """person_crossing made regular: the person crossing the robot's line reacts to it, and is not touched."""
-    env = gymnasium.make(ENV_ID, preset="person_crossing", params={"people_behaviour": "regular"}, **FAST_TURNS)
+    env = gymnasium.make(ENV_ID, preset="person_crossing", params={"people_behaviour": "regular"})
     info = drive_timed(env, seed=0)
     assert info["success"] and info["collisions"] == []
     walked = env.unwrapped.episode.walkers.reacted["person_0"]
     recorded = np.asarray(env.unwrapped.world.movers[0]["trajectory"], dtype=float)
     here = np.c_[np.interp(walked[:, 0], recorded[:, 0], recorded[:, 1]), np.interp(walked[:, 0], recorded[:, 0], recorded[:, 2])]
     assert np.hypot(*(walked[:, 1:] - here).T).max() > 0.05  # it reacted, not replayed its recording
+
+
+@pytest.mark.parametrize("preset", PEOPLE_PRESETS)
+def test_the_timed_follower_at_the_envs_defaults_reaches_the_goal_in_every_people_preset(preset):
+    """The time limit covers the certified arrival, and the follower keeps within the tracking margin."""
+    from worldgen.envs.policies import TimedFollower
+    from worldgen.people.timed import TRACKING
+
+    env = gymnasium.make(ENV_ID, preset=preset)
+    _, start = env.reset(seed=0)
+    # The default limit: twice the longer of L / v_max (at the env's 1 m/s) and the certified arrival (at the
+    # world's 0.5 m/s), plus a half turn: never shorter than the schedule.
+    arrival = env.unwrapped.task["arrival_time"]
+    assert start["time_limit"] == pytest.approx(2.0 * max(start["reference_path_length"] / 1.0, arrival) + np.pi / 1.0)
+    info = drive_timed(env, seed=0)
+    assert info["success"] and info["collisions"] == [], (info["time_to_goal"], info["collisions"])
+    u = env.unwrapped
+    follower, rows = TimedFollower.for_env(env), np.asarray(u.episode.rows)
+    lag = max(float(np.hypot(*(follower.at(t) - rows[k, 1:3]))) for k, t in enumerate(rows[:, 0]))
+    assert lag <= TRACKING, lag
 
 
 def test_the_same_seed_gives_the_same_reactions_and_vector_envs_react_too():

@@ -29,7 +29,7 @@ def _counting_builds(monkeypatch):
     return calls
 
 
-@pytest.mark.parametrize("scenario, where", [("head_on", "place (-0.750, 0.000)"), ("overtaking", "start (-1.250, 1.000)")])
+@pytest.mark.parametrize("scenario, where", [("head_on", "place (2.160, 0.513)"), ("overtaking", "start (-1.250, 1.000)")])
 def test_a_corridor_script_behind_its_end_wall_is_refused_before_any_draw(monkeypatch, scenario, where):
     calls = _counting_builds(monkeypatch)
     with pytest.raises(InfeasibleError) as err:

@@ -11,7 +11,7 @@ import pytest
 
 from worldgen.people.behaviours import BEHAVIOURS, TUBES, Tube, tube_distance
 from worldgen.people.react import Reactions
-from worldgen.people.timed import MARGIN, timed_path
+from worldgen.people.timed import MARGIN, TRACKING, timed_path
 
 ROBOT_R = 0.2
 PERSON_R = 0.25
@@ -126,5 +126,5 @@ def test_the_timed_path_clears_the_tube_and_a_wider_tube_is_touched(tube):
     gap = tube_distance(me, t, track, tube.tau + h / 2) - (inflation + PERSON_R + tube.d)
     assert gap.min() >= 0.5 * h  # the certificate's margin, less what the robot moves between samples
     # The earliest schedule waits only as long as it must: a tube widened past the margin is entered.
-    wider = tube_distance(me, t, track, tube.tau + 0.1) - (inflation + PERSON_R + tube.d + MARGIN + 0.06)
+    wider = tube_distance(me, t, track, tube.tau + 0.1) - (inflation + PERSON_R + tube.d + MARGIN + TRACKING + 0.06)
     assert wider.min() < 0

@@ -1,5 +1,6 @@
 """The certificate among people (tasks[].timed_path): checked independently from world.json alone at a
-fine time step against every person, against a hand-checked wait, and against a brute-force search."""
+fine time step against every person and the robot's limits, against a hand-checked wait, against a
+brute-force search, and driven by an independent unicycle at the stated limits."""
 
 from __future__ import annotations
 
@@ -9,9 +10,10 @@ import numpy as np
 import pytest
 
 import worldgen
+from tests.support.unicycle import drive
 from worldgen.errors import InfeasibleError
 from worldgen.export import metadata
-from worldgen.people.timed import CELLS_PER_STEP, DT, MARGIN, SPARE, person_speed, timed_path
+from worldgen.people.timed import DT, MARGIN, SPARE, TRACKING, Limits, person_speed, timed_path, turn_angles
 
 #: The fine step (s) of the independent check.
 H = 0.002
@@ -24,7 +26,8 @@ def _interp(rows: np.ndarray, t: np.ndarray) -> np.ndarray:
 def _verify(meta: dict) -> int:
     """Check every task's timed path of a world.json dict on its own terms; the number checked."""
     robot = meta["robot"]
-    inflation, v_max = robot["radius"] + robot["clearance"], robot["max_speed"]
+    inflation, v_max = robot["radius"] + robot["clearance"] + robot["tracking_margin"], robot["max_speed"]
+    assert robot["tracking_margin"] == TRACKING
     people = [(np.array(p["trajectory"]), p["radius"]) for p in meta["people"]]
     w = v_max + max(float(np.max(np.hypot(*np.diff(t[:, 1:], axis=0).T) / np.diff(t[:, 0]))) for t, _ in people)
     checked = 0
@@ -36,6 +39,7 @@ def _verify(meta: dict) -> int:
         np.testing.assert_allclose(rows[-1, 1:], task["goal"][:2], atol=1e-6)
         speed = np.hypot(*np.diff(rows[:, 1:], axis=0).T) / np.diff(rows[:, 0])
         assert speed.max() <= v_max
+        _assert_drivable(rows, task["spawn"][-1], robot["max_turn_rate"], robot["max_acceleration"])
         # Every row lies on the proven static path (so between rows the robot stays on it too: rows hold
         # each corner the path turns at).
         wp = np.array(task["path"]["waypoints"])
@@ -55,6 +59,23 @@ def _verify(meta: dict) -> int:
             assert gap.min() >= w * H / 2, (task["id"], gap.min())
         checked += 1
     return checked
+
+
+def _assert_drivable(rows: np.ndarray, yaw: float, turn_rate: float, acceleration: float) -> None:
+    """Resampled every DT: speed steps within acceleration x DT, and a stand of angle / turn_rate at every turn."""
+    t = np.round(np.arange(0.0, rows[-1, 0] + DT / 2, DT), 9)
+    p = _interp(rows, t)
+    step = np.diff(p, axis=0)
+    v = np.r_[0.0, np.hypot(*step.T) / DT, 0.0]
+    assert np.all(np.abs(np.diff(v)) <= acceleration * DT + 1e-4)
+    heading, stood = yaw, 0.0
+    for d in step:
+        if math.hypot(*d) < 1e-7:
+            stood += DT
+            continue
+        turn = abs((math.atan2(d[1], d[0]) - heading + math.pi) % (2 * math.pi) - math.pi)
+        assert turn <= stood * turn_rate + 1e-3, (turn, stood)
+        heading, stood = math.atan2(d[1], d[0]), 0.0
 
 
 @pytest.mark.parametrize("generator,params", [
@@ -89,18 +110,20 @@ def _straight_wait_case(stand_until: float):
 
 def test_a_person_in_the_way_makes_the_robot_wait_as_long_as_hand_worked_out():
     waypoints, tracks, radii = _straight_wait_case(15.0)
-    inflation, v = 0.25, 0.5
-    found = timed_path(waypoints, tracks, radii, inflation, v)
+    inflation, v, a = 0.25, 0.5, 1.0
+    found = timed_path(waypoints, tracks, radii, inflation, Limits(v, 1.0, a))
     assert found is not None
-    # The robot must not be at x = 5 until the person is R' = inflation + radius + MARGIN + w DT / 2 off the
-    # line (w = 0.5 + 1 m/s), at t* = 15 + R' s; from there 5 m remain: arrival >= t* + 10 s. Waiting at
-    # x = 5 - R' and leaving at t* costs at most R' / v more, plus a step of the grid either way.
-    reach = inflation + 0.25 + MARGIN + (v + 1.0) * DT / 2
+    # The robot must not be at x = 5 until the person is R' = inflation + radius + MARGIN + TRACKING + w DT / 2
+    # off the line (w = 0.5 + 1 m/s), at t* = 15 + R' s; from there 5 m remain: arrival >= t* + 10 s. Waiting
+    # at x = 5 - R' and leaving at t* costs at most R' / v more, speeding up from rest and slowing down to
+    # the goal v / a more, plus a step of the grid either way.
+    reach = inflation + 0.25 + MARGIN + TRACKING + (v + 1.0) * DT / 2
     t_star = 15.0 + reach
-    assert t_star + 10.0 - DT <= found.arrival <= t_star + 10.0 + reach / v + 2 * DT
-    # Without the person in the way (gone at t = 0 + 3 s, long before the robot gets there) it drives through.
-    free = timed_path(waypoints, _straight_wait_case(0.0)[1], radii, inflation, v)
-    assert free is not None and abs(free.arrival - 10.0 / v) <= DT + 1e-9
+    assert t_star + 10.0 - DT <= found.arrival <= t_star + 10.0 + reach / v + 2 * v / a + 2 * DT
+    # Without the person in the way (gone at t = 0 + 3 s, long before the robot gets there) it drives through:
+    # half a second longer than at full speed all the way, the ramps up from rest and down to the goal.
+    free = timed_path(waypoints, _straight_wait_case(0.0)[1], radii, inflation, Limits(v, 1.0, a))
+    assert free is not None and abs(free.arrival - (10.0 / v + v / a)) <= 2 * DT + 1e-9
 
 
 def test_no_timed_path_when_a_person_stands_on_the_goal():
@@ -109,42 +132,63 @@ def test_no_timed_path_when_a_person_stands_on_the_goal():
     assert timed_path(waypoints, [person], [0.25], 0.25, 0.5) is None
 
 
-def _brute_force(waypoints, tracks, radii, inflation, v) -> float | None:
-    """Earliest arrival by breadth-first search over (step, cell), every cell measured against every person."""
+def _brute_force(waypoints, tracks, radii, inflation, lim: Limits, heading: float | None = None) -> float | None:
+    """Earliest arrival by breadth-first search over (cell, speed in cells a step, steps stood turning), every
+    cell measured against every person."""
     w = np.asarray(waypoints, dtype=float)
-    ds = v * DT / CELLS_PER_STEP * (1 - SPARE)
-    xy, leg = [w[0]], [{0}]  # each cell's point and the legs it lies on (a corner on two)
+    top = math.ceil(lim.max_speed / (lim.acceleration * DT) - 1e-9)
+    ds = min(lim.max_speed * DT / top, lim.acceleration * DT * DT) * (1 - SPARE)
+    xy, corners, cell = [w[0]], [0], []
     for q in range(len(w) - 1):
         n = max(1, math.ceil(math.hypot(*(w[q + 1] - w[q])) / ds - 1e-9))
-        leg[-1].add(q)
-        for m in range(1, n + 1):
-            xy.append(w[q] + (w[q + 1] - w[q]) * m / n)
-            leg.append({q})
-    n = len(xy) - 1
+        xy += [w[q] + (w[q + 1] - w[q]) * m / n for m in range(1, n + 1)]
+        corners.append(corners[-1] + n)
+        cell.append(math.hypot(*(w[q + 1] - w[q])) / n)
+    goal = len(xy) - 1
+    inner = set(corners[1:-1])
+    first = math.atan2(w[1, 1] - w[0, 1], w[1, 0] - w[0, 0])
+    stand = {c: math.ceil(a / (lim.turn_rate * DT) - 1e-9)
+             for c, a in zip(corners, turn_angles(w, first if heading is None else heading))}
     length = float(np.sum(np.hypot(*np.diff(w, axis=0).T)))
     speed = person_speed(tracks)
-    reach = [r + inflation + MARGIN + (v + speed) * DT / 2 for r in radii]
-    end = max(t[-1, 0] for t in tracks) + length / v + 5.0
-
+    reach = [r + inflation + MARGIN + TRACKING + (lim.max_speed + speed) * DT / 2 for r in radii]
+    end = max(t[-1, 0] for t in tracks) + length / lim.max_speed + 30.0
     cells = np.array(xy)
-    moves = [[j for j in range(max(0, i - CELLS_PER_STEP), min(n, i + CELLS_PER_STEP) + 1)
-              if all(leg[m] & leg[i] & leg[j] for m in range(min(i, j), max(i, j) + 1))] for i in range(n + 1)]
 
     def free_at(k: int) -> np.ndarray:
-        """Every cell against every person at step k."""
-        ok = np.ones(n + 1, dtype=bool)
+        ok = np.ones(len(xy), dtype=bool)
         for traj, rr in zip(tracks, reach):
             p = np.array([np.interp(k * DT, traj[:, 0], traj[:, c]) for c in (1, 2)])
             ok &= np.hypot(*(cells - p).T) > rr
         return ok
 
-    front = {0} if free_at(0)[0] else set()
+    def moves(state):
+        i, u, stood = state
+        if stand.get(i, 0) and stood < stand[i]:
+            yield i, 0, stood + 1  # still turning on the spot
+            return
+        for u2 in range(max(0, u - 1), min(top, u + 1) + 1) if i not in inner else range(top + 1):
+            j = i + u2
+            if i in inner:  # passed without a turn: the speed in m/s changes by one cell a step at most
+                q = corners.index(i)
+                if abs(u2 * cell[q] - u * cell[q - 1]) > ds * (1 + 1e-9):
+                    continue
+            if j > goal or any(i < c < j for c in corners):
+                continue  # past the goal, or across a corner
+            if u2 and stand.get(j, 0):
+                if u2 == 1:
+                    yield j, 0, 0  # come to the corner slowly enough to stop there, and start turning
+                continue
+            yield j, u2, stood if u2 == 0 else 0
+
+    ok0 = free_at(0)
+    front = {(0, 0, 0)} if ok0[0] else set()
     k = 0
     while front and k * DT <= end:
         k += 1
         ok = free_at(k)
-        front = {j for i in front for j in moves[i] if ok[j]}
-        if n in front:
+        front = {m for state in front for m in moves(state) if ok[m[0]]}
+        if any(i == goal and u <= 1 for i, u, _ in front):
             return k * DT
     return None
 
@@ -160,13 +204,15 @@ def test_the_certificate_agrees_with_brute_force_on_small_worlds():
             b = rng.uniform([0.0, -1.5], [3.0, 2.5])
             t1 = rng.uniform(1.0, 6.0)
             tracks.append(np.array([[0.0, *a], [t1, *a], [t1 + math.hypot(*(b - a)) / 1.2, *b]]))
-        found = timed_path(waypoints, tracks, [0.25, 0.25], 0.25, 0.5)
-        brute = _brute_force(waypoints, tracks, [0.25, 0.25], 0.25, 0.5)
+        lim = Limits(0.5, 2.0, 5.0)  # 2 speed levels: a brute force small enough to run
+        heading = rng.uniform(-math.pi, math.pi)
+        found = timed_path(waypoints, tracks, [0.25, 0.25], 0.25, lim, heading=heading)
+        brute = _brute_force(waypoints, tracks, [0.25, 0.25], 0.25, lim, heading)
         assert (found is None) == (brute is None)
         if found is not None:
             assert abs(found.arrival - brute) < 1e-9, (found.arrival, brute)
-            length = float(np.sum(np.hypot(*np.diff(waypoints, axis=0).T)))
-            waits += found.arrival > length / 0.5 + DT
+            alone = timed_path(waypoints, [], [], 0.25, lim, heading=heading)
+            waits += found.arrival > alone.arrival + DT
         agreed += 1
     assert agreed == 12 and waits >= 2  # some of them made the robot wait
 
@@ -191,6 +237,77 @@ def test_the_certificate_agrees_with_brute_force_on_a_generated_world():
     radii = [m.radius for m in people]
     path = w.feasibility.paths[0].waypoints
     found = w.feasibility.timed_paths[0]
-    assert found.arrival == timed_path(path, tracks, radii, w.robot.inflation, 0.5).arrival
-    assert abs(found.arrival - _brute_force(path, tracks, radii, w.robot.inflation, 0.5)) < 1e-9
-    assert found.arrival > float(np.sum(np.hypot(*np.diff(path, axis=0).T))) / 0.5 + 1.0  # the people held it up
+    yaw = w.tasks[0].spawn.yaw
+    assert found.arrival == timed_path(path, tracks, radii, w.robot.inflation, Limits(0.5), heading=yaw).arrival
+    assert abs(found.arrival - _brute_force(path, tracks, radii, w.robot.inflation, Limits(0.5), yaw)) < 1e-9
+    alone = timed_path(path, [], [], w.robot.inflation, Limits(0.5), heading=yaw)
+    assert found.arrival > alone.arrival  # the people held it up
+
+
+def _tracking_error(rows: np.ndarray, yaw0: float, lim: Limits) -> tuple[float, np.ndarray]:
+    """(largest distance of the unicycle from the schedule at the same time, the unicycle's (n, 4) run)."""
+    run = drive(rows, yaw0, lim.max_speed, lim.turn_rate, lim.acceleration)
+    return float(np.hypot(*(run[:, 1:3] - _interp(rows, run[:, 0])).T).max()), run
+
+
+@pytest.mark.parametrize("preset", ["person_crossing", "person_head_on", "crowd_reacting"])
+def test_a_unicycle_at_the_stated_limits_stays_inside_the_certificate(preset):
+    meta = worldgen.generate_preset(preset).metadata
+    robot, task = meta["robot"], meta["tasks"][0]
+    lim = Limits(robot["max_speed"], robot["max_turn_rate"], robot["max_acceleration"])
+    rows = np.array(task["timed_path"])
+    error, run = _tracking_error(rows, task["spawn"][-1], lim)
+    assert error <= robot["tracking_margin"], error
+    # So it keeps what the certificate promises from every person's recorded walk (a reacting person's
+    # tube is wider still), less what it may be off by, at every one of its 1 ms steps.
+    contact = robot["radius"] + robot["clearance"]
+    for p in meta["people"]:
+        gap = np.hypot(*(run[:, 1:3] - _interp(np.array(p["trajectory"]), run[:, 0])).T) - contact - p["radius"]
+        assert gap.min() >= MARGIN + robot["tracking_margin"] - error - 1e-9, (p["name"], gap.min())
+    assert np.hypot(*(run[-1, 1:3] - task["goal"][:2])) <= 0.02
+
+
+def test_a_spawn_facing_away_from_the_path_turns_first_and_the_unicycle_keeps_up():
+    waypoints = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 3.0]])
+    person = np.array([[0.0, 2.0, -2.0], [4.0, 2.0, 2.0]])  # crosses the first leg at 1 m/s
+    lim = Limits(0.5, 1.0, 1.0)
+    away = timed_path(waypoints, [person], [0.25], 0.25, lim, heading=math.pi)
+    ahead = timed_path(waypoints, [person], [0.25], 0.25, lim, heading=0.0)
+    assert away is not None and ahead is not None
+    moves = np.flatnonzero(np.hypot(*np.diff(away.rows[:, 1:], axis=0).T) > 0)
+    assert away.rows[moves[0], 0] >= math.pi / lim.turn_rate - 1e-9  # it stands while it turns round
+    assert ahead.rows[np.flatnonzero(np.hypot(*np.diff(ahead.rows[:, 1:], axis=0).T) > 0)[0], 0] == 0.0
+    _assert_drivable(away.rows, math.pi, lim.turn_rate, lim.acceleration)
+    error, run = _tracking_error(away.rows, math.pi, lim)
+    assert error <= TRACKING
+    gap = np.hypot(*(run[:, 1:3] - _interp(person, run[:, 0])).T) - 0.5
+    assert gap.min() >= MARGIN + TRACKING - error - 1e-9
+    # The same schedule without the turn at the spawn: a robot facing away that drives it at its limits
+    # falls behind by more than the margin (what the turn at the spawn is for).
+    late, _ = _tracking_error(ahead.rows, math.pi, lim)
+    assert late > TRACKING
+
+
+@pytest.mark.parametrize("behaviour", ["impassive", "regular", "surprised", "scared", "curious"])
+def test_person_head_on_is_made_with_every_behaviour_on_its_first_draw(behaviour):
+    """A reacting person starts where its tube fits (farther from the goal) and walks round the robot."""
+    world = worldgen.generate_preset("person_head_on", people_behaviour=behaviour)
+    meta = world.metadata
+    metadata.validate(meta)
+    assert world.attempts == 1 and meta["feasibility"]["feasible"] and _verify(meta) == 1
+    start = np.array(meta["people"][0]["trajectory"][0][1:])
+    short = float(np.hypot(*(start - meta["tasks"][0]["goal"][:2])))
+    assert (short == pytest.approx(1.0)) == (behaviour in ("impassive", "surprised")), short
+
+
+def test_a_path_of_many_corners_is_given_time_to_stop_and_turn_at_each():
+    """29 legs at right angles, nobody in the way: each corner costs a stop, a quarter turn and a start,
+    more than the sweep's slack after the drive at full speed, and the schedule still arrives."""
+    waypoints = np.array([[i * 0.5, (i % 2) * 0.5] for i in range(30)])
+    far = np.array([[0.0, 50.0, 50.0], [1.0, 50.0, 50.0]])
+    lim = Limits(0.5, 1.0, 1.0)
+    found = timed_path(waypoints, [far], [0.25], 0.25, lim, heading=0.0)
+    length = float(np.sum(np.hypot(*np.diff(waypoints, axis=0).T)))
+    turning = sum(math.ceil(a / (lim.turn_rate * DT) - 1e-9) * DT for a in turn_angles(waypoints, 0.0))
+    assert found is not None and found.arrival > length / lim.max_speed + turning + 5.0
+    _assert_drivable(found.rows, 0.0, lim.turn_rate, lim.acceleration)

@@ -51,7 +51,8 @@ SETTINGS: tuple[Param, ...] = (
     Param("reward_time", "float", 0.05, "time penalty subtracted every step (geodesic, euclidean_progress)",
           0.0, 1e6),
     Param("time_limit_factor", "float", 2.0, "time limit as a multiple of the optimal time L / v_max (L the exact "
-          "shortest path's length), plus a half turn pi / w_max; unset: the task's own time_limit (world.json)",
+          "shortest path's length; among people the certified arrival_time where longer), plus a half turn "
+          "pi / w_max; unset: the task's own time_limit (world.json)",
           0.1, 1000.0, optional=True),
     Param("geodesic_spacing", "float", 0.1, "grid spacing of the geodesic distance field built at each reset "
           "(see worldgen.envs.geodesic for its error bound)", 0.01, 10.0, unit="m"),

@@ -44,8 +44,9 @@ robot may push a leaf open, and those contacts are reported apart,
 ``door_contacts``, one per push; by default a door whose leaf swings towards
 the robot opens by itself as it comes near: the ``doors`` setting,
 :mod:`worldgen.envs.doors`); it is truncated at the time limit: ``time_limit_factor`` x
-the optimal time ``L / v_max`` plus a half turn ``pi / w_max`` (default factor
-2), or the task's own ``time_limit`` (world.json) when ``time_limit_factor`` is None.
+the optimal time ``L / v_max`` (among people: the task's certified ``arrival_time`` where that is
+longer) plus a half turn ``pi / w_max`` (default factor 2), or the task's own ``time_limit``
+(world.json) when ``time_limit_factor`` is None.
 
 Info: at reset ``world_id``, ``task``, ``reference_path_length`` (the optimal
 path length, world.json ``tasks[].path.length``), ``time_limit`` (the one in force),
@@ -206,7 +207,8 @@ class NavigationEnv(gym.Env):
             self._time_limit = float(world.task["time_limit"])
         else:
             v_max, w_max = float(self._act_hi[0]), float(self._act_hi[1])
-            self._time_limit = cfg.time_limit_factor * world.reference_path_length / v_max + math.pi / w_max
+            optimal = max(world.reference_path_length / v_max, world.task.get("arrival_time") or 0.0)  # among people
+            self._time_limit = cfg.time_limit_factor * optimal + math.pi / w_max
         self._lidar_height = cfg.lidar_height if cfg.lidar_height is not None else world.lidar_height
         self._last_action = np.zeros(2)
         self.episode = Episode(world, *sim.pose())

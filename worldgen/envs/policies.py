@@ -84,14 +84,21 @@ class TimedFollower:
     """Drives a task's timed path (world.json ``tasks[].timed_path``: ``t, x, y`` rows): each step it heads
     for where the timed path is at the step's end and asks the speed that gets there in ``period`` s
     (turning first where that point lies more than ``turn_in_place`` rad off the heading), within ``v_max``
-    and ``w_max``. A robot that keeps to its timed path keeps the certificate's distance from every
-    person's tube (docs/people.md), however the people react. Give it turn rates well above the path's:
-    the timed path turns its corners on the spot."""
+    and ``w_max``; where that point is within ``near`` m (the timed path standing at the spawn or a corner,
+    or just overshot) it turns to face the path's next leg instead. The timed path turns on the spot no
+    faster than ``robot.max_turn_rate`` and changes speed no faster than ``robot.max_acceleration``, so a
+    follower with the environment's default limits keeps up with it, within the certificate's
+    ``robot.tracking_margin`` (docs/people.md: measured), and so keeps the certificate's distance from
+    every person's tube, however the people react."""
 
-    def __init__(self, rows, v_max: float, w_max: float, period: float, turn_in_place: float = 0.3):
+    def __init__(self, rows, v_max: float, w_max: float, period: float, turn_in_place: float = 0.3,
+                 near: float = 0.01):
         self.rows = np.asarray(rows, dtype=float).reshape(-1, 3)
         self.v_max, self.w_max, self.period = float(v_max), float(w_max), float(period)
-        self.turn_in_place = float(turn_in_place)
+        self.turn_in_place, self.near = float(turn_in_place), float(near)
+        step = np.diff(self.rows[:, 1:], axis=0)
+        self._moves = np.flatnonzero(np.hypot(step[:, 0], step[:, 1]) > 1e-9)  # the rows a movement starts at
+        self._yaws = np.arctan2(step[:, 1], step[:, 0])
 
     @classmethod
     def for_env(cls, env, **kwargs) -> "TimedFollower":
@@ -105,12 +112,22 @@ class TimedFollower:
         r = self.rows
         return np.array([np.interp(t, r[:, 0], r[:, 1]), np.interp(t, r[:, 0], r[:, 2])])
 
+    def next_heading(self, t: float) -> float | None:
+        """The direction (rad) of the timed path's next movement after time ``t``, None once it has arrived."""
+        k = int(np.searchsorted(self.rows[:, 0], t, side="right")) - 1
+        later = self._moves[self._moves >= k]
+        return float(self._yaws[later[0]]) if len(later) else None
+
     def action(self, x: float, y: float, yaw: float, t: float) -> np.ndarray:
         """(v, w) as float32 for the robot at (x, y) heading ``yaw`` at time ``t``."""
         dx, dy = self.at(t + self.period) - np.array([x, y])
         dist = math.hypot(dx, dy)
-        if dist < 1e-6:
-            return np.zeros(2, dtype=np.float32)
+        if dist < self.near:  # close enough (never turn round for a few mm overshot): face where it goes next
+            ahead = self.next_heading(t + self.period)
+            if ahead is None:
+                return np.zeros(2, dtype=np.float32)
+            err = (ahead - yaw + math.pi) % (2.0 * math.pi) - math.pi
+            return np.array([0.0, float(np.clip(err / self.period, -self.w_max, self.w_max))], dtype=np.float32)
         err = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi
         w = float(np.clip(err / self.period, -self.w_max, self.w_max))
         v = 0.0 if abs(err) > self.turn_in_place else min(self.v_max, dist / self.period * math.cos(err))

@@ -101,9 +101,15 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
 
 
 def _add_people(meta: dict, world, people) -> None:
-    """world.json's ``people``, ``robot.max_speed`` and each task's ``timed_path`` (docs/people.md)."""
+    """world.json's ``people``, the robot's limits (``robot.max_speed``, ``max_turn_rate``,
+    ``max_acceleration``), the ``tracking_margin`` its timed paths keep, and each task's ``timed_path``
+    (docs/people.md)."""
+    from worldgen.people.timed import TRACKING, limits_of
+
     meta["people"] = [person_entry(m, world.params, meta["files"]) for m in people]
-    meta["robot"]["max_speed"] = world.params["robot_speed"]
+    limits = limits_of(world.params)
+    meta["robot"].update(max_speed=world.params["robot_speed"], max_turn_rate=limits.turn_rate,
+                         max_acceleration=limits.acceleration, tracking_margin=TRACKING)
     timed = list(getattr(world.feasibility, "timed_paths", ()))
     timed += [None] * max(0, len(meta["tasks"]) - len(timed))
     for entry, certificate in zip(meta["tasks"], timed):

@@ -39,7 +39,8 @@ from worldgen.scene.doors import door_records
 from worldgen.scene.footprint import Footprint, FootprintIndex, scene_footprints
 
 __all__ = ["PeoplePlan", "draw_people", "group_ids", "people_footprints", "PERSON_HEIGHT", "SLACK", "KEEP_OUT", "LEG_MIN",
-           "LEG_MAX", "HEAD_ON_SHORT", "HEAD_ON_BEHIND", "CROSSING_HALF", "LAG", "GROUP_SPACING", "GROUP_START",
+           "LEG_MAX", "HEAD_ON_SHORT", "HEAD_ON_BEHIND", "HEAD_ON_STEP", "HEAD_ON_ARC", "CROSSING_HALF", "LAG",
+           "GROUP_SPACING", "GROUP_START",
            "OVERTAKE_BEHIND", "OVERTAKE_SIDE", "OVERTAKE_BEYOND", "GROUP_SHORT", "GROUP_SIDE", "GROUP_BEHIND", "DOOR_WAIT",
            "ASIDE_AHEAD", "ASIDE_SIDE"]
 
@@ -49,13 +50,19 @@ PERSON_HEIGHT = 1.75
 #: rounding of the written rows, far below anything a person would notice.
 SLACK = 1e-3
 #: How much farther (m) than touching people keep from a robot standing at its spawn or goal: more than
-#: the certificate's margin (worldgen.people.timed: 0.01 m + (robot + person speed) x 0.025 s, 0.07 m
-#: at 0.5 m/s) for robot speeds up to 1.7 m/s, so that a robot waiting at its spawn is in nobody's way.
+#: the certificate's margin (worldgen.people.timed: 0.01 m + the 0.03 m tracking margin + (robot + person
+#: speed) x 0.025 s, 0.0875 m at 0.5 and 1.4 m/s) while the two speeds add up to less than 2.4 m/s, so
+#: that a robot waiting at its spawn is in nobody's way.
 KEEP_OUT = 0.1
 #: The human-encounter scenarios (``people_scenario``; see :func:`_scripted`): head-on, the person
 #: starts this far short of the goal (m), walks along the path to this far short of the spawn (m), then
 #: round the robot to as far behind it
 HEAD_ON_SHORT, HEAD_ON_BEHIND = 1.0, 1.5
+#: head-on, where a reacting person's tube keeps it off HEAD_ON_SHORT: the start moves back in steps of (m)
+HEAD_ON_STEP = 0.05
+#: head-on, the arc round the robot is walked in steps of this many degrees (every chord within 1.5 %
+#: of the arc's radius)
+HEAD_ON_ARC = 20.0
 #: crossing, the person walks from this far right of the path's midpoint to as far left (m)
 CROSSING_HALF = 3.0
 #: how far behind a steady walker (s) a person starting from rest falls: the crowd model's tau (0.5 s)
@@ -232,9 +239,10 @@ def _scripted(scenario: str, scene: Scene, task: Task, speed: float, params: Map
     against the first task's straight line from spawn S to goal G (u its direction, n its left normal,
     L its length); or (None, reason) when a start or place is not free floor.
 
-    - ``head_on``: starts on the line :data:`HEAD_ON_SHORT` m short of G and walks along it toward the
-      robot to :data:`HEAD_ON_BEHIND` m short of S, then round the robot's disc at S to as far behind
-      it: it sets off at once.
+    - ``head_on``: starts on the line :data:`HEAD_ON_SHORT` m short of G (or farther, by
+      :data:`HEAD_ON_STEP`, as near as it fits: a reacting person's tube keeps off G) and walks along it toward the
+      robot to :data:`HEAD_ON_BEHIND` m short of S, then round the robot at S, on an arc of that radius to
+      its left (:data:`HEAD_ON_ARC` degree steps), to as far behind it: it sets off at once.
     - ``crossing``: starts :data:`CROSSING_HALF` m to the right of the line's midpoint M and walks to as
       far to the left, across the line at right angles; it sets off so as to reach M when a robot
       driving the line at ``robot_speed`` would, ``L / 2 / robot_speed`` s (:data:`LAG`: a person starting
@@ -255,7 +263,7 @@ def _scripted(scenario: str, scene: Scene, task: Task, speed: float, params: Map
     n = np.array([-u[1], u[0]])
     people: list[tuple[np.ndarray, list[np.ndarray], float]]
     if scenario == "head_on":
-        people = [(g - HEAD_ON_SHORT * u, [s + HEAD_ON_BEHIND * u, s - HEAD_ON_BEHIND * u], 0.0)]
+        people = [_head_on(s, g, u, n, length, index, radius)]
     elif scenario == "crossing":
         mid = s + u * length / 2
         depart = max(0.0, length / 2 / params["robot_speed"] - CROSSING_HALF / speed - LAG)
@@ -285,6 +293,20 @@ def _scripted(scenario: str, scene: Scene, task: Task, speed: float, params: Map
                 return None, f"the {scenario} person's {label} ({p[0]:.3f}, {p[1]:.3f}) is not free floor"
         out.append((start, places, round(depart, 6)))
     return out, None
+
+
+def _head_on(s, g, u, n, length: float, index: FootprintIndex,
+             radius: float) -> tuple[np.ndarray, list[np.ndarray], float]:
+    """(start, places, departure) of the head-on person (:func:`_scripted`)."""
+    # As near the goal as the person fits: farther back where a reacting person's tube, kept off the
+    # goal, would not let it stand HEAD_ON_SHORT short of it.
+    short = next((d for d in HEAD_ON_SHORT + HEAD_ON_STEP * np.arange(int(length / 2 / HEAD_ON_STEP))
+                  if not index.blocked(np.round(g - d * u, 6)[None], radius)[0]), HEAD_ON_SHORT)
+    # Round the robot along an arc of HEAD_ON_BEHIND about S (on its left), in steps short enough that every
+    # chord keeps outside the robot's keep-out disc: a person walking straight at that disc can stall
+    # against it, the wider the tube the sooner.
+    arc = np.radians(np.arange(0.0, 180.0 + HEAD_ON_ARC / 2, HEAD_ON_ARC))
+    return g - short * u, [s + HEAD_ON_BEHIND * (np.cos(a) * u + np.sin(a) * n) for a in arc], 0.0
 
 
 class _Pool:

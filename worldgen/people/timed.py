@@ -1,22 +1,29 @@
-"""The certificate among people: a timed path along the proven static path that no person comes near.
+"""The certificate among people: a timed path along the proven static path that no person comes near, and
+that a differential-drive robot within its limits can drive.
 
-Method (docs/people.md): the robot keeps to its task's proven static path (its polyline, which
-keeps ``robot.clearance`` from every obstacle) and only chooses *when* to be where along it. Each
-leg of the polyline is cut into equal cells no longer than ``ds = 0.999 max_speed x DT /
-CELLS_PER_STEP`` (so every corner is a cell), time into steps of :data:`DT`; a cell is blocked at a
-step when the robot's centre there is closer than ``robot.inflation + person radius + margin`` to
-any person's centre, with ``margin = MARGIN + w DT / 2`` and ``w`` the robot's top speed plus the
-fastest any person walks: two positions that far apart at both ends of a step cannot come closer
-than ``inflation + radius + MARGIN`` in between, each moving straight at constant speed. In a step
-the robot may wait, or go ahead or back by up to ``CELLS_PER_STEP`` cells of one leg (a corner is
-passed at a step's end), so it never leaves the path nor goes faster than ``max_speed`` (the 0.1 %
-spare pays for the 6-decimal rounding of the rows). A forward sweep over the steps keeps the set of
-cells it can be in (a dilation, then the step's free cells); the first step the goal's cell is
-reachable is the arrival time, and the path is read back from the stored sets.
+Method (docs/people.md): the robot keeps to its task's proven static path (its polyline, which keeps
+``robot.clearance`` from every obstacle) and only chooses *when* to be where along it, within its
+:class:`Limits`: top speed ``v``, turn rate ``omega`` and acceleration ``a``. Time is cut into steps of
+:data:`DT`; in a step the robot moves ``u`` cells forward at constant speed, ``u`` a whole number from 0
+to ``V = ceil(v / (a DT))``, and ``u`` changes by at most one from a step to the next. Each leg is cut into
+equal cells no longer than ``v DT / V`` (0.1 % spare for the 6-decimal rows), so ``u`` cells a step is
+never faster than ``v`` and one cell a step more or less is never a change of speed above ``a DT``. The
+path turns on the spot: the robot comes to every corner at one cell a step at most, stops there, and
+stands ``ceil(theta / (omega DT))`` steps while it turns the corner's angle ``theta`` (the first turn
+from the spawn's heading onto the first leg), before it moves on; no step crosses a corner. A cell is
+blocked at a step when the robot's centre there is closer than ``robot.inflation + person radius +
+margin`` to any person's centre, with ``margin = MARGIN + TRACKING + w DT / 2`` and ``w`` the robot's top
+speed plus the fastest any person walks: two positions that far apart at both ends of a step cannot
+come closer than ``inflation + radius + MARGIN + TRACKING`` in between, each moving straight at
+constant speed; :data:`TRACKING` is what a follower may lag or lead the schedule by (the shipped
+:class:`~worldgen.envs.policies.TimedFollower`'s measured error, docs/people.md). A forward sweep over
+the steps keeps the set of states (cell and speed, or corner and turn done) the robot can be in; the
+first step it can stand at the goal is the arrival time, and the schedule is read back from the stored
+sets.
 
-The arrival time is optimal only among such profiles along this one static path at this
-resolution; another route round the people, or a finer grid, could arrive earlier. It is an
-upper bound on the earliest arrival, and the timed path a checkable witness (world.json's
+The arrival time is optimal only among such schedules along this one static path at this resolution,
+forward only; another route round the people, a finer grid or backing up could arrive earlier. It is
+an upper bound on the earliest arrival, and the timed path a checkable witness (world.json's
 ``tasks[].timed_path``), not the optimum.
 """
 
@@ -30,22 +37,47 @@ import numpy as np
 
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.people.behaviours import Tube, tube_of
-from worldgen.scene.motion import positions_at
+from worldgen.people.blocked import free_cells, steps_within
 
-__all__ = ["DT", "CELLS_PER_STEP", "MARGIN", "SPARE", "TimedPath", "timed_path", "person_speed", "certify", "tube_steps"]
+__all__ = ["DT", "MARGIN", "TRACKING", "SPARE", "TURN_RATE", "ACCELERATION", "MAX_LEVELS", "Limits", "limits_of",
+           "TimedPath", "timed_path", "person_speed", "certify", "tube_steps", "turn_angles"]
 
-#: Time step (s) of the sweep, and the largest one between two rows of a timed path.
+#: Time step (s) of the sweep, and the shortest time between two rows of a timed path.
 DT = 0.05
-#: Cells the robot may cover in one step at full speed.
-CELLS_PER_STEP = 2
 #: Distance (m) kept beyond contact at every instant, over and above the sampling bound.
 MARGIN = 0.01
-#: Share of the top speed the cells leave spare, for the rounding of the written rows.
+#: Distance (m) a follower may be off its schedule, kept beyond MARGIN: three times the shipped
+#: TimedFollower's largest measured tracking error in the environment at its defaults (0.0099 m over 42
+#: episodes, docs/people.md), and above tests/support/unicycle.py's (0.018 m on the presets).
+TRACKING = 0.03
+#: Share of the top speed and of the acceleration the cells leave spare, for the rounding of the rows.
 SPARE = 1e-3
+#: Default turn rate (rad/s) of a small differential-drive base (params.robot_turn_rate, docs/people.md).
+TURN_RATE = 1.0
+#: Default acceleration (m/s^2) of a small differential-drive base (params.robot_acceleration).
+ACCELERATION = 1.0
+#: Most speed levels a step may have: beyond, the cells keep the acceleration and the top speed is not used.
+MAX_LEVELS = 40
 #: Time (s) the sweep goes on after the last person stops, beyond the time the path takes.
 AFTER = 5.0
 #: Steps whose free cells are worked out at once (6.4 s): the sweep rarely needs all of them.
 FREE_CHUNK = 128
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What the robot can do: ``max_speed`` (m/s), ``turn_rate`` (rad/s, on the spot), ``acceleration``
+    (m/s^2, speeding up and slowing down alike)."""
+
+    max_speed: float
+    turn_rate: float = TURN_RATE
+    acceleration: float = ACCELERATION
+
+
+def limits_of(params) -> Limits:
+    """The robot's limits a world's resolved ``params`` state (the defaults where they are not recorded)."""
+    return Limits(float(params["robot_speed"]), float(params.get("robot_turn_rate", TURN_RATE)),
+                  float(params.get("robot_acceleration", ACCELERATION)))
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,64 +99,155 @@ def person_speed(tracks: Sequence[np.ndarray]) -> float:
     return best
 
 
+def turn_angles(waypoints: np.ndarray, heading: float) -> np.ndarray:
+    """(k - 1,) the angle (rad, 0 to pi) the robot turns on the spot at each waypoint but the goal: at the
+    spawn from ``heading`` onto the first leg, at each corner from one leg onto the next."""
+    d = np.diff(np.asarray(waypoints, dtype=float).reshape(-1, 2), axis=0)
+    yaw = np.arctan2(d[:, 1], d[:, 0])
+    before = np.concatenate([[heading], yaw[:-1]])
+    return np.abs((yaw - before + math.pi) % (2 * math.pi) - math.pi)
+
+
+# long: the sweep and its read-back share every array; apart they would pass a dozen of them around
 def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Sequence[float], inflation: float,
-               max_speed: float, tubes: Optional[Sequence[Tube]] = None) -> Optional[TimedPath]:
-    """The earliest timed path along ``waypoints`` (k, 2) at up to ``max_speed`` that keeps the robot's
-    disc (``inflation``) and every person's (its (m, 3) track, not looping, and radius) apart, or None.
+               limits, tubes: Optional[Sequence[Tube]] = None, heading: Optional[float] = None,
+               tracking: float = TRACKING) -> Optional[TimedPath]:
+    """The earliest timed path along ``waypoints`` (k, 2) within ``limits`` (a :class:`Limits`, or a top
+    speed with the default turn rate and acceleration) that keeps the robot's disc (``inflation``) and
+    every person's (its (m, 3) track, not looping, and radius) apart, or None. The robot starts at rest
+    facing ``heading`` (rad; default: along the first leg).
 
     ``tubes`` (one per person, default the recorded line): the robot keeps clear of the whole tube, every
-    recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`_free_cells`)."""
+    recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`worldgen.people.blocked.free_cells`)."""
+    lim = limits if isinstance(limits, Limits) else Limits(float(limits))
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
-    s, corner = _cells(w, max_speed * DT / CELLS_PER_STEP * (1 - SPARE))
+    if len(w) == 1:
+        w = np.vstack([w, w])
+    levels = min(MAX_LEVELS, max(1, math.ceil(lim.max_speed / (lim.acceleration * DT) - 1e-9)))
+    ds = min(lim.max_speed * DT / levels, lim.acceleration * DT * DT) * (1 - SPARE)
+    s, corner = _cells(w, ds)
     cum = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(w, axis=0).T))])
     length = float(cum[-1])
     n_cells = len(s) - 1
-    i = np.arange(n_cells + 1)
-    # Each cell's window: up to CELLS_PER_STEP cells either way, not past a corner (a corner cell reaches
-    # into both of its legs). The relation is symmetric, so it serves both the sweep and the read-back.
-    before = corner[np.maximum(np.searchsorted(corner, i, side="left") - 1, 0)]
-    after = corner[np.minimum(np.searchsorted(corner, i, side="right"), len(corner) - 1)]
-    on_corner = np.isin(i, corner)
-    lo = np.maximum(i - CELLS_PER_STEP, np.where(on_corner, before, corner[np.searchsorted(corner, i, side="right") - 1]))
-    hi = np.minimum(i + CELLS_PER_STEP, np.where(on_corner, after, corner[np.searchsorted(corner, i, side="left")]))
-    lo[0], hi[-1] = 0, n_cells
+    angles = turn_angles(w, math.atan2(*(w[1] - w[0])[::-1]) if heading is None else heading)
+    turns = np.ceil(angles / (lim.turn_rate * DT) - 1e-9).astype(np.int64)
+    turns[np.hypot(*np.diff(w, axis=0).T) == 0] = 0  # a leg of no length has no heading to turn to
+    spot = corner[:-1][turns > 0]  # the cells the robot stands on to turn, and for how many steps
+    spot_steps = turns[turns > 0]
+    # A corner passed without a turn joins legs of slightly different cells: which speed (in cells a step)
+    # may follow which there, for the change in m/s to stay within one cell a step of the finest legs.
+    leg_ds = np.diff(s[corner])
+    lv = np.arange(levels + 1)
+    passes = {int(corner[j]): np.abs(lv[None, :] * leg_ds[j] - lv[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
+              for j in range(1, len(corner) - 1) if turns[j] == 0}
+    # A move of u cells from cell c may not cross a corner: c + u <= the first corner after c.
+    nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
+    ok = np.arange(n_cells + 1)[:, None] + np.arange(levels + 1)[None, :] <= nxt[:, None]
     end = max((float(t[-1, 0]) for t in tracks), default=0.0)
-    steps = math.ceil((end + length / max_speed + AFTER) / DT)
+    # Beyond the drive at full speed: the stands to turn, and slowing to a stop and speeding up again at
+    # every corner (V steps each way at most).
+    steps = math.ceil((end + length / lim.max_speed + float(spot_steps.sum()) * DT + AFTER) / DT) + levels * len(corner)
     times = np.arange(steps + 1) * DT
-    reach = np.asarray(radii, dtype=float) + inflation + MARGIN + (max_speed + person_speed(tracks)) * DT / 2
+    reach = (np.asarray(radii, dtype=float) + inflation + MARGIN + tracking
+             + (lim.max_speed + person_speed(tracks)) * DT / 2)
     tubes = list(tubes) if tubes is not None else [Tube(0.0, 0.0)] * len(tracks)
     reach = reach + np.array([tube.d for tube in tubes], dtype=float).reshape(len(tracks))
     window = np.array([tube_steps(tube.tau) for tube in tubes], dtype=np.int64).reshape(len(tracks))
-    # Which cells are free at which step, worked out a chunk of steps at a time as the sweep gets there:
-    # the sweep usually stops long before the last person stops (each row depends on its step alone).
-    free = np.zeros((steps + 1, n_cells + 1), dtype=bool)
-    known = 0
-    sets = np.zeros((steps + 1, n_cells + 1), dtype=bool)
+    span = int(spot_steps.max(initial=1))
+    live = np.arange(span)[None, :] < spot_steps[:, None]
+    free = np.zeros((0, n_cells + 1), dtype=bool)
+    # Per step: the (speed, cell) states, bit-packed (a long path holds some 10^4 cells at 11 speeds for
+    # 10^3 steps), and the (spot, steps turned) states; ``cell`` is the last step's, unpacked.
+    moving: list[np.ndarray] = []
+    turning: list[np.ndarray] = []
     k_goal = None
-    for k in range(0, steps + 1):
-        if k == known:
-            known = min(k + FREE_CHUNK, steps + 1)
-            free[k:known] = _free_cells(w, cum, s, tracks, reach, times[k:known], window)
+    ok_t = np.ascontiguousarray(ok.T)  # the sweep works speed by speed: each speed's cells in a row
+    cell = np.zeros((levels + 1, n_cells + 1), dtype=bool)
+    for k in range(steps + 1):
+        if k == len(free):
+            free = np.concatenate([free, free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], DT, window)])
+        here = free[k]
+        prev, cell = cell, np.zeros((levels + 1, n_cells + 1), dtype=bool)
+        turn = np.zeros((len(spot), span), dtype=bool)
         if k == 0:
-            sets[0, 0] = free[0, 0]
-            continue
-        prev = sets[k - 1]
-        if not prev.any():
-            return None
-        c = np.concatenate([[0], np.cumsum(prev)])
-        sets[k] = (c[hi + 1] - c[lo] > 0) & free[k]
-        if sets[k, n_cells]:
+            if len(spot) and spot[0] == 0:
+                turn[0, 0] = here[0]
+            else:
+                cell[0, 0] = here[0]
+        else:
+            cell, turn = _advance(prev, turning[-1], here, passes, ok_t, live, spot, spot_steps)
+        moving.append(np.packbits(cell))
+        turning.append(turn)
+        if cell[:2, n_cells].any():
             k_goal = k
             break
+        if not (cell.any() or turn.any()):
+            return None
     if k_goal is None:
         return None
-    cells = [n_cells]
-    for k in range(k_goal, 0, -1):
-        j = cells[-1]
-        options = np.flatnonzero(sets[k - 1, lo[j]:hi[j] + 1]) + lo[j]
-        cells.append(int(options[np.argmin(np.abs(options - j))]))  # wait where it can, else move least
-    profile = s[np.array(cells[::-1])]
-    return TimedPath(_rows(w, cum, times[: k_goal + 1], profile), k_goal * DT)
+    def states(step: int) -> np.ndarray:
+        """(cell, speed) bool: the states of ``step``, unpacked one step at a time."""
+        return np.unpackbits(moving[step], count=(levels + 1) * (n_cells + 1)).reshape(levels + 1, -1).T.astype(bool)
+
+    cells = _read_back(states, len(moving), turning, spot, spot_steps, ok, passes, n_cells, levels)
+    return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)]), k_goal * DT)
+
+
+def _advance(prev: np.ndarray, was: np.ndarray, here: np.ndarray, passes: dict, ok_t: np.ndarray, live: np.ndarray,
+             spot: np.ndarray, spot_steps: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """One step of the sweep: from the last step's (speed, cell) states ``prev`` and (spot, steps turned)
+    states ``was`` to this step's, kept where the cells are ``here`` (free at this step's time)."""
+    levels, n_cells = prev.shape[0] - 1, prev.shape[1] - 1
+    cell = np.zeros_like(prev)
+    turn = np.zeros_like(was)
+    near = prev.copy()  # the speeds one level or less away from each next speed
+    near[1:] |= prev[:-1]
+    near[:-1] |= prev[1:]
+    for c, fits in passes.items():
+        near[:, c] = (prev[:, c][:, None] & fits).any(axis=0)
+    near &= ok_t
+    for u in range(levels + 1):
+        cell[u, u:] = near[u, :n_cells + 1 - u]
+    turn[:, 1:] = was[:, :-1] & live[:, 1:]
+    turn[:, 0] = cell[1, spot]  # come to a corner at one cell a step, and stop there to turn
+    cell[1:, spot] = False
+    cell[0, spot] |= was[np.arange(len(spot)), spot_steps - 1]
+    cell &= here[None, :]
+    turn &= here[spot][:, None]
+    return cell, turn
+
+
+def _read_back(states, n_steps: int, turning, spot, spot_steps, ok, passes, goal: int, levels: int) -> list[int]:
+    """The cell of every step, from 0 to the arrival, of one schedule the sweep's stored sets allow: from
+    the goal back, each step's predecessor the first the sets hold (standing before moving, slower first)."""
+    k = n_steps - 1
+    state = ("cell", goal, int(np.flatnonzero(states(k)[goal, :2])[0]))
+    cells = [goal]
+    where = {int(c): j for j, c in enumerate(spot)}
+    while k > 0:
+        prev, was = states(k - 1), turning[k - 1]
+        if state[0] == "turn":
+            j, m = state[1], state[2]
+            if m > 0:
+                state = ("turn", j, m - 1)
+            else:
+                c = int(spot[j]) - 1
+                u = next(u for u in range(0, min(2, levels) + 1) if prev[c, u] and ok[c, 1])
+                state = ("cell", c, u)
+        else:
+            c, u = state[1], state[2]
+            at = where.get(c)
+            if at is not None and u == 0 and was[at, spot_steps[at] - 1]:
+                state = ("turn", at, int(spot_steps[at]) - 1)
+            else:
+                src = c - u
+                fits = passes.get(src)
+                before = range(levels + 1) if fits is not None else range(max(0, u - 1), min(levels, u + 1) + 1)
+                u0 = next(v for v in before if prev[src, v] and ok[src, u] and (fits is None or fits[v, u]))
+                state = ("cell", src, u0)
+        cells.append(int(spot[state[1]]) if state[0] == "turn" else state[1])
+        k -= 1
+    return cells[::-1]
 
 
 def _cells(w: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarray]:
@@ -142,23 +265,27 @@ def _cells(w: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(parts), np.array(corner)
 
 
-def certify(report: FeasibilityReport, scene, tasks, robot, max_speed: float,
+def certify(report: FeasibilityReport, scene, tasks, robot, limits,
             behaviours: Optional[Sequence[str]] = None) -> FeasibilityReport:
-    """``report`` with the check ``timed_path`` and each task's certificate among the scene's people.
+    """``report`` with the check ``timed_path`` and each task's certificate among the scene's people, within
+    ``limits`` (a :class:`Limits`, or a top speed with the default turn rate and acceleration), each from
+    its spawn's heading.
 
     A task without a static path has no certificate either; the check fails then, and where the
     people leave the robot no way through along its path (its value: the latest arrival, s).
     """
+    lim = limits if isinstance(limits, Limits) else Limits(float(limits))
     people = [m for m in scene.movers if m.person]
     tracks = [np.asarray(m.trajectory, dtype=float) for m in people]
     radii = [m.radius for m in people]
     tubes = [tube_of(b) for b in behaviours] if behaviours is not None else None
     found, missing = [], []
     for task, path in zip(tasks, report.paths):
-        timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, max_speed, tubes)
+        timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, lim, tubes,
+                                                     heading=float(task.spawn.yaw))
         found.append(timed)
         if timed is None:
-            why = "no static path" if path is None else f"the people leave no way through at <= {max_speed:g} m/s"
+            why = "no static path" if path is None else f"the people leave no way through at <= {lim.max_speed:g} m/s"
             missing.append(f"{task.id}: {why}")
     if missing:
         check = Check("timed_path", False, None, "no timed path among the people for " + "; ".join(missing))
@@ -175,73 +302,9 @@ def _at(w: np.ndarray, cum: np.ndarray, s: np.ndarray) -> np.ndarray:
 
 
 def tube_steps(tau: float) -> int:
-    """Steps either side of a step whose recorded positions its tube of ``tau`` s must keep clear of: every
-    time within ``tau`` of an instant between this step and the next half-way is within DT / 2 of one of
-    them (0 for the recorded line itself, whose instant is within DT / 2 of the step)."""
-    return 0 if tau <= 0 else math.ceil(tau / DT + 0.5 - 1e-9)
-
-
-def _free_cells(w, cum, s, tracks, reach, times, window=None) -> np.ndarray:
-    """(steps + 1, cells) bool: no person's recorded position within ``window`` steps of the step (its
-    tube's, :func:`tube_steps`) within its ``reach`` of the cell's point.
-
-    People with the same window are taken together: the cells they block at the steps from ``window``
-    before the first to ``window`` after the last, then each step blocked where any of its window is.
-    """
-    window = np.zeros(len(tracks), dtype=np.int64) if window is None else window
-    free = np.ones((len(times), len(s)), dtype=bool)
-    for m in np.unique(window):
-        who = np.flatnonzero(window == m)
-        m = int(m)
-        ext = np.concatenate([times[0] - DT * np.arange(m, 0, -1), times, times[-1] + DT * np.arange(1, m + 1)])
-        blocked = ~_free_at(w, cum, s, [tracks[j] for j in who], reach[who], ext)
-        if m:
-            c = np.concatenate([np.zeros((1, len(s)), dtype=np.int32), np.cumsum(blocked, axis=0, dtype=np.int32)])
-            blocked = (c[2 * m + 1:] - c[:-2 * m - 1]) > 0
-        free &= ~blocked
-    return free
-
-
-def _free_at(w, cum, s, tracks, reach, times) -> np.ndarray:
-    """(steps + 1, cells) bool: no person within its ``reach`` of the cell's point at the step's time.
-
-    Only (step, person) pairs within reach of the polyline are looked at; each blocks the cells
-    whose arc length falls inside the circle's chords on the path's segments (exact, then marked
-    through a difference array)."""
-    n_t, n_s = len(times), len(s)
-    marks = np.zeros((n_t, n_s + 1), dtype=np.int32)
-    if not len(tracks):
-        return np.ones((n_t, n_s), dtype=bool)
-    pos = positions_at(list(tracks), [False] * len(tracks), times)  # (n_t, people, 2)
-    a, b = w[:-1], w[1:]
-    d = b - a
-    dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
-    for j in range(pos.shape[1]):
-        p = pos[:, j, :]
-        r2 = reach[j] ** 2
-        # Circle-segment chords: |a + u d - p|^2 = r^2, u in [0, 1], for every step and segment.
-        ap = a[None, :, :] - p[:, None, :]
-        bq = np.einsum("tsk,sk->ts", ap, d)
-        cq = np.einsum("tsk,tsk->ts", ap, ap) - r2
-        disc = bq * bq - dd[None] * cq
-        t_idx, seg_idx = np.nonzero(disc > 0)
-        if not len(t_idx):
-            continue
-        root = np.sqrt(disc[t_idx, seg_idx])
-        u0 = np.maximum((-bq[t_idx, seg_idx] - root) / dd[seg_idx], 0.0)
-        u1 = np.minimum((-bq[t_idx, seg_idx] + root) / dd[seg_idx], 1.0)
-        keep = u0 <= u1
-        t_idx, seg_idx, u0, u1 = t_idx[keep], seg_idx[keep], u0[keep], u1[keep]
-        seg_len = np.sqrt(dd[seg_idx])
-        s0 = cum[seg_idx] + u0 * seg_len
-        s1 = cum[seg_idx] + u1 * seg_len
-        # Cells with s0 <= s <= s1 (closed: a cell on the circle counts as blocked).
-        first = np.searchsorted(s, s0 - 1e-12, side="left")
-        last = np.searchsorted(s, s1 + 1e-12, side="right")
-        hit = last > first
-        np.add.at(marks, (t_idx[hit], first[hit]), 1)
-        np.add.at(marks, (t_idx[hit], last[hit]), -1)
-    return np.cumsum(marks, axis=1)[:, :n_s] == 0
+    """Steps either side of a step whose recorded positions its tube of ``tau`` s must keep clear of
+    (:func:`worldgen.people.blocked.steps_within` at :data:`DT`)."""
+    return steps_within(tau, DT)
 
 
 def _rows(w: np.ndarray, cum: np.ndarray, times: np.ndarray, profile: np.ndarray) -> np.ndarray:

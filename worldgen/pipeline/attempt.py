@@ -156,11 +156,11 @@ def _walk_and_certify(request: Request, scene, tasks, plan, report):
     """(scene with its people walked, ``report`` with the timed certificate among them and their tubes)."""
     from worldgen.people.behaviours import behaviours_of
     from worldgen.people.crowd import walk_plan
-    from worldgen.people.timed import certify
+    from worldgen.people.timed import certify, limits_of
 
     params, robot = request.params, request.robot
     scene = scene.with_movers(scene.movers + walk_plan(scene, tasks, robot, params, plan))
-    return scene, certify(report, scene, tasks, robot, params["robot_speed"], behaviours_of(params))
+    return scene, certify(report, scene, tasks, robot, limits_of(params), behaviours_of(params))
 
 
 def _with_common_extras(request: Request, draft: Draft, number: int):

@@ -24,8 +24,10 @@ ones would only repeat it in other words):
                  sampled every 2 ms against every person's
                  ``trajectory`` (straight between rows, standing after the last),
                  never closer than ``robot.radius + robot.clearance + radius``
-                 plus what the two could close between samples
-                 (:mod:`worldgen.verify.timed`);
+                 (+ ``robot.tracking_margin``) plus what the two could close
+                 between samples; and, where world.json states them, within
+                 ``robot.max_acceleration`` and ``robot.max_turn_rate`` (a stand
+                 at every turn) (:mod:`worldgen.verify.timed`);
 ``reproduce``    when this worldgen version wrote the world: a fresh export gives
                  world.json and every listed file byte for byte (another version
                  may format files differently, so there this check is skipped and

@@ -33,7 +33,7 @@ from worldgen.errors import ParameterError
 from worldgen.people.behaviours import behaviours_of
 from worldgen.people.crowd import walk_plan
 from worldgen.people.places import PeoplePlan, draw_people
-from worldgen.people.timed import certify
+from worldgen.people.timed import certify, limits_of
 from worldgen.scene import Scene
 from worldgen.seeding import people_rng
 
@@ -80,7 +80,7 @@ def settle(world, plan: PeoplePlan, scene: Scene, tasks, report):
     people = tuple(replace(m, name=k.name) for m, k in zip(walked, kept))
     scene = static.with_movers(static.movers + people)
     behaviours = behaviours_of(world.params)
-    return scene, certify(report, scene, tasks, world.robot, world.params["robot_speed"],
+    return scene, certify(report, scene, tasks, world.robot, limits_of(world.params),
                           [behaviours[i] for i in rows])
 
 

@@ -18,6 +18,14 @@ at t is checked against the exact distance to the trajectory's part from ``t - t
 which must be at least ``robot.radius + robot.clearance + radius + d`` plus ``robot.max_speed h / 2``
 (how far the robot moves in half a step). The tube itself must be its behaviour's
 (:data:`worldgen.people.behaviours.TUBES`): a widened or narrowed tube fails.
+
+Where world.json states the robot's limits (``robot.max_turn_rate``, ``robot.max_acceleration``,
+``robot.tracking_margin``: worlds written since the limits exist) the rows must also be a schedule such a
+robot drives: from one row interval to the next the speed changes by at most ``max_acceleration`` times
+the shorter interval (at rest before t = 0 and after the goal); wherever the direction of travel turns
+by an angle (at the spawn from the spawn's yaw) the robot stands at least that angle over
+``max_turn_rate`` in between (:data:`TURN_SLACK` rad forgiven for the rounding of the rows); and every
+distance above is kept with ``tracking_margin`` more.
 """
 
 from __future__ import annotations
@@ -26,12 +34,14 @@ import numpy as np
 
 from worldgen.errors import EXIT_FAILED, WorldgenError
 
-__all__ = ["TIMED_STEP", "ON_PATH", "TimedPathError", "check_timed"]
+__all__ = ["TIMED_STEP", "ON_PATH", "TURN_SLACK", "TimedPathError", "check_timed"]
 
 #: Time step (s) at which a timed path is sampled against every person (docs/people.md: 2 ms).
 TIMED_STEP = 0.002
 #: How far (m) a timed path's row may lie off the recorded path: world.json's rows are rounded to 6 decimals.
 ON_PATH = 1e-5
+#: Angle (rad) a turn may be short of its standing time: a 6-decimal row on a 2.5 mm step tilts it ~4e-4 rad.
+TURN_SLACK = 1e-3
 
 
 class TimedPathError(WorldgenError):
@@ -49,6 +59,7 @@ def check_timed(meta: dict, world) -> None:
         return
     robot = meta["robot"]
     inflation, v_max = robot["radius"] + robot["clearance"], float(robot["max_speed"])
+    inflation += float(robot.get("tracking_margin", 0.0))
     tracks = [(str(p["name"]), np.asarray(p["trajectory"], dtype=float).reshape(-1, 3), float(p["radius"]))
               for p in people]
     tubes = [_tube(p) for p in people]
@@ -89,8 +100,10 @@ def check_timed(meta: dict, world) -> None:
             if gap[k] < reach:
                 raise TimedPathError(f"{task['id']} timed_path at t = {t[k]:.3f} s comes "
                                      f"{gap[k] + radius + inflation:.4f} m from {name}'s centre, under "
-                                     "robot.radius + robot.clearance + its radius = "
+                                     "robot.radius + robot.clearance (+ robot.tracking_margin) + its radius = "
                                      f"{inflation + radius:.4f} m (+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
+        if "max_turn_rate" in robot or "max_acceleration" in robot:
+            _drivable(task, rows, float(robot["max_turn_rate"]), float(robot["max_acceleration"]))
 
 
 def _tube(person: dict):
@@ -122,7 +135,7 @@ def _check_tube(task_id: str, name: str, me: np.ndarray, t: np.ndarray, track: n
     if gap[k] < reach:
         raise TimedPathError(f"{task_id} timed_path at t = {t[k]:.3f} s comes {gap[k] + contact:.4f} m from "
                              f"{name}'s recorded positions within {tau:g} s of then, under robot.radius + "
-                             f"robot.clearance + its radius + its tube's d = {contact + d:.4f} m "
+                             f"robot.clearance (+ robot.tracking_margin) + its radius + its tube's d = {contact + d:.4f} m "
                              f"(+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
 
 
@@ -178,3 +191,33 @@ def _timed_on_path(task: dict, rows: np.ndarray) -> None:
         k = int(apart[0])
         raise TimedPathError(f"{task['id']} timed_path leaves the recorded path between t = {rows[k, 0]:g} and "
                              f"{rows[k + 1, 0]:g} s (the rows lie on different legs: it cuts a corner)")
+
+
+def _drivable(task: dict, rows: np.ndarray, turn_rate: float, acceleration: float) -> None:
+    """Speed changes within ``acceleration``; a stand of at least angle / ``turn_rate`` wherever the way turns."""
+    tid = task["id"]
+    dt = np.diff(rows[:, 0])
+    step = np.diff(rows[:, 1:], axis=0)
+    speed = np.hypot(*step.T) / dt
+    # At rest before the first row and after the last: an interval without end on either side.
+    v = np.concatenate([[0.0], speed, [0.0]])
+    span = np.concatenate([[np.inf], dt, [np.inf]])
+    # The rows are rounded to 6 decimals: a speed over an interval dt may be off by 1e-6 / dt either way.
+    slack = 2e-6 / np.minimum(span[:-1], span[1:])
+    over = np.abs(np.diff(v)) - acceleration * np.minimum(span[:-1], span[1:]) - slack
+    if len(over) and over.max() > 0:
+        k = int(np.argmax(over))
+        at = rows[min(k, len(rows) - 1), 0]
+        raise TimedPathError(f"{tid} timed_path changes speed from {v[k]:.6f} to {v[k + 1]:.6f} m/s at t = {at:g} s, "
+                             f"faster than robot.max_acceleration {acceleration:g} m/s^2")
+    heading, stood = float(task["spawn"][-1]), 0.0
+    for k in range(len(dt)):
+        if speed[k] * dt[k] <= 1e-6:  # standing (within the rounding)
+            stood += dt[k]
+            continue
+        yaw = float(np.arctan2(step[k, 1], step[k, 0]))
+        angle = abs((yaw - heading + np.pi) % (2 * np.pi) - np.pi)
+        if angle - TURN_SLACK > stood * turn_rate:
+            raise TimedPathError(f"{tid} timed_path turns {angle:.4f} rad at t = {rows[k, 0]:g} s after standing "
+                                 f"{stood:g} s, faster than robot.max_turn_rate {turn_rate:g} rad/s")
+        heading, stood = yaw, 0.0
