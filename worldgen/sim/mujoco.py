@@ -30,6 +30,7 @@ from worldgen.envs.reacting import Walkers
 from worldgen.envs.robot import add_robot, compile_world
 from worldgen.export.xml import safe_parser
 from worldgen.groundtruth.folder import robot_of
+from worldgen.judge.figures import DOOR_DEBOUNCE
 
 __all__ = ["MujocoBackend", "V_RANGE", "W_MAX", "DOOR_MODE", "DOOR_TRIGGER", "DOOR_SPEED", "movers_of"]
 
@@ -72,7 +73,9 @@ class MujocoBackend:
         self._openers: Optional[Openers] = None
         self._last: tuple[float, float, float] = (0.0, 0.0, 0.0)
         self._touching: frozenset = frozenset()
-        #: (t, name) of every contact of the robot that began, door leaves left out; and those with a leaf.
+        self._leaf_last: dict[str, float] = {}
+        #: (t, name) of every contact of the robot that began, door leaves left out; and the pushes on a leaf
+        #: (a contact with a leaf that began more than the judge's DOOR_DEBOUNCE after the last, as the env counts).
         self.contacts: list[tuple[float, str]] = []
         self.door_contacts: list[tuple[float, str]] = []
         self.dt = 0.0
@@ -137,7 +140,12 @@ class MujocoBackend:
         now = frozenset(mujoco.mj_id2name(sim.model, mujoco.mjtObj.mjOBJ_GEOM, int(g)) or f"geom_{int(g)}"
                         for g in others if int(g) not in sim.floor)
         for name in sorted(now - self._touching):
-            (self.door_contacts if name in self._leaves else self.contacts).append((t, name))
+            if name not in self._leaves:
+                self.contacts.append((t, name))
+            elif t - self._leaf_last.get(name, -math.inf) > DOOR_DEBOUNCE:
+                self.door_contacts.append((t, name))  # one push, however often the leaf bounces off the body
+        for name in now & self._leaves:
+            self._leaf_last[name] = t
         self._touching = now
 
     def close(self) -> None:

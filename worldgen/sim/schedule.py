@@ -109,16 +109,15 @@ def _among_movers(meta: dict, task: dict, waypoints: np.ndarray, top: float, sce
                         f"{room * 100:g} cm of room for the follower, arrival {found.arrival:.2f} s")
     if scene_of is None:
         return None
-    from worldgen.feasibility.geometry import Obstacles2D
     from worldgen.scene.doors import open_scene
     from worldgen.scene.footprint import robot_footprints
     from worldgen.sim.spacetime import spacetime_path
 
     scene = scene_of()
     robot_ = robot_of(meta)
-    obstacles = Obstacles2D.from_footprints(robot_footprints(open_scene(scene), robot_))
+    footprints = robot_footprints(open_scene(scene), robot_)
     for room in (TRACKING, 0.0):
-        rows = spacetime_path(obstacles, scene.bounds, task["spawn"], task["goal"], float(task["goal_tolerance"]),
+        rows = spacetime_path(footprints, scene.bounds, task["spawn"], task["goal"], float(task["goal_tolerance"]),
                               waypoints, tracks, radii, tubes, inflation, top, horizon, room)
         if rows is not None:
             return Plan("spacetime", waypoints, top, rows,

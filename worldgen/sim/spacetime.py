@@ -32,15 +32,17 @@ BORDER = 2.0
 #: m kept beyond contact at every instant, over and above the sampling bound (worldgen.people.timed's).
 MARGIN = 0.01
 _SPARE = 1e-3
+#: m added to every growth of a footprint: more than shapely's chords lose on a rounded corner.
+_ROUNDING = 1e-3
 _NEIGHBOURS = [(di, dj) for di in (-1, 0, 1) for dj in (-1, 0, 1)]
 
 
 # long: one sweep, set up (grid, static floor, agents' reach) and read back in one place as timed_path is
-def spacetime_path(obstacles, bounds, spawn, goal, tolerance: float, waypoints, tracks: Sequence[np.ndarray],
+def spacetime_path(footprints, bounds, spawn, goal, tolerance: float, waypoints, tracks: Sequence[np.ndarray],
                    radii: Sequence[float], tubes, inflation: float, speed: float, horizon: float,
                    room: float = 0.0) -> Optional[np.ndarray]:
     """(k, 3) ``t, x, y`` rows from ``spawn`` at t = 0 to within ``tolerance / 4`` of ``goal``, clear of
-    ``obstacles`` (:class:`~worldgen.feasibility.geometry.Obstacles2D`, the robot's footprints) and of every
+    ``footprints`` (:class:`~worldgen.scene.footprint.Footprint` s, the robot's) and of every
     agent's (``tracks``, (m, 3) rows that do not loop; ``radii``; ``tubes`` with ``d`` and ``tau``) tube, at
     most ``speed``, ``room`` m further from every agent; None when no such rows arrive within ``horizon`` s."""
     h = speed * DT / math.sqrt(2.0) * (1.0 - _SPARE)
@@ -52,10 +54,7 @@ def spacetime_path(obstacles, bounds, spawn, goal, tolerance: float, waypoints, 
     gx, gy = np.meshgrid(xs, ys)  # (ny, nx)
     grid = np.column_stack([gx.ravel(), gy.ravel()])
     edge = np.minimum.reduce([grid[:, 0] - bx0, bx1 - grid[:, 0], grid[:, 1] - by0, by1 - grid[:, 1]])
-    clear = edge.copy()
-    if len(obstacles):
-        clear = np.minimum(clear, obstacles.points_distance(grid)[0])
-    static = (clear >= inflation + h).reshape(gx.shape)
+    static = ((edge >= inflation + h) & _clear_of(footprints, xs, ys, inflation + h)).reshape(gx.shape)
     near_spawn = (np.hypot(*(grid - np.asarray(spawn[:2], float)).T) <= 1.5 * h).reshape(gx.shape) & static
     at_goal = (np.hypot(*(grid - np.asarray(goal[:2], float)).T) <= tolerance / 4).reshape(gx.shape) & static
     if not near_spawn.any() or not at_goal.any():
@@ -91,6 +90,23 @@ def spacetime_path(obstacles, bounds, spawn, goal, tolerance: float, waypoints, 
     rows = np.array([(k * DT, xs[j], ys[i]) for k, (i, j) in enumerate(cells)])
     rows[0, 1:] = spawn[:2]
     return _thinned(rows)
+
+
+def _clear_of(footprints, xs: np.ndarray, ys: np.ndarray, least: float) -> np.ndarray:
+    """(ny * nx,) bool: grid points at least ``least`` from every footprint (a polygon or a disc).
+
+    Each footprint grown by ``least`` + :data:`_ROUNDING` (shapely's rounded corners are chords, inside the
+    true arcs by under 0.4 mm at 16 segments a quarter): a point outside the union is far enough."""
+    import shapely
+
+    gx, gy = np.meshgrid(xs, ys)
+    if not footprints:
+        return np.ones(gx.size, dtype=bool)
+    shapes = [f.polygon if not f.is_disc else shapely.Point(f.centre).buffer(f.radius, quad_segs=16)
+              for f in footprints]
+    grown = shapely.union_all([shape.buffer(least + _ROUNDING, quad_segs=16) for shape in shapes])
+    shapely.prepare(grown)
+    return ~shapely.contains_xy(grown, gx.ravel(), gy.ravel())
 
 
 def _fastest(track: np.ndarray) -> float:
