@@ -5,11 +5,12 @@ a robot that keeps to the path (:func:`worldgen.people.timed.timed_path`) then h
 robot that steps aside has. This is the certificate's sweep in the plane: the floor near the task (the
 box round spawn, goal and static path, :data:`BORDER` wider) is a grid of cells ``h = speed x DT / sqrt 2``
 apart, time is steps of :data:`DT`; in a step the robot waits or moves to one of its 8 neighbouring cells (at
-most ``speed``). A cell is free of the static world when its centre is ``robot.inflation + h`` from every
-footprint below the robot's top (doors at their open limit, as the static planner has them; ``h`` covers
-the straight move to a neighbour), and free of an agent at a step when its centre is ``reach`` from every
-position the agent's tube allows around the step, with ``reach = inflation + the agent's radius + MARGIN +
-d + (speed + the fastest agent) x DT / 2``, as in worldgen/people/timed.py. A forward sweep keeps the cells
+most ``speed``). A cell is free of the static world when its centre is ``robot.inflation`` from every
+footprint below the robot's top (doors at their open limit, as the static planner has them), plus the most
+a straight move to a neighbour can dip towards a convex footprint; it is free of an agent at a step when its
+centre is ``reach`` from every position the agent's tube allows round the step (sampled every half step),
+``reach = inflation + the agent's radius + MARGIN + d + speed x DT / 2 + the fastest agent x DT / 4``, as
+in worldgen/people/timed.py. A forward sweep keeps the cells
 the robot can be in; the first step a goal cell (within a quarter of the goal's tolerance) is reachable is
 the arrival; the rows are read back, waiting where the robot can and else keeping its last direction.
 
@@ -54,7 +55,11 @@ def spacetime_path(footprints, bounds, spawn, goal, tolerance: float, waypoints,
     gx, gy = np.meshgrid(xs, ys)  # (ny, nx)
     grid = np.column_stack([gx.ravel(), gy.ravel()])
     edge = np.minimum.reduce([grid[:, 0] - bx0, bx1 - grid[:, 0], grid[:, 1] - by0, by1 - grid[:, 1]])
-    static = ((edge >= inflation + h) & _clear_of(footprints, xs, ys, inflation + h)).reshape(gx.shape)
+    # Between two neighbouring centres (a move of L <= h sqrt 2) the distance to one convex footprint, a
+    # convex function along the move, dips below the ends' by at most L^2 / (8 inflation) (the dip past a
+    # corner; none along a face): centres that much further out keep the whole move ``inflation`` off.
+    least = inflation + 2.0 * h * h / (8.0 * inflation) + _ROUNDING
+    static = ((edge >= least) & _clear_of(footprints, xs, ys, least)).reshape(gx.shape)
     near_spawn = (np.hypot(*(grid - np.asarray(spawn[:2], float)).T) <= 1.5 * h).reshape(gx.shape) & static
     at_goal = (np.hypot(*(grid - np.asarray(goal[:2], float)).T) <= tolerance / 4).reshape(gx.shape) & static
     if not near_spawn.any() or not at_goal.any():
