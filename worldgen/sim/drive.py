@@ -39,7 +39,7 @@ from worldgen.groundtruth.folder import WorldFolder, open_world
 from worldgen.sim.schedule import Plan, plan_for
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "CATCH_UP",
-           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "Outcome", "controller", "drive", "run_loop", "steps_per_command"]
+           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "ON_THE_SPOT", "Outcome", "controller", "drive", "run_loop", "steps_per_command"]
 
 #: Simulators ``worldgen drive --sim`` knows.
 SIMS = ("gazebo", "mujoco")
@@ -60,6 +60,8 @@ V_LIMIT = 1.0
 TIMED_TURN_RATE = 8.0
 #: m: a robot this close to where its schedule has it is waiting with the schedule, not stuck.
 LAG = 0.1
+#: m: within this of where the schedule has it a command ahead, the robot stands (and turns to where it goes next).
+ON_THE_SPOT = 0.01
 
 
 @dataclass
@@ -94,7 +96,21 @@ def controller(plan: Plan, speed: float = SPEED) -> Callable[[float, float, floa
     if plan.rows is not None:
         timed = TimedFollower(plan.rows, v_max=min(CATCH_UP * plan.speed, V_LIMIT), w_max=TIMED_TURN_RATE,
                               period=CONTROL_PERIOD)
-        return lambda t, x, y, yaw: tuple(float(a) for a in timed.action(x, y, yaw, t))  # type: ignore[return-value]
+        rows = plan.rows
+
+        def act(t: float, x: float, y: float, yaw: float) -> tuple[float, float]:
+            if math.hypot(*(timed.at(t + CONTROL_PERIOD) - (x, y))) > ON_THE_SPOT:
+                v, w = (float(a) for a in timed.action(x, y, yaw, t))
+                return v, w
+            # Where the schedule waits (or the goal): stand, facing where it goes next, so that setting off costs
+            # no turn (heading for a point millimetres away would only jitter).
+            ahead = rows[(rows[:, 0] > t) & (np.hypot(rows[:, 1] - x, rows[:, 2] - y) > LAG / 2)]
+            if not len(ahead):
+                return 0.0, 0.0
+            err = (math.atan2(ahead[0, 2] - y, ahead[0, 1] - x) - yaw + math.pi) % (2.0 * math.pi) - math.pi
+            return 0.0, float(np.clip(err / CONTROL_PERIOD, -TIMED_TURN_RATE, TIMED_TURN_RATE))
+
+        return act
     pursuit = PathFollower(plan.waypoints.tolist(), v_max=speed, w_max=TURN_RATE, lookahead=LOOKAHEAD)
     return lambda t, x, y, yaw: tuple(float(a) for a in pursuit.action(x, y, yaw))  # type: ignore[return-value]
 

@@ -51,7 +51,10 @@ def spacetime_path(footprints, bounds, spawn, goal, tolerance: float, waypoints,
     (bx0, by0), (bx1, by1) = bounds
     x0, y0 = max(pts[:, 0].min() - BORDER, bx0), max(pts[:, 1].min() - BORDER, by0)
     x1, y1 = min(pts[:, 0].max() + BORDER, bx1), min(pts[:, 1].max() + BORDER, by1)
-    xs, ys = np.arange(x0, x1 + 1e-9, h), np.arange(y0, y1 + 1e-9, h)
+    # The grid runs through the spawn: the robot starts on a cell, and its first move is a move like any other.
+    sx, sy = float(spawn[0]), float(spawn[1])
+    xs = sx + h * np.arange(math.ceil((x0 - sx) / h), math.floor((x1 - sx) / h) + 1)
+    ys = sy + h * np.arange(math.ceil((y0 - sy) / h), math.floor((y1 - sy) / h) + 1)
     gx, gy = np.meshgrid(xs, ys)  # (ny, nx)
     grid = np.column_stack([gx.ravel(), gy.ravel()])
     edge = np.minimum.reduce([grid[:, 0] - bx0, bx1 - grid[:, 0], grid[:, 1] - by0, by1 - grid[:, 1]])
@@ -60,9 +63,12 @@ def spacetime_path(footprints, bounds, spawn, goal, tolerance: float, waypoints,
     # corner; none along a face): centres that much further out keep the whole move ``inflation`` off.
     least = inflation + 2.0 * h * h / (8.0 * inflation) + _ROUNDING
     static = ((edge >= least) & _clear_of(footprints, xs, ys, least)).reshape(gx.shape)
-    near_spawn = (np.hypot(*(grid - np.asarray(spawn[:2], float)).T) <= 1.5 * h).reshape(gx.shape) & static
+    near_spawn = np.zeros(gx.shape, dtype=bool)
+    near_spawn[int(np.argmin(np.abs(ys - sy))), int(np.argmin(np.abs(xs - sx)))] = True
+    # The spawn is the world's, proven clear of the static world; only the margin of a move is not.
+    static |= near_spawn
     at_goal = (np.hypot(*(grid - np.asarray(goal[:2], float)).T) <= tolerance / 4).reshape(gx.shape) & static
-    if not near_spawn.any() or not at_goal.any():
+    if not at_goal.any():
         return None
     fastest = max([_fastest(t) for t in tracks], default=0.0)
     # The robot's cell at a step stands for every instant within DT / 2 of it (it moves at most speed DT / 2
@@ -93,7 +99,6 @@ def spacetime_path(footprints, bounds, spawn, goal, tolerance: float, waypoints,
         cells.append(nxt)
     cells.reverse()
     rows = np.array([(k * DT, xs[j], ys[i]) for k, (i, j) in enumerate(cells)])
-    rows[0, 1:] = spawn[:2]
     return _thinned(rows)
 
 
