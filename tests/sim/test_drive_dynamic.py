@@ -155,3 +155,28 @@ def test_a_schedule_that_sets_off_at_once_is_caught_up_with_after_the_turn_at_a_
     lag = np.hypot(trajectory[:, 1] - np.interp(trajectory[:, 0], rows[:, 0], rows[:, 1]), trajectory[:, 2])
     # The half turn at TIMED_TURN_RATE costs 0.4 s (0.2 m behind); at CATCH_UP x 0.5 m/s it is made up by 1.3 s.
     assert lag.max() < 0.25 and lag[trajectory[:, 0] > 1.3].max() < 0.02, (lag.max(), lag[trajectory[:, 0] > 1.3].max())
+
+
+def test_reacting_people_react_to_the_driven_robot_inside_their_tubes():
+    """The backend steps the environment's reactions: a regular person steps off its recorded walk as the robot
+    comes (by more than a centimetre), and stays within its tube's d of a recorded position within tau."""
+    from worldgen.groundtruth.folder import open_world
+    from worldgen.scene.motion import positions_at
+    from worldgen.sim.mujoco import MujocoBackend
+
+    world = generate_preset("person_crossing", seed=0, people_behaviour="regular")
+    opened = open_world(world)
+    meta, task = opened.metadata, opened.task()
+    backend = MujocoBackend(opened.file_bytes("mjcf"), meta, world.scene)
+    _, _, ended = run_loop(backend, task, plan=plan_for(meta, task, 0.5))
+    assert ended == "goal"
+    person = meta["people"][0]
+    walked = backend.walkers.reacted[person["name"]]
+    track = np.asarray(person["trajectory"])
+    off = np.hypot(*(walked[:, 1:] - positions_at([track], [False], walked[:, 0])[:, 0]).T)
+    assert off.max() > 0.01, "nobody reacted"
+    d, tau = person["tube"]["d"], person["tube"]["tau"]
+    for t, x, y in walked:
+        near = positions_at([track], [False], np.linspace(t - tau, t + tau, 301))[:, 0]
+        # Samples 0.01 s apart: the nearest is within half of it of any instant, at under 1.82 m/s (1.3 x 1.4).
+        assert np.hypot(near[:, 0] - x, near[:, 1] - y).min() <= d + 1.82 * 0.005 + 1e-9
