@@ -9,7 +9,9 @@ the door generator, every door's state and swing drawn (``state=random``, ``swin
 generator refuses (no timed path among the people, a door that cannot swing) is counted as refused and
 not driven. A drive succeeds when the judge passes the run (the goal reached in time, no collision) and
 MuJoCo saw no contact of the robot but with door leaves. A failure is listed with what the drive
-followed (``plan``), how it ended, the first contact, and the world's parameters.
+followed (``plan``), how it ended, the first contact, the world's parameters and a ``cause`` read from
+world.json (no schedule exists; a mover runs over the spawn or the goal; the schedule was left; a pull
+door's leaf sweeps the spawn).
 
 Pinned to one core (--all-cores to not pin). The table goes to stdout, the figures to
 benchmarks/results/drive_dynamic.json.
@@ -50,6 +52,36 @@ def draw(k: int, start: int) -> tuple[str, dict]:
     return generator, params
 
 
+def cause(world, outcome) -> str:
+    """Why a drive failed, as far as world.json tells: no schedule (and a mover over the spawn or the goal,
+    when one is), a schedule left (the follower's lag), or a door."""
+    from worldgen.scene.motion import positions_at
+
+    meta = world.metadata_for({})
+    task, robot = meta["tasks"][0], meta["robot"]
+    movers = meta.get("dynamic_obstacles") or []
+    why = []
+    if outcome.plan in ("movers", "spacetime"):
+        why.append(f"the robot left its {outcome.plan} schedule")
+    elif movers:
+        why.append(f"no schedule among the movers and people; it followed the {outcome.plan.replace('_', ' ')}")
+    if movers:
+        t = np.arange(0.0, float(task["time_limit"]), 0.01)
+        at = positions_at([np.asarray(m["trajectory"]) for m in movers], [True] * len(movers), t)
+        for where in ("spawn", "goal"):
+            gap = np.hypot(*(at - np.asarray(task[where][:2])).transpose(2, 0, 1)) - \
+                (np.array([m["radius"] for m in movers]) + robot["radius"])
+            k, j = np.unravel_index(np.argmin(gap), gap.shape)
+            if gap[k, j] < 0:
+                why.append(f"{movers[j]['name']} runs over the {where} at {t[k]:.2f} s")
+    if outcome.ended == "stuck" and outcome.doors_opened:
+        for d in meta.get("doors") or []:
+            reach = float(np.hypot(*(np.asarray(task["spawn"][:2]) - np.asarray(d["hinge"][:2]))))
+            if d["name"] in outcome.doors_opened and reach < d["width"] + robot["radius"]:
+                why.append(f"{d['name']} is a pull door whose leaf sweeps the spawn ({reach:.2f} m from its hinge)")
+    return "; ".join(why) or "unknown"
+
+
 def run(n: int, start: int) -> dict:
     import worldgen
     from worldgen.errors import InfeasibleError
@@ -80,7 +112,7 @@ def run(n: int, start: int) -> dict:
                     "generator": generator, "seed": seed, "params": params, "plan": outcome.plan,
                     "ended": outcome.ended, "sim_contact": outcome.contacts[:1] if outcome.contacts else [],
                     "judged_collision": run["collisions"][:1], "reached_goal": run["reached_goal"],
-                    "doors_opened": outcome.doors_opened})
+                    "doors_opened": outcome.doors_opened, "cause": cause(world, outcome)})
             print(f"{k:4d} {generator:9s} seed {seed:5d} {outcome.plan:10s} {outcome.ended:10s} "
                   f"{'ok' if ok else 'FAIL'}", flush=True)
     out["seconds"] = round(time.perf_counter() - t0, 1)
