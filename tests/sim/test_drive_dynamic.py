@@ -60,6 +60,27 @@ def test_doors_in_every_state_and_swing_are_driven_through(state, swing, tmp_pat
         assert outcome.door_contacts, "the robot went through a closed push door without touching it"
 
 
+#: Worlds of every generator with movers and reacting people (worlds 0, 1, 27, 9 and 23 of
+#: benchmarks/bench_drive_dynamic.py); the plan each is driven on.
+MIXED = [
+    ("cluttered", 0, {"size": [10.0, 10.0], "n_obstacles": 6, "n_movers": 3, "n_people": 4,
+                      "people_behaviour": "scared"}),
+    ("door", 1, {"state": "random", "swing": "random", "n_movers": 2, "n_people": 6,
+                 "people_behaviour": "impassive,regular,surprised,scared,curious"}),
+    ("barn", 27, {"n_movers": 1, "n_people": 5, "people_behaviour": "scared"}),
+    ("minimal", 9, {"n_movers": 1, "n_people": 3, "people_behaviour": "regular"}),
+    ("corridor", 23, {"width": 3.0, "n_movers": 2, "n_people": 3}),
+]
+
+
+@pytest.mark.parametrize("generator, seed, params", MIXED, ids=[m[0] for m in MIXED])
+def test_every_generator_with_movers_and_people_is_driven_without_contact(generator, seed, params, tmp_path):
+    world = worldgen.generate(generator, seed=seed, people_duration=20.0, **params)
+    outcome = drive(world, tmp_path, sim="mujoco")
+    _assert_clean(outcome)
+    assert outcome.plan in ("movers", "spacetime")
+
+
 @pytest.mark.parametrize("seed", [3, 5])
 def test_movers_are_passed_on_a_schedule_where_the_static_path_meets_them(seed, tmp_path):
     # Driven along the static path, mover_1 (seed 3, at 10.16 s) and mover_2 (seed 5, at 3.04 s) hit the robot;
