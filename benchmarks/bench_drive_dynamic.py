@@ -61,7 +61,7 @@ def cause(world, outcome) -> str:
     task, robot = meta["tasks"][0], meta["robot"]
     movers = meta.get("dynamic_obstacles") or []
     why = []
-    if outcome.plan in ("movers", "spacetime"):
+    if outcome.plan in ("movers", "spacetime") and outcome.contacts:
         why.append(f"the robot left its {outcome.plan} schedule")
     elif movers:
         why.append(f"no schedule among the movers and people; it followed the {outcome.plan.replace('_', ' ')}")
@@ -76,9 +76,12 @@ def cause(world, outcome) -> str:
                 why.append(f"{movers[j]['name']} runs over the {where} at {t[k]:.2f} s")
     if outcome.ended == "stuck" and outcome.doors_opened:
         for d in meta.get("doors") or []:
+            if d["name"] not in outcome.doors_opened:
+                continue
             reach = float(np.hypot(*(np.asarray(task["spawn"][:2]) - np.asarray(d["hinge"][:2]))))
-            if d["name"] in outcome.doors_opened and reach < d["width"] + robot["radius"]:
-                why.append(f"{d['name']} is a pull door whose leaf sweeps the spawn ({reach:.2f} m from its hinge)")
+            why.append(f"stuck at pull door {d['name']}, its leaf opening onto the robot" + (
+                f" (the leaf sweeps the spawn, {reach:.2f} m from its hinge)" if reach < d["width"] + robot["radius"]
+                else ""))
     return "; ".join(why) or "unknown"
 
 
@@ -87,7 +90,7 @@ def run(n: int, start: int) -> dict:
     from worldgen.errors import InfeasibleError
     from worldgen.sim.drive import drive
 
-    out = {"worlds": n, "start": start, "driven": 0, "refused": 0, "succeeded": 0, "plans": {}, "failures": [],
+    out = {"worlds": n, "start": start, "driven": 0, "refused": 0, "succeeded": 0, "plans": {}, "drives": [], "failures": [],
            "refusals": []}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="bench-drive-") as tmp:
@@ -106,6 +109,10 @@ def run(n: int, start: int) -> dict:
             out["plans"][outcome.plan] = out["plans"].get(outcome.plan, 0) + 1
             ok = outcome.passed and not outcome.contacts
             out["succeeded"] += ok
+            meta = world.metadata_for({})
+            out["drives"].append({"generator": generator, "seed": seed, "plan": outcome.plan, "ok": bool(ok),
+                                  "movers": len(meta.get("dynamic_obstacles") or []),
+                                  "people": len(meta.get("people") or []), "doors": len(meta.get("doors") or [])})
             if not ok:
                 run = outcome.run
                 out["failures"].append({
