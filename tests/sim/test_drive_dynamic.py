@@ -201,3 +201,17 @@ def test_reacting_people_react_to_the_driven_robot_inside_their_tubes():
         near = positions_at([track], [False], np.linspace(t - tau, t + tau, 301))[:, 0]
         # Samples 0.01 s apart: the nearest is within half of it of any instant, at under 1.82 m/s (1.3 x 1.4).
         assert np.hypot(near[:, 0] - x, near[:, 1] - y).min() <= d + 1.82 * 0.005 + 1e-9
+
+
+@pytest.mark.parametrize("seed, params", [
+    (96, {"n_movers": 2, "n_people": 6, "people_behaviour": "surprised"}),
+    (151, {"n_movers": 2, "n_people": 4}),
+])
+def test_a_pull_leaf_opening_onto_the_robot_is_given_way(seed, params, tmp_path):
+    """Worlds 96 and 151 of the benchmark: a pull door whose leaf sweeps the spawn (0.97 m from the hinge, a
+    0.9 m leaf), and one the schedule walks into while the leaf opens; standing in the sweep, the robot kept
+    the leaf shut and ended stuck. It backs out of the sweep, or waits outside it, until the leaf is open."""
+    world = worldgen.generate("door", seed=seed, state="random", swing="random", people_duration=20.0, **params)
+    outcome = drive(world, tmp_path, sim="mujoco")
+    _assert_clean(outcome)
+    assert outcome.doors_opened == ["door_0"]

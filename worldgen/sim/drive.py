@@ -127,6 +127,7 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
         plan = Plan("straight" if straight else "static",
                     np.asarray([spawn[:2], goal] if straight else task["path"]["waypoints"], dtype=float), speed)
     act = controller(plan, speed)
+    give_way = getattr(backend, "give_way", None)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
     t0 = t
     per = steps_per_command(backend.dt)
@@ -143,6 +144,8 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
             ended = "stuck"
             break
         v, w = act(t - t0, x, y, yaw)
+        if give_way is not None:  # a door opening onto the robot (worldgen.sim.mujoco)
+            v = give_way(x, y, yaw, v, per * backend.dt)
         commands.append((t, v, w))
         t, x, y, yaw = backend.step(v, w, per)
         rows.append((t, x, y, yaw))

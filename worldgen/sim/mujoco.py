@@ -32,12 +32,19 @@ from worldgen.export.xml import safe_parser
 from worldgen.groundtruth.folder import robot_of
 from worldgen.judge.figures import DOOR_DEBOUNCE
 
-__all__ = ["MujocoBackend", "V_RANGE", "W_MAX", "DOOR_MODE", "DOOR_TRIGGER", "DOOR_SPEED", "movers_of"]
+__all__ = ["MujocoBackend", "V_RANGE", "W_MAX", "DOOR_MODE", "DOOR_TRIGGER", "DOOR_SPEED", "GIVE_WAY", "BACK_OFF",
+           "OPEN_WITHIN", "movers_of"]
 
 #: The servos' limits: forward speed (m/s) and turn rate (rad/s), beyond anything the controller asks.
 V_RANGE = (-1.0, 1.0)
 W_MAX = 10.0
 _DEFAULTS = {p.name: p.default for p in SETTINGS}
+#: m beyond a leaf's sweep (its width, plus the robot's radius) the robot keeps while the leaf swings open.
+GIVE_WAY = 0.05
+#: m/s the robot backs away from the hinge when a leaf opens onto where it stands.
+BACK_OFF = 0.2
+#: rad: a leaf this close to its open limit is open.
+OPEN_WITHIN = 0.1
 #: How doors open: the environment's default (worldgen.envs.doors), and its trigger distance (m) and speed (rad/s).
 DOOR_MODE = str(_DEFAULTS["doors"])
 DOOR_TRIGGER = float(_DEFAULTS["door_trigger"])
@@ -100,6 +107,51 @@ class MujocoBackend:
         self._last = (float(sim.data.time), x, y)
         return (float(sim.data.time), *sim.pose())
 
+    def give_way(self, x: float, y: float, yaw: float, v: float, ahead: float) -> float:
+        """The forward speed the robot at (x, y, yaw) asking ``v`` may take for the next ``ahead`` s: ``v``,
+        unless a leaf its opener swings is still short of open and the robot stands in its sweep on the side
+        it swings into (then it backs away from the hinge at :data:`BACK_OFF`, or stands if backing brings
+        it nearer) or would enter it (then it stands): a leaf opening onto the robot presses on it, and the
+        robot pressing back keeps it shut."""
+        sim, openers = self._sim, self._openers
+        if sim is None or openers is None or not openers.opened:
+            return v
+        p = np.array([x, y])
+        heading = np.array([math.cos(yaw), math.sin(yaw)])
+        for d in self._doors:
+            if d["name"] not in openers.opened or not d.get("passage"):
+                continue
+            lo, hi = d["limits"]
+            opened = lo if abs(lo) > abs(hi) else hi
+            angle = float(sim.data.qpos[sim.model.joint(d["joint"]).qposadr[0]])
+            if abs(opened - angle) <= OPEN_WITHIN or float((p - d["passage"]["center"]) @ d["passage"]["normal"]) <= 0:
+                continue
+            hinge, reach = np.asarray(d["hinge"][:2], dtype=float), float(d["width"]) + self.robot.radius + GIVE_WAY
+            now = float(np.hypot(*(p - hinge)))
+            if now < reach:
+                back = p - 0.01 * heading
+                away = np.hypot(*(back - hinge)) > now and _to_segment(back, hinge, _open_leaf_end(d, opened)) > \
+                    self.robot.radius + GIVE_WAY
+                return -BACK_OFF if away and self._room_behind(x, y, yaw) else 0.0
+            if np.hypot(*(p + max(v, 0.0) * ahead * heading - hinge)) < reach:
+                return 0.0
+        return v
+
+    def _room_behind(self, x: float, y: float, yaw: float) -> bool:
+        """Whether nothing (a wall, an obstacle, a mover, a person) is within 3 cm of the robot's back: rays
+        from its centre at half its height, straight back and 30 degrees either side."""
+        import mujoco
+
+        sim = self._sim
+        reach = self.robot.radius / math.cos(math.radians(30.0)) + 0.03
+        for off in (-30.0, 0.0, 30.0):
+            a = yaw + math.pi + math.radians(off)
+            hit = mujoco.mj_ray(sim.model, sim.data, np.array([x, y, self.robot.height / 2]),
+                                np.array([math.cos(a), math.sin(a), 0.0]), None, 1, sim.body, np.zeros(1, np.int32))
+            if 0 <= hit < reach:
+                return False
+        return True
+
     def step(self, v: float, w: float, n: int) -> tuple[float, float, float, float]:
         import mujoco
 
@@ -150,6 +202,22 @@ class MujocoBackend:
 
     def close(self) -> None:
         self._sim = None
+
+
+def _open_leaf_end(door: dict, opened: float) -> np.ndarray:
+    """(2,) the free end of a leaf at its open limit ``opened``: the closed leaf runs from the hinge across the
+    doorway (to twice the passage's centre, seen from the hinge), turned about the hinge's axis."""
+    hinge = np.asarray(door["hinge"][:2], dtype=float)
+    across = 2.0 * (np.asarray(door["passage"]["center"], dtype=float) - hinge)
+    turn = opened * (1.0 if door["axis"][2] >= 0 else -1.0)
+    c, s = math.cos(turn), math.sin(turn)
+    return hinge + np.array([c * across[0] - s * across[1], s * across[0] + c * across[1]])
+
+
+def _to_segment(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    ab = b - a
+    u = float(np.clip((p - a) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0))
+    return float(np.hypot(*(p - a - u * ab)))
 
 
 def _wall_gap(scene):
