@@ -15,6 +15,11 @@ from worldgen.cli.context import CONTEXT as _CONTEXT
 
 __all__ = ["drive_command"]
 
+#: How the verdict line names what the robot followed (worldgen.sim.schedule.Plan's kinds, docs/drive.md).
+_FOLLOWED = {"timed_path": "timed path", "movers": "schedule among the movers along the path",
+             "spacetime": "schedule among the movers off the path", "static": "static path",
+             "straight": "straight line"}
+
 
 @click.command("drive", context_settings=_CONTEXT, epilog="""\b
 Examples:
@@ -36,7 +41,8 @@ def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: 
     """Drive a world's task in a simulator, record the run as a rosbag2 bag and judge it.
 
     The robot (worldgen.export.robot in Gazebo, the RL environment's robot in MuJoCo) starts at the
-    task's spawn and follows the reference path by pure pursuit on the simulator's own pose; the run
+    task's spawn and follows the world's timed path among people, a schedule it works out among movers,
+    or else the reference path by pure pursuit, on the simulator's own pose (docs/drive.md); the run
     stops at the goal, the time limit, or when the robot is stuck. The bag holds /clock, /odom, /tf,
     /cmd_vel and /ground_truth and is judged as 'worldgen judge BAG --world WORLD' would judge it.
     Exit status 0 when the run succeeds, 1 when it does not, 2 on bad input. Needs the ros extra.
@@ -57,7 +63,7 @@ def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: 
         stopped = {"stuck": "stuck", "time_limit": "time limit", "goal": "at the goal"}[outcome.ended]
         what = f"{run.get('reason') or 'judged a failure'} (the drive stopped: {stopped})"
     click.echo(f"{sim}: {'PASS' if outcome.passed else 'FAIL'}: {what} ({outcome.sim_seconds:.2f} s simulated, "
-               f"{outcome.wall['drive']:.2f} s wall)")
+               f"{outcome.wall['drive']:.2f} s wall; followed the {_FOLLOWED[outcome.plan]})")
     click.echo(f"bag: {outcome.bag}")
     if not outcome.passed:
         raise click.exceptions.Exit(1)

@@ -29,16 +29,17 @@ import math
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Optional
+from typing import Callable, Optional
 
 import numpy as np
 
-from worldgen.envs.policies import PathFollower
+from worldgen.envs.policies import PathFollower, TimedFollower
 from worldgen.errors import OutputError, ParameterError
 from worldgen.groundtruth.folder import WorldFolder, open_world
+from worldgen.sim.schedule import Plan, plan_for
 
-__all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "Outcome",
-           "drive", "run_loop", "steps_per_command"]
+__all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "CATCH_UP",
+           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "ON_THE_SPOT", "Outcome", "controller", "drive", "run_loop", "steps_per_command"]
 
 #: Simulators ``worldgen drive --sim`` knows.
 SIMS = ("gazebo", "mujoco")
@@ -50,6 +51,17 @@ CONTROL_PERIOD = 0.05
 TURN_RATE = 2.0
 STUCK_SECONDS = 2.0
 STUCK_MOVE = 0.02      # m
+#: On a schedule, the follower may go this many times the schedule's top speed to catch up with it (the
+#: schedule turns its corners on the spot, so a robot that turns at a finite rate falls behind at each).
+CATCH_UP = 1.5
+#: m/s, the fastest the drive ever asks for (the MuJoCo servos' and the bridge's range).
+V_LIMIT = 1.0
+#: rad/s, the turn rate the timed follower may ask for: a quarter turn in 0.2 s, 0.1 m behind a 0.5 m/s schedule.
+TIMED_TURN_RATE = 8.0
+#: m: a robot this close to where its schedule has it is waiting with the schedule, not stuck.
+LAG = 0.1
+#: m: within this of where the schedule has it a command ahead, the robot stands (and turns to where it goes next).
+ON_THE_SPOT = 0.01
 
 
 @dataclass
@@ -63,6 +75,13 @@ class Outcome:
     run: dict
     sim_seconds: float
     wall: dict = field(default_factory=dict)
+    #: What the robot followed (worldgen.sim.schedule.Plan's kind: timed_path, movers, static or straight).
+    plan: str = "static"
+    #: The simulator's own contacts of the robot, (t, name), door leaves left out (MuJoCo; None in Gazebo,
+    #: whose bridge reports none), the doors whose opener the robot triggered, and its contacts with leaves.
+    contacts: Optional[list] = None
+    doors_opened: list = field(default_factory=list)
+    door_contacts: Optional[list] = None
 
 
 def steps_per_command(dt: float) -> int:
@@ -70,12 +89,48 @@ def steps_per_command(dt: float) -> int:
     return max(1, round(CONTROL_PERIOD / dt))
 
 
-def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED) -> tuple[np.ndarray, np.ndarray, str]:
-    """Drive ``task`` in a started-or-not ``backend``: the (n, 4) trajectory, (m, 3) commands and why it ended."""
+def controller(plan: Plan, speed: float = SPEED) -> Callable[[float, float, float, float], tuple[float, float]]:
+    """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t from the run's start): the environment's
+    :class:`~worldgen.envs.policies.TimedFollower` on a schedule (within :data:`CATCH_UP` x its top speed and
+    :data:`TIMED_TURN_RATE`), its :class:`~worldgen.envs.policies.PathFollower` on a path (at ``speed``)."""
+    if plan.rows is not None:
+        timed = TimedFollower(plan.rows, v_max=min(CATCH_UP * plan.speed, V_LIMIT), w_max=TIMED_TURN_RATE,
+                              period=CONTROL_PERIOD)
+        rows = plan.rows
+
+        def act(t: float, x: float, y: float, yaw: float) -> tuple[float, float]:
+            if math.hypot(*(timed.at(t + CONTROL_PERIOD) - (x, y))) > ON_THE_SPOT:
+                v, w = (float(a) for a in timed.action(x, y, yaw, t))
+                return v, w
+            # Where the schedule waits (or the goal): stand, facing where it goes next, so that setting off costs
+            # no turn (heading for a point millimetres away would only jitter).
+            ahead = rows[(rows[:, 0] > t) & (np.hypot(rows[:, 1] - x, rows[:, 2] - y) > LAG / 2)]
+            if not len(ahead):
+                return 0.0, 0.0
+            err = (math.atan2(ahead[0, 2] - y, ahead[0, 1] - x) - yaw + math.pi) % (2.0 * math.pi) - math.pi
+            return 0.0, float(np.clip(err / CONTROL_PERIOD, -TIMED_TURN_RATE, TIMED_TURN_RATE))
+
+        return act
+    pursuit = PathFollower(plan.waypoints.tolist(), v_max=speed, w_max=TURN_RATE, lookahead=LOOKAHEAD)
+    # tuple() of a generator is typed tuple[float, ...]; the follower's action is always (v, w)
+    return lambda t, x, y, yaw: tuple(float(a) for a in pursuit.action(x, y, yaw))  # type: ignore[return-value]
+
+
+def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
+             plan: Optional[Plan] = None) -> tuple[np.ndarray, np.ndarray, str]:
+    """Drive ``task`` in a started-or-not ``backend``: the (n, 4) trajectory, (m, 3) commands and why it ended.
+
+    ``plan`` (default: the static path, or spawn -> goal when ``straight``) says what to follow. On a
+    schedule the robot is stuck only when it stands while the schedule has it more than :data:`LAG` away:
+    waiting where the schedule waits is no sign of being stuck."""
     spawn, goal = task["spawn"], np.asarray(task["goal"][:2], dtype=float)
-    path = [spawn[:2], goal] if straight else task["path"]["waypoints"]
-    pursuit = PathFollower(path, v_max=speed, w_max=TURN_RATE, lookahead=LOOKAHEAD)
+    if plan is None:
+        plan = Plan("straight" if straight else "static",
+                    np.asarray([spawn[:2], goal] if straight else task["path"]["waypoints"], dtype=float), speed)
+    act = controller(plan, speed)
+    give_way = getattr(backend, "give_way", None)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
+    t0 = t
     per = steps_per_command(backend.dt)
     limit = t + float(task["time_limit"])
     rows, commands = [(t, x, y, yaw)], []
@@ -84,12 +139,14 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED) 
         if math.hypot(x - goal[0], y - goal[1]) < float(task["goal_tolerance"]) / 2:
             ended = "goal"
             break
-        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE:
+        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE or _on_schedule(plan, t - t0, x, y):
             still_since, still_at = t, (x, y)
         elif t - still_since > STUCK_SECONDS:
             ended = "stuck"
             break
-        v, w = (float(a) for a in pursuit.action(x, y, yaw))
+        v, w = act(t - t0, x, y, yaw)
+        if give_way is not None:  # a door opening onto the robot (worldgen.sim.mujoco)
+            v = give_way(x, y, yaw, v, per * backend.dt)
         commands.append((t, v, w))
         t, x, y, yaw = backend.step(v, w, per)
         rows.append((t, x, y, yaw))
@@ -97,12 +154,22 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED) 
     return np.array(rows), np.array(commands), ended
 
 
+def _on_schedule(plan: Plan, t: float, x: float, y: float) -> bool:
+    """Whether the robot is within :data:`LAG` of where ``plan``'s schedule has it at ``t`` (False on a path)."""
+    if plan.rows is None:
+        return False
+    r = plan.rows
+    return math.hypot(x - float(np.interp(t, r[:, 0], r[:, 1])), y - float(np.interp(t, r[:, 0], r[:, 2]))) < LAG
+
+
 def _backend(sim: str, world: WorldFolder):
     meta = world.metadata
     if sim == "mujoco":
         from worldgen.sim.mujoco import MujocoBackend
 
-        return MujocoBackend(world.file_bytes("mjcf"), meta)
+        people = meta.get("people") or []
+        return MujocoBackend(world.file_bytes("mjcf"), meta,
+                             _scene_of(world) if any(p.get("behaviour") for p in people) else None)
     from worldgen.export.contract import SIM_GZ_RELEASE
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.bridge import GazeboBackend, world_step
@@ -143,19 +210,39 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
         raise OutputError(f"output folder '{out}' is not a folder")
     wall = {}
     started = time.perf_counter()
+    plan = plan_for(meta, chosen, speed, straight, lambda: _scene_of(opened))
+    wall["plan"] = time.perf_counter() - started
     backend = _backend(sim, opened)
     try:
-        trajectory, commands, ended = run_loop(backend, chosen, straight, speed)
+        trajectory, commands, ended = run_loop(backend, chosen, straight, speed, plan)
     finally:
         backend.close()
-    wall["drive"] = time.perf_counter() - started
+    wall["drive"] = time.perf_counter() - started - wall["plan"]
     _write_bag(bag, trajectory, commands, meta, chosen, run_part)
-    wall["record"] = time.perf_counter() - started - wall["drive"]
+    wall["record"] = time.perf_counter() - started - wall["plan"] - wall["drive"]
     result = judge([bag], world=world)
-    wall["judge"] = time.perf_counter() - started - wall["drive"] - wall["record"]
+    wall["judge"] = time.perf_counter() - started - sum(wall.values())
     run = result.report["runs"][0]
     return Outcome(bag, ended, bool(result.passed), _verdict(run, ended), run,
-                   float(trajectory[-1, 0] - trajectory[0, 0]), wall)
+                   float(trajectory[-1, 0] - trajectory[0, 0]), wall, plan.kind,
+                   getattr(backend, "contacts", None), list(getattr(backend, "doors_opened", [])),
+                   getattr(backend, "door_contacts", None))
+
+
+def _scene_of(world: WorldFolder):
+    """The world's scene: a World's own, else the world regenerated from its recorded generator, seed and
+    parameters (it must give the recorded ``content_hash``)."""
+    if world.scene is not None:
+        return world.scene
+    from worldgen.api import generate
+
+    meta = world.metadata
+    again = generate(meta["generator"], meta["seed"],
+                     allow_infeasible=meta["feasibility"].get("allow_infeasible", False), **meta["params"])
+    if again.content_hash != meta["content_hash"]:
+        raise ParameterError(f"world {meta['world_id']} does not regenerate with this worldgen version "
+                             f"({again.content_hash} != {meta['content_hash']}); its reacting people need its scene")
+    return again.scene
 
 
 def _write_bag(bag: Path, trajectory, commands, meta: dict, task: dict, run: str) -> None:
