@@ -504,6 +504,7 @@ class _Commander:
     finishes_after = 5.0
     result: object = None
     crash_in = ""
+    interrupt_in = ""
 
     def __init__(self, node_name="basic_navigator", namespace=""):
         self.t = 100.0
@@ -520,6 +521,8 @@ class _Commander:
         self.calls.append((name,) + args)
         if name == self.crash_in:
             raise RuntimeError(f"{name} failed")
+        if name == self.interrupt_in:  # launch's SIGINT, as Python delivers it
+            raise KeyboardInterrupt
 
     def get_clock(self):
         return _msg(now=lambda: _Time(round(self.t * 1e9)))
@@ -641,6 +644,14 @@ def test_a_goal_sender_that_fails_writes_a_crashed_result(folder, tmp_path, monk
     code, _, _, record = _send_goal(folder, tmp_path, monkeypatch, crash_in=crash_in)
     assert code == 4 and record["outcome"] == "crashed"
     assert record["reason"] == f"RuntimeError: {crash_in} failed" and record["task"] == "task_1"
+
+
+@pytest.mark.parametrize("interrupt_in", ["waitUntilNav2Active", "isTaskComplete"])
+def test_a_goal_sender_stopped_by_sigint_writes_interrupted_not_crashed(folder, tmp_path, monkeypatch, interrupt_in):
+    """E5 (issue 39): a Ctrl-C is no crash, so the loop never counts it as an attempt."""
+    code, _, _, record = _send_goal(folder, tmp_path, monkeypatch, interrupt_in=interrupt_in)
+    assert code == 5 and record["outcome"] == "interrupted" and record["finished_sim_time"] is None
+    assert (record["task"], record["run"], record["seed"], record["world_dir"]) == ("task_1", 4, 7, str(folder))
 
 
 def test_the_first_result_written_wins(folder, tmp_path):
