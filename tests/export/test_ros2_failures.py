@@ -152,17 +152,22 @@ def test_e3_a_bridge_that_ends_mid_run_is_a_crash(world, description, tmp_path):
 
 # -- E4, E5: SIGTERM and interrupts ------------------------------------------------------------------
 
-#: A `ros2 launch` stand-in that behaves as launch does on signals (launch_service.py, Jazzy): SIGINT
-#: stops what it started (a child standing in for Gazebo), then it exits; SIGTERM cancels launch's run
-#: task at once, which leaves the child running ("using SIGTERM can result in orphaned processes").
+#: A `ros2 launch` stand-in that behaves as launch does on signals (launch_service.py, execute_local.py,
+#: Jazzy): on SIGINT it sends its processes (a child standing in for Gazebo) nothing, expecting the
+#: Ctrl-C to have reached them too, waits, and escalates to SIGTERM for what did not stop; SIGTERM
+#: cancels launch's run task at once, which leaves the child running ("can result in orphaned processes").
 SIGNALLED_ROS2 = r'''#!{python}
 import os, signal, subprocess, sys, time
 child = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(120)'])
 mark = os.environ['FAKE_SCENARIO']
 def stop(signum, frame):
-    child.terminate()
-    child.wait()
-    open(mark + '.stopped', 'w').write('clean')
+    try:  # a Ctrl-C reached every process of the group: launch waits for them before it escalates
+        child.wait(timeout=3)
+        how = 'clean'
+    except subprocess.TimeoutExpired:
+        child.terminate()
+        how = 'escalated to SIGTERM'
+    open(mark + '.stopped', 'w').write(how)
     sys.exit(0)
 def orphan(signum, frame):
     open(mark + '.orphaned', 'w').write(str(child.pid))
