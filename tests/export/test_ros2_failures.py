@@ -180,10 +180,15 @@ time.sleep(120)
 '''
 
 
-def _start_loop(folder, tmp_path, env, scenario):
+def _start_loop(folder, tmp_path, env, scenario, sigint_ignored=False):
+    """run_loop.py, its own process group's leader; ``sigint_ignored``: as a script's `&` starts it."""
+    def ignore():
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+
     proc = subprocess.Popen([sys.executable, str(folder / "ros2" / "run_loop.py"), "--retries", "0", "--out",
                              str(tmp_path / "bags"), str(folder)], env=env, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            preexec_fn=ignore if sigint_ignored else None)
     deadline = time.monotonic() + 30
     while not Path(str(scenario) + ".started").exists() and time.monotonic() < deadline:
         time.sleep(0.05)
@@ -240,6 +245,24 @@ def test_e5_an_interrupted_run_is_no_attempt(world, folder, tmp_path):
     assert kept == [f"{name}.interrupted{i}" for i in range(3)]
     first = yaml.safe_load((bags / ".attempts" / kept[0] / f"{name}.result.yaml").read_text())
     assert first["outcome"] == "interrupted" and first["reason"] == "the loop got SIGINT during the run"
+
+
+def test_e5_a_loop_started_with_sigint_ignored_still_stops_its_run_on_sigint(world, folder, tmp_path):
+    """A loop started in a script's background inherits SIGINT ignored; it sets its own handler, so the
+    SIGINT it forwards is not ignored by launch and the processes launch starts either."""
+    scenario, env = ros2_env(tmp_path, SIGNALLED_ROS2)
+    proc = _start_loop(folder, tmp_path, env, scenario, sigint_ignored=True)
+    child, launch = map(int, Path(str(scenario) + ".child").read_text().split())
+    try:
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=30)
+        assert proc.returncode == 130 and Path(str(scenario) + ".stopped").read_text() == "clean", err
+    finally:
+        for pid in (child, launch):
+            if _alive(pid):
+                os.kill(pid, signal.SIGKILL)
+        if proc.poll() is None:
+            proc.kill()
 
 
 def test_e5_ctrl_c_of_a_launch_is_recorded_interrupted(world, description, tmp_path):
