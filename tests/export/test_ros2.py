@@ -42,9 +42,12 @@ BRIDGE_TYPES = {"rosgraph_msgs/msg/Clock": "Clock", "tf2_msgs/msg/TFMessage": "P
                 "nav_msgs/msg/Odometry": "Odometry", "sensor_msgs/msg/LaserScan": "LaserScan",
                 "sensor_msgs/msg/Imu": "IMU", "sensor_msgs/msg/JointState": "Model"}
 #: (package, executable) the launch file starts as Nodes: ros_gz_sim's `create` (ros_gz_sim/src/create.cpp),
-#: ros_gz_bridge's `parameter_bridge` (its README), robot_state_publisher.
+#: ros_gz_bridge's `parameter_bridge` (its README), robot_state_publisher; where doors start shut, the
+#: planner's map server and its lifecycle manager (nav2 1.3.13's localization_launch.py starts the same
+#: two executables; nav2_map_server/CMakeLists.txt, nav2_lifecycle_manager/CMakeLists.txt).
 NODES = {("ros_gz_sim", "create"), ("ros_gz_bridge", "parameter_bridge"),
-         ("robot_state_publisher", "robot_state_publisher")}
+         ("robot_state_publisher", "robot_state_publisher"), ("nav2_map_server", "map_server"),
+         ("nav2_lifecycle_manager", "lifecycle_manager")}
 #: Files of other packages the launch file uses: nav2_bringup/launch/bringup_launch.py and
 #: nav2_bringup/params/nav2_params.yaml (Gazebo is started directly, not through ros_gz_sim's gz_sim.launch.py).
 SHARED_FILES = {("nav2_bringup", "launch", "bringup_launch.py"), ("nav2_bringup", "params", "nav2_params.yaml")}
@@ -69,7 +72,7 @@ LAUNCH_API = {"launch": {"LaunchDescription"},
               "launch.actions": {"DeclareLaunchArgument", "OpaqueFunction", "ExecuteProcess", "IncludeLaunchDescription",
                                  "RegisterEventHandler", "Shutdown", "TimerAction"},
               "launch.conditions": {"IfCondition", "UnlessCondition"},
-              "launch.event_handlers": {"OnProcessExit"},
+              "launch.event_handlers": {"OnProcessExit", "OnShutdown"},
               "launch.launch_description_sources": {"PythonLaunchDescriptionSource"},
               "launch.substitution": {"Substitution"},
               "launch.substitutions": {"LaunchConfiguration"},
@@ -240,9 +243,11 @@ def test_the_launch_file_starts_what_the_ros_documentation_names(world, folder):
         if isinstance(node, ast.ImportFrom) and node.module.split(".")[0] in {"launch", "launch_ros", "ament_index_python"}:
             imported.setdefault(node.module, set()).update(a.name for a in node.names)
     assert imported and all(names <= LAUNCH_API[module] for module, names in imported.items())
-    # Shutdown on the goal sender's exit, on a failed spawn (either way of spawning), on Gazebo's end and on a
+    # One handler for every process's exit (the goal sender's, a crash anywhere), Ctrl-C's shutdown, and a
     # wall-clock backstop; never a kill by name.
-    assert len(_calls(tree, "OnProcessExit")) == 4 and len(_calls(tree, "Shutdown")) == 2 and _calls(tree, "TimerAction")
+    [on_exit] = _calls(tree, "OnProcessExit")
+    assert "target_action" not in _keywords(on_exit) and len(_calls(tree, "OnShutdown")) == 1
+    assert len(_calls(tree, "Shutdown")) == 2 and _calls(tree, "TimerAction")
     assert not re.search(r"\b(pkill|killall|kill)\b", path.read_text())
 
 
@@ -330,14 +335,14 @@ def test_the_loop_plans_n_worlds_by_m_runs(tmp_path):
     loop = load(worlds[0] / "ros2" / "run_loop.py", "bundle_run_loop")
     plan = loop.runs([str(w) for w in worlds], 3, "robot.urdf", "", str(tmp_path / "bags"), seed=10, which="all")
     assert len(plan) == 2 * 2 * 3
-    bag, command = plan[5]
+    bag, command = plan[5]["bag"], plan[5]["command"]
     assert command[:2] == ["ros2", "launch"] and command[2].endswith(".launch.py") and Path(command[2]).is_file()
     assert f"seed:={10 + 2}" in command and "run:=2" in command and "task:=task_1" in command
     assert bag == str(tmp_path / "bags" / f"{worlds[0].name}__task_1__run2")
     assert len(loop.runs([str(worlds[0])], 2, "", "/robot_description", "bags")) == 2  # first task only
     (tmp_path / "bags").mkdir()
-    Path(plan[0][0]).mkdir()  # a run is done with its result file, not with its bag
-    Path(plan[1][0] + ".result.yaml").write_text("outcome: failed\n")
+    Path(plan[0]["bag"]).mkdir()  # a run is done with its result file, not with its bag
+    Path(plan[1]["bag"] + ".result.yaml").write_text("outcome: failed\n")
     (tmp_path / "r.urdf").write_text("<robot name='r'/>")
     out = subprocess.run([sys.executable, str(worlds[0] / "ros2" / "run_loop.py"), "--runs", "3", "--robot",
                           str(tmp_path / "r.urdf"),
@@ -499,6 +504,7 @@ class _Commander:
     finishes_after = 5.0
     result: object = None
     crash_in = ""
+    interrupt_in = ""
 
     def __init__(self, node_name="basic_navigator", namespace=""):
         self.t = 100.0
@@ -515,6 +521,8 @@ class _Commander:
         self.calls.append((name,) + args)
         if name == self.crash_in:
             raise RuntimeError(f"{name} failed")
+        if name == self.interrupt_in:  # launch's SIGINT, as Python delivers it
+            raise KeyboardInterrupt
 
     def get_clock(self):
         return _msg(now=lambda: _Time(round(self.t * 1e9)))
@@ -636,6 +644,14 @@ def test_a_goal_sender_that_fails_writes_a_crashed_result(folder, tmp_path, monk
     code, _, _, record = _send_goal(folder, tmp_path, monkeypatch, crash_in=crash_in)
     assert code == 4 and record["outcome"] == "crashed"
     assert record["reason"] == f"RuntimeError: {crash_in} failed" and record["task"] == "task_1"
+
+
+@pytest.mark.parametrize("interrupt_in", ["waitUntilNav2Active", "isTaskComplete"])
+def test_a_goal_sender_stopped_by_sigint_writes_interrupted_not_crashed(folder, tmp_path, monkeypatch, interrupt_in):
+    """E5 (issue 39): a Ctrl-C is no crash, so the loop never counts it as an attempt."""
+    code, _, _, record = _send_goal(folder, tmp_path, monkeypatch, interrupt_in=interrupt_in)
+    assert code == 5 and record["outcome"] == "interrupted" and record["finished_sim_time"] is None
+    assert (record["task"], record["run"], record["seed"], record["world_dir"]) == ("task_1", 4, 7, str(folder))
 
 
 def test_the_first_result_written_wins(folder, tmp_path):

@@ -1,9 +1,10 @@
 """The ROS 2 bundle at run time, without ROS: the launch file's description run through stand-ins of
 ROS's launch API, and run_loop.py over stand-in `ros2 launch` processes.
 
-The stand-ins perform substitutions and conditions as launch does (launch's substitution.py,
-conditions, OnProcessExit's callback with the exit event); they run the bundle's own code, they do not
-emulate ROS. The real Gazebo server's shutdown is in test_ros2_gazebo.py; docs/ros2.md says what was
+The stand-ins (tests/support/launch_standins.py) perform substitutions and conditions as launch does
+(launch's substitution.py, conditions, OnProcessExit's matcher and callback with the exit event); they
+run the bundle's own code, they do not emulate ROS. What each failure of a run becomes is in
+test_ros2_failures.py. The real Gazebo server's shutdown is in test_ros2_gazebo.py; docs/ros2.md says what was
 verified where.
 """
 
@@ -12,131 +13,11 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import types
 from pathlib import Path
 
 import pytest
 import yaml
-from support.bundle import load_script as load
-
-from worldgen.export import ros2
-
-# -- stand-ins of ROS's launch API ------------------------------------------------
-
-class _Action:
-    def __init__(self, *args, **kwargs):
-        self.args, self.kwargs = args, kwargs
-
-
-class _Substitution:
-    """launch.substitution.Substitution: describe() and perform(context)."""
-
-    def describe(self):
-        return type(self).__name__
-
-
-class _LaunchConfiguration(_Substitution):
-    def __init__(self, name):
-        self.name = name
-
-    def perform(self, context):
-        return context.launch_configurations[self.name]
-
-
-def perform(value, context) -> str:
-    """One command-line argument or parameter as launch makes it: text, a substitution, or a list of them."""
-    if isinstance(value, (list, tuple)):
-        return "".join(perform(v, context) for v in value)
-    return value.perform(context) if hasattr(value, "perform") else str(value)
-
-
-class _IfCondition:
-    def __init__(self, predicate):
-        self.predicate = predicate
-
-    def evaluate(self, context):
-        return perform(self.predicate, context).lower() in ("true", "1")
-
-
-class _UnlessCondition(_IfCondition):
-    def evaluate(self, context):
-        return not super().evaluate(context)
-
-
-class _ParameterValue:
-    def __init__(self, value, value_type=None):
-        self.value, self.value_type = value, value_type
-
-
-def fake_launch_api(monkeypatch, share: Path) -> None:
-    classes = {"launch": {"LaunchDescription": type("LaunchDescription", (_Action,), {})},
-               "launch.actions": {n: type(n, (_Action,), {}) for n in (
-                   "DeclareLaunchArgument", "ExecuteProcess", "IncludeLaunchDescription", "OpaqueFunction",
-                   "RegisterEventHandler", "Shutdown", "TimerAction")},
-               "launch.conditions": {"IfCondition": _IfCondition, "UnlessCondition": _UnlessCondition},
-               "launch.event_handlers": {"OnProcessExit": type("OnProcessExit", (_Action,), {})},
-               "launch.launch_description_sources": {"PythonLaunchDescriptionSource": type("Source", (_Action,), {})},
-               "launch.substitution": {"Substitution": _Substitution},
-               "launch.substitutions": {"LaunchConfiguration": _LaunchConfiguration},
-               "launch_ros": {}, "launch_ros.actions": {"Node": type("Node", (_Action,), {})},
-               "launch_ros.parameter_descriptions": {"ParameterValue": _ParameterValue},
-               "ament_index_python": {},
-               "ament_index_python.packages": {"get_package_share_directory": lambda package: str(share / package)}}
-    for name, attrs in classes.items():
-        module = types.ModuleType(name)
-        module.__dict__.update(attrs)
-        monkeypatch.setitem(sys.modules, name, module)
-
-
-class Context:
-    """launch's LaunchContext as the bundle reads it: the arguments' values and whether it is shutting down."""
-
-    def __init__(self, configs):
-        self.launch_configurations = dict(configs)
-        self.is_shutdown = False
-
-
-def launch_run(description, configs: dict):
-    """What launch does with the description: arguments get their defaults, then the entities in order:
-    an OpaqueFunction runs (an exception stops the launch there), a process starts if its condition holds.
-    Returns (context, [(action, its command as strings)])."""
-    context = Context({})
-    for entity in description.args[0]:
-        if type(entity).__name__ == "DeclareLaunchArgument":
-            context.launch_configurations.setdefault(entity.args[0], entity.kwargs["default_value"])
-    context.launch_configurations.update(configs)
-    started = []
-    for entity in description.args[0]:
-        kind = type(entity).__name__
-        if kind == "OpaqueFunction":
-            entity.kwargs["function"](context)
-        elif kind in ("Node", "ExecuteProcess"):
-            condition = entity.kwargs.get("condition")
-            if condition is None or condition.evaluate(context):
-                cmd = entity.kwargs.get("cmd") or [entity.kwargs["package"], entity.kwargs["executable"],
-                                                   *entity.kwargs.get("arguments", [])]
-                started.append((entity, [perform(a, context) for a in cmd]))
-    return context, started
-
-
-@pytest.fixture
-def description(folder, world, tmp_path, monkeypatch):
-    share = tmp_path / "share"
-    (share / "nav2_bringup" / "params").mkdir(parents=True)
-    (share / "nav2_bringup" / "params" / "nav2_params.yaml").write_text(yaml.safe_dump(
-        {"amcl": {"ros__parameters": {"use_sim_time": False, "max_particles": 2000}},
-         "controller_server": {"ros__parameters": {"use_sim_time": False, "controller_frequency": 20.0}}}))
-    fake_launch_api(monkeypatch, share)
-    monkeypatch.setenv("ROS_DISTRO", "jazzy")
-    (tmp_path / "robot.urdf").write_text("<robot name='r'/>")
-    launch = load(folder / "ros2" / "launch" / f"{ros2.ros_name(world.world_id)}.launch.py", "runs_launch")
-    return launch, launch.generate_launch_description()
-
-
-def _configs(tmp_path, **more):
-    return {"robot": str(tmp_path / "robot.urdf"), "task": "task_1", "run": "2", "seed": "5",
-            "out": str(tmp_path / "bags"), **more}
-
+from support.launch_standins import SLOW_ROS2, closed_bag, configs, counts, launch_run, loop, perform, process_exited
 
 # -- the launch file -------------------------------------------------------------
 
@@ -147,12 +28,12 @@ def test_every_process_is_an_action_of_the_description(description):
     kinds = [type(e).__name__ for e in described.args[0]]
     assert kinds.count("Node") == 4 and kinds.count("ExecuteProcess") == 3 and kinds.count("OpaqueFunction") == 1
     assert kinds.index("OpaqueFunction") < min(kinds.index("Node"), kinds.index("ExecuteProcess"))  # checks first
-    assert kinds.count("IncludeLaunchDescription") == 1 and kinds.count("RegisterEventHandler") == 4
+    assert kinds.count("IncludeLaunchDescription") == 1 and kinds.count("RegisterEventHandler") == 2
 
 
 def test_a_run_starts_what_it_should(world, folder, description, tmp_path):
     _, described = description
-    context, started = launch_run(described, _configs(tmp_path, robot_state_publisher="true"))
+    context, started = launch_run(described, configs(tmp_path, robot_state_publisher="true"))
     commands = {e.kwargs.get("name") or e.kwargs.get("executable"): cmd for e, cmd in started}
     assert set(commands) == {"gazebo", "create", "robot_state_publisher", "parameter_bridge", "record", "send_goal"}
     gazebo = next(e for e, _ in started if e.kwargs.get("name") == "gazebo")
@@ -184,7 +65,7 @@ def test_a_run_starts_what_it_should(world, folder, description, tmp_path):
 
 def test_a_robot_from_a_topic_is_spawned_from_it(description, tmp_path):
     _, described = description
-    _, started = launch_run(described, _configs(tmp_path, robot="", robot_topic="/robot_description"))
+    _, started = launch_run(described, configs(tmp_path, robot="", robot_topic="/robot_description"))
     [create] = [cmd for e, cmd in started if e.kwargs.get("executable") == "create"]
     assert create[create.index("-topic") + 1] == "/robot_description" and "-file" not in create
 
@@ -206,7 +87,7 @@ def test_a_robot_from_a_topic_is_spawned_from_it(description, tmp_path):
 def test_a_bad_argument_stops_the_launch_before_anything_is_written(description, tmp_path, bad, message):
     _, described = description
     with pytest.raises(ValueError) as caught:
-        launch_run(described, _configs(tmp_path, **bad))
+        launch_run(described, configs(tmp_path, **bad))
     assert str(caught.value).startswith(message)
     assert not (tmp_path / "bags").exists()
 
@@ -217,27 +98,22 @@ def test_a_recorded_run_is_never_overwritten(description, tmp_path, world):
     bags.mkdir()
     (bags / f"{world.folder_name}__task_1__run2.result.yaml").write_text("outcome: succeeded\n")
     with pytest.raises(ValueError, match="recorded already"):
-        launch_run(described, _configs(tmp_path))
+        launch_run(described, configs(tmp_path))
     assert sorted(p.name for p in bags.iterdir()) == [f"{world.folder_name}__task_1__run2.result.yaml"]
 
 
-def _handler(described, target):
-    for entity in described.args[0]:
-        if type(entity).__name__ == "RegisterEventHandler":
-            handler = entity.args[0]
-            if handler.kwargs["target_action"].kwargs.get("name", "") == target or (
-                    handler.kwargs["target_action"].kwargs.get("executable") == target):
-                yield handler.kwargs["on_exit"]
+def _action(described, name):
+    """The description's process ``name`` (an ExecuteProcess's name or a Node's executable)."""
+    return next(e for e in described.args[0] if name in (e.kwargs.get("name"), e.kwargs.get("executable")))
 
 
 def test_a_run_that_ends_without_an_answer_is_recorded(world, description, tmp_path):
     """launch returned 0 when the goal sender crashed, the robot failed to spawn or the wall clock ran
     out; the result file now says what happened, and the first answer stays."""
     _, described = description
-    context, _ = launch_run(described, _configs(tmp_path))
+    context, _ = launch_run(described, configs(tmp_path))
     result = tmp_path / "bags" / f"{world.folder_name}__task_1__run2.result.yaml"
-    [on_goal] = _handler(described, "send_goal")
-    actions = on_goal(types.SimpleNamespace(returncode=-11), context)
+    actions = process_exited(described, context, _action(described, "send_goal"), -11)
     assert [type(a).__name__ for a in actions] == ["Shutdown"]
     record = yaml.safe_load(result.read_text())
     assert (record["outcome"], record["reason"], record["task"], record["run"]) == (
@@ -250,79 +126,28 @@ def test_a_run_that_ends_without_an_answer_is_recorded(world, description, tmp_p
     assert yaml.safe_load(result.read_text())["reason"] == (
         f"wall-clock limit of {10 * world.metadata['tasks'][1]['time_limit'] + 120:g} s reached")
     result.unlink()
-    spawns = list(_handler(described, "create"))
-    assert len(spawns) == 2 and spawns[0](types.SimpleNamespace(returncode=0), context) == [] and not result.exists()
-    assert [type(a).__name__ for a in spawns[0](types.SimpleNamespace(returncode=1), context)] == ["Shutdown"]
+    spawns = [e for e in described.args[0] if e.kwargs.get("executable") == "create"]
+    assert len(spawns) == 2 and process_exited(described, context, spawns[0], 0) == [] and not result.exists()
+    assert [type(a).__name__ for a in process_exited(described, context, spawns[1], 1)] == ["Shutdown"]
     assert yaml.safe_load(result.read_text())["reason"] == "ros_gz_sim create exited with 1"
     result.unlink()
-    [on_gazebo] = _handler(described, "gazebo")
+    gazebo = _action(described, "gazebo")
     context.is_shutdown = True  # Gazebo stopping because the run is shutting down is no crash
-    on_gazebo(types.SimpleNamespace(returncode=0), context)
-    assert not result.exists()
+    assert process_exited(described, context, gazebo, 0) == [] and not result.exists()
     context.is_shutdown = False
-    on_gazebo(types.SimpleNamespace(returncode=134), context)
+    process_exited(described, context, gazebo, 134)
     assert yaml.safe_load(result.read_text())["reason"] == "Gazebo exited with 134"
     assert sorted(p.name for p in result.parent.iterdir() if ".tmp" in p.name) == []
 
 
 # -- the loop ------------------------------------------------------------------
 
-#: A stand-in for `ros2 launch`: reads its arguments as the launch file would, then does what the
-#: scenario file says for this run's next attempt (JSON: {"<task>/<run>": ["good" | "crash" | "silent" |
-#: "timeout", ...]}), and counts its launches. "crash": the bag begun, a crashed result, exit 0 (launch's
-#: status after a crash); "silent": exit 1 with no result; "timeout": a timed_out result.
-FAKE_ROS2 = r'''#!{python}
-import json, os, sys
-args = dict(a.split(':=', 1) for a in sys.argv[3:])
-scenario = json.load(open(os.environ['FAKE_SCENARIO']))
-counts_path = os.environ['FAKE_SCENARIO'] + '.counts'
-counts = json.load(open(counts_path)) if os.path.exists(counts_path) else {{}}
-key = args['task'] + '/' + args['run']
-attempt = counts.get(key, 0)
-counts[key] = attempt + 1
-json.dump(counts, open(counts_path, 'w'))
-plan = scenario.get(key, ['good'])
-what = plan[min(attempt, len(plan) - 1)]
-folder = os.path.basename(os.path.dirname(os.path.dirname(os.path.dirname(sys.argv[2]))))
-bag = os.path.join(args['out'], folder + '__' + args['task'] + '__run' + args['run'])
-os.makedirs(args['out'], exist_ok=True)
-if what == 'silent':
-    sys.exit(1)
-os.makedirs(bag)
-outcome = {{'good': 'succeeded', 'crash': 'crashed', 'timeout': 'timed_out'}}[what]
-with open(bag + '.result.yaml', 'w') as fh:
-    fh.write('outcome: ' + outcome + '\nreason: ' + what + '\n')
-'''
-
-
-@pytest.fixture
-def fake_ros2(tmp_path, monkeypatch):
-    bin_dir = tmp_path / "bin"
-    bin_dir.mkdir()
-    (bin_dir / "ros2").write_text(FAKE_ROS2.format(python=sys.executable))
-    (bin_dir / "ros2").chmod(0o755)
-    scenario = tmp_path / "scenario.json"
-    env = {**os.environ, "PATH": f"{bin_dir}{os.pathsep}{os.environ['PATH']}", "FAKE_SCENARIO": str(scenario)}
-    return scenario, env
-
-
-def _loop(folder, tmp_path, env, *more):
-    (tmp_path / "robot.urdf").write_text("<robot name='r'/>")
-    return subprocess.run([sys.executable, str(folder / "ros2" / "run_loop.py"), "--runs", "4", "--robot",
-                           str(tmp_path / "robot.urdf"), "--out", str(tmp_path / "bags"), *more, str(folder)],
-                          capture_output=True, text=True, timeout=120, env=env)
-
-
-def _counts(scenario):
-    return yaml.safe_load(Path(str(scenario) + ".counts").read_text())
-
-
 def test_the_loop_retries_crashed_and_timed_out_runs_then_sets_them_aside(world, folder, tmp_path, fake_ros2):
     scenario, env = fake_ros2
     scenario.write_text('{"task_0/1": ["crash", "good"], "task_0/2": ["timeout"], "task_0/3": ["silent", "good"]}')
-    done = _loop(folder, tmp_path, env, "--retries", "2")
+    done = loop(folder, tmp_path, env, "--retries", "2")
     assert done.returncode == 1, done.stdout + done.stderr  # one run set aside
-    assert _counts(scenario) == {"task_0/0": 1, "task_0/1": 2, "task_0/2": 3, "task_0/3": 2}
+    assert counts(scenario) == {"task_0/0": 1, "task_0/1": 2, "task_0/2": 3, "task_0/3": 2}
     assert "4 runs: 3 done, 1 set aside" in done.stdout
     assert "crashed (crash), attempt 1 of 3" in done.stdout and "timed_out (timeout), attempt 3 of 3" in done.stdout
     bags = tmp_path / "bags"
@@ -336,11 +161,12 @@ def test_the_loop_retries_crashed_and_timed_out_runs_then_sets_them_aside(world,
     assert not (bags / f"{name}2").exists()  # no bag of a set-aside run where `worldgen judge bags/*/` looks
     silent = yaml.safe_load((bags / ".attempts" / f"{name}3.attempt0" / f"{name}3.result.yaml").read_text())
     assert silent == {"outcome": "crashed", "reason": "ros2 launch exited with 1 and no result file",
-                      "written_by": "run_loop.py"}
+                      "written_by": "run_loop.py", "world_dir": str(folder), "world_id": world.world_id,
+                      "task": "task_0", "run": 3, "seed": 3}
     assert (bags / ".attempts" / f"{name}1.attempt0" / f"{name}1").is_dir()  # the crashed attempt's bag, kept
 
-    again = _loop(folder, tmp_path, env, "--retries", "2")  # resume: nothing runs again
-    assert again.returncode == 1 and _counts(scenario) == {"task_0/0": 1, "task_0/1": 2, "task_0/2": 3, "task_0/3": 2}
+    again = loop(folder, tmp_path, env, "--retries", "2")  # resume: nothing runs again
+    assert again.returncode == 1 and counts(scenario) == {"task_0/0": 1, "task_0/1": 2, "task_0/2": 3, "task_0/3": 2}
     assert again.stdout.count("skip ") == 4 and "set aside already" in again.stdout
 
 
@@ -350,11 +176,14 @@ def test_an_interrupted_run_is_run_again_on_resume(world, folder, tmp_path, fake
     bags = tmp_path / "bags"
     name = f"{world.folder_name}__task_0__run"
     (bags / f"{name}0").mkdir(parents=True)  # the loop was stopped mid-run: a bag, no result
-    (bags / f"{name}1.result.yaml").write_text("outcome: failed\n")  # nav2's answer: done
-    done = _loop(folder, tmp_path, env)
+    closed_bag(bags / f"{name}1")
+    (bags / f"{name}1.result.yaml").write_text("outcome: failed\n")  # nav2's answer over a bag: done
+    done = loop(folder, tmp_path, env)
     assert done.returncode == 0, done.stdout + done.stderr
-    assert _counts(scenario) == {"task_0/0": 1, "task_0/2": 1, "task_0/3": 1}
-    assert (bags / ".attempts" / f"{name}0.attempt0" / f"{name}0").is_dir()
+    assert counts(scenario) == {"task_0/0": 1, "task_0/2": 1, "task_0/3": 1}
+    # The loop itself was stopped: no attempt of the run's, so it is kept as an interrupted one.
+    assert (bags / ".attempts" / f"{name}0.interrupted0" / f"{name}0").is_dir()
+    assert not list((bags / ".attempts").glob("*.attempt*"))
     assert yaml.safe_load((bags / f"{name}0.result.yaml").read_text())["outcome"] == "succeeded"
 
 
@@ -385,30 +214,16 @@ def test_the_loop_checks_its_arguments_before_writing(folder, tmp_path, args, me
 
 def test_the_bundles_own_robot_is_spawned_unless_the_run_names_another(folder, description, tmp_path):
     _, described = description
-    context, started = launch_run(described, _configs(tmp_path, robot=""))
+    context, started = launch_run(described, configs(tmp_path, robot=""))
     create = next(cmd for e, cmd in started if e.kwargs.get("executable") == "create")
     assert create[create.index("-file") + 1] == str(folder / "ros2" / "robot.sdf")
     state = next(e for e, _ in started if e.kwargs.get("executable") == "robot_state_publisher")
     urdf = perform(state.kwargs["parameters"][0]["robot_description"].value, context)
     assert urdf == (folder / "ros2" / "robot.urdf").read_text()
     (tmp_path / "mine.sdf").write_text("<sdf version='1.9'/>")
-    _, started = launch_run(described, _configs(tmp_path, robot=str(tmp_path / "mine.sdf")))
+    _, started = launch_run(described, configs(tmp_path, robot=str(tmp_path / "mine.sdf")))
     kinds = [e.kwargs.get("executable") for e, _ in started]
     assert "robot_state_publisher" not in kinds  # auto: a robot of the user's own, no URDF named
-
-
-#: A `ros2 launch` stand-in that, on SIGINT, takes a while to stop what it started (launch's escalation
-#: takes up to 10 s) and notes that it finished its shutdown.
-SLOW_ROS2 = r'''#!{python}
-import os, signal, sys, time
-def stop(signum, frame):
-    time.sleep(1.0)  # stopping Gazebo, nav2, the recorder
-    open(os.environ['FAKE_SCENARIO'] + '.stopped', 'w').write('clean')
-    sys.exit(0)
-signal.signal(signal.SIGINT, stop)
-open(os.environ['FAKE_SCENARIO'] + '.started', 'w').write('')
-time.sleep(60)
-'''
 
 
 def test_an_interrupted_loop_lets_launch_stop_what_it_started(folder, tmp_path, fake_ros2):
@@ -418,14 +233,14 @@ def test_an_interrupted_loop_lets_launch_stop_what_it_started(folder, tmp_path, 
     scenario, env = fake_ros2
     (tmp_path / "bin" / "ros2").write_text(SLOW_ROS2.format(python=sys.executable))
     (tmp_path / "robot.urdf").write_text("<robot name='r'/>")
-    loop = subprocess.Popen([sys.executable, str(folder / "ros2" / "run_loop.py"), "--out", str(tmp_path / "bags"),
+    looping = subprocess.Popen([sys.executable, str(folder / "ros2" / "run_loop.py"), "--out", str(tmp_path / "bags"),
                              str(folder)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 30
     while not Path(str(scenario) + ".started").exists() and time.monotonic() < deadline:
         time.sleep(0.05)
-    loop.send_signal(signal.SIGINT)  # only the loop, as `kill -INT`; a terminal's Ctrl-C reaches both
-    _, err = loop.communicate(timeout=30)
-    assert loop.returncode == 130 and "run the same command again to resume" in err
+    looping.send_signal(signal.SIGINT)  # only the loop, as `kill -INT`; a terminal's Ctrl-C reaches both
+    _, err = looping.communicate(timeout=30)
+    assert looping.returncode == 130 and "run the same command again to resume" in err
     assert Path(str(scenario) + ".stopped").read_text() == "clean"  # launch finished its own shutdown
 
 
@@ -440,15 +255,14 @@ def test_without_the_goal_a_run_starts_the_simulation_and_nav2_only(world, descr
     bags.mkdir()
     earlier = bags / f"{world.folder_name}__task_1__run2.result.yaml"
     earlier.write_text("outcome: succeeded\n")
-    context, started = launch_run(described, _configs(tmp_path, goal="false", robot_state_publisher="true"))
+    context, started = launch_run(described, configs(tmp_path, goal="false", robot_state_publisher="true"))
     names = {e.kwargs.get("name") or e.kwargs.get("executable") for e, _ in started}
     assert names == {"gazebo", "create", "robot_state_publisher", "parameter_bridge"}
     assert (bags / f"{world.folder_name}__task_1__run2.nav2_params.yaml").exists()
-    [on_gazebo] = _handler(described, "gazebo")
+    gazebo = next(e for e, _ in started if e.kwargs.get("name") == "gazebo")
     earlier.unlink()
-    on_gazebo(types.SimpleNamespace(returncode=134), context)
-    timer = next(e for e in described.args[0] if type(e).__name__ == "TimerAction")
-    timer.kwargs["actions"][0].kwargs["function"](context)
+    ended = process_exited(described, context, gazebo, 134, "gazebo-1")  # a crash ends the run: the driver records it
+    assert any(type(e).__name__ == "Shutdown" for e in ended), ended
     assert not earlier.exists()
     with pytest.raises(ValueError, match="goal must be true or false, got 'no'"):
-        launch_run(described, _configs(tmp_path, goal="no"))
+        launch_run(described, configs(tmp_path, goal="no"))

@@ -8,7 +8,9 @@
   (hand-built scenes that use every feature), ``exact_reference`` (an independent exact planner),
   ``cli`` (running the command), ``checks`` (geometric re-checks of a world), ``fuzzing``; for campaigns,
   ``planted`` (a policy with a planted weakness), ``bag_command`` and ``stand_in_ros2`` (stand-in robot stacks
-  that leave bags).
+  that leave bags); for the ROS 2 bundle, ``bundle`` (its world, loading its scripts) and
+  ``launch_standins`` (ROS's launch API, launch's handling of a description and of a process's exit,
+  `ros2 launch` processes).
 """
 
 from __future__ import annotations

@@ -7,7 +7,8 @@ Opt-in (``worldgen generate --ros``, ``World.write(..., ros=True)``, ``ros: true
 ``ros2/bridge.yaml``               ros_gz_bridge ``config_file``: /clock, the ground-truth pose, contacts,
                                    /cmd_vel, /odom, /tf, /scan (keys and directions as the bridge documents)
 ``ros2/nav2/<task>.yaml``          nav2 parameter overrides per task: the map, AMCL's initial pose at the
-                                   task's spawn, the footprint radius, ``use_sim_time`` for every node
+                                   task's spawn, the footprint radius, the goal checker's tolerance, the
+                                   planner's map where doors start shut, ``use_sim_time`` for every node
 ``ros2/tasks.yaml``                every task: spawn, goal pose in the map frame, tolerance, time limit
 ``ros2/launch/<name>.launch.py``   one run: Gazebo headless, spawn, bridge, nav2, ``ros2 bag record``, the
                                    goal once nav2 is active, shutdown on the result or the time limit
@@ -33,8 +34,9 @@ from worldgen.errors import ParameterError
 from worldgen.export.contract import BRIDGED, DEFAULT_GZ_RELEASE, GZ_RELEASES, RECORDED, release
 from worldgen.export.robot import DEFAULT_NAME as DEFAULT_ROBOT_NAME
 
-__all__ = ["BUNDLE_DIR", "ROBOT_SDF", "ROBOT_URDF", "DEFAULT_ROBOT_NAME", "ros_name", "release_of", "plugins",
-           "with_plugins", "bridge_config", "nav2_map", "nav2_overrides", "tasks_spec", "bundle", "dumps"]
+__all__ = ["BUNDLE_DIR", "GOAL_CHECKER", "PLANNER_MAP_TOPIC", "ROBOT_SDF", "ROBOT_URDF", "DEFAULT_ROBOT_NAME",
+           "ros_name", "release_of", "plugins",
+           "with_plugins", "bridge_config", "nav2_map", "planner_map", "nav2_overrides", "tasks_spec", "bundle", "dumps"]
 
 BUNDLE_DIR = "ros2"
 #: The shipped robot's files in the bundle (worldgen.export.robot).
@@ -50,6 +52,12 @@ _NAV2_NODES = ("amcl", "bt_navigator", "controller_server", "planner_server", "s
                "velocity_smoother", "waypoint_follower", "collision_monitor", "map_server",
                "lifecycle_manager_localization", "lifecycle_manager_navigation")
 _NAME_RE = re.compile(r"[^A-Za-z0-9_]+")
+#: The goal checker nav2_bringup's params file names (nav2 1.3.13 ``goal_checker_plugins``); the launch
+#: file also caps every other checker a params file names at the task's tolerance.
+GOAL_CHECKER = "general_goal_checker"
+#: Where the planner's map is published when it is not map_server's (absolute: the costmap resolves it
+#: in no namespace of its own).
+PLANNER_MAP_TOPIC = "/planner_map"
 
 
 def ros_name(text: str) -> str:
@@ -136,10 +144,29 @@ def nav2_overrides(world, task) -> dict[str, Any]:
     out["amcl"]["ros__parameters"].update({"set_initial_pose": True, "initial_pose": _spawn(task),
                                            "global_frame_id": "map"})
     out["map_server"]["ros__parameters"]["yaml_filename"] = nav2_map(world)
+    # nav2's SimpleGoalChecker counts a goal reached within xy_goal_tolerance (0.25 m in nav2 1.3.13's
+    # nav2_params.yaml); above the task's tolerance nav2's `succeeded` could be a judged miss.
+    out["controller_server"]["ros__parameters"][GOAL_CHECKER] = {"xy_goal_tolerance": round_float(task.goal_tolerance)}
     radius = round_float(world.robot.radius)
     for costmap in ("local_costmap", "global_costmap"):
         out[costmap] = {costmap: {"ros__parameters": {"use_sim_time": True, "robot_radius": radius}}}
+    if planner_map(world):
+        # The planner plans in the scene with every leaf open (the doors the robot may open); AMCL keeps
+        # map_server's map of the scene as it starts. Both the costmap's and the static layer's own
+        # map_topic: a static layer's own one wins where a params file sets it.
+        block = out["global_costmap"]["global_costmap"]["ros__parameters"]
+        block.update({"map_topic": PLANNER_MAP_TOPIC, "static_layer": {"map_topic": PLANNER_MAP_TOPIC}})
     return out
+
+
+def planner_map(world) -> Optional[str]:
+    """The map the global costmap plans in when it differs from :func:`nav2_map`: the world's map.yaml
+    (every door leaf at its open limit) where a leaf starts closed or ajar, published by a map server of
+    the planner's own on :data:`PLANNER_MAP_TOPIC`; None elsewhere (one map serves both)."""
+    from worldgen.files import MAP_YAML_NAME
+    from worldgen.groundtruth.truth import doors_start_shut
+
+    return MAP_YAML_NAME if doors_start_shut(world) else None
 
 
 def tasks_spec(world) -> dict[str, Any]:
@@ -208,6 +235,8 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
         sdf_file = f"{BUNDLE_DIR}/{SDF_NAME}"
     values = {"WORLD_ID": world.world_id, "WORLD_NAME": world.world_id, "ROS_NAME": name,
               "FOLDER": folder_name or world.folder_name, "SDF": sdf_file, "ROBOT": robot, "MAP": nav2_map(world),
+              "PLANNER_MAP": planner_map(world) or "", "PLANNER_MAP_TOPIC": PLANNER_MAP_TOPIC,
+              "GOAL_CHECKER": GOAL_CHECKER,
               "ROBOT_SDF": ROBOT_SDF, "ROBOT_URDF": ROBOT_URDF,
               "GZ_COMMAND": repr(row.server), "GZ_SEED": repr(row.seed), "GZ_PLUGIN_PATH": row.plugin_path_var,
               "FIRST_TASK": world.tasks[0].id, "TOPICS": repr(tuple(t.name for t in RECORDED))}
