@@ -17,8 +17,9 @@ after it may import them.
 Gazebo releases (gz-sim's and ign-gazebo's ``server.config`` for the plugin names, their ``cmdsim.rb``
 for the command line): Fortress (ROS 2 Humble's pair) keeps the ignition names; Garden and later use
 the gz ones. :data:`DEFAULT_GZ_RELEASE` is what a bundle and a robot are written for unless told
-otherwise; :data:`SIM_GZ_RELEASE` is the release ``worldgen.sim`` runs, the one installed where the
-Gazebo tests run and the one the C++ drive bridge is compiled against.
+otherwise; :data:`SIM_GZ_RELEASES` are the releases ``worldgen.sim`` runs and the Gazebo tests run in
+(:data:`SIM_GZ_RELEASE`, the first, unless told otherwise); the C++ drive bridge is compiled against the
+transport of the one it runs.
 
 The ground truth is ``nav_msgs/msg/Odometry`` on ``/ground_truth``: the robot's OdometryPublisher
 publishes the model's world pose (= the map frame's) both as ``Odometry`` on ``ground_truth/odom`` and as

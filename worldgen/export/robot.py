@@ -51,8 +51,11 @@ __all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "Dimensions",
 DEFAULT_NAME = "robot"
 #: The element Gazebo's sensors take their message frame from. Without it a scan's frame is the scoped
 #: sensor name (``robot::base_scan::lidar``, measured in Fortress 6.18), a frame no URDF has, and AMCL and
-#: the costmaps drop the scans. ``gz_frame_id`` is read by Fortress 6.18's ign-sensors and by gz-sensors 8
-#: (Harmonic); it is a Gazebo extension, not SDFormat, so a strict libsdformat check flags it.
+#: the costmaps drop the scans. ``gz_frame_id`` is read by Fortress 6.18's ign-sensors (beside its older
+#: ``ignition_frame_id``) and is the only element gz-sensors 8 (Harmonic) reads (measured in 8.14: without it
+#: the scan's frame is the scoped name): one element serves every release. It is a Gazebo extension, not
+#: SDFormat, so a strict libsdformat check flags it and sdformat 14 warns about it on every spawn (the
+#: Gazebo harness knows that warning: worldgen.sim.gazebo_log.SENSOR_FRAME_NOTE).
 SENSOR_FRAME_ELEMENT = "gz_frame_id"
 #: Half-height (m) of the gap the chassis' visual leaves around the lidar's plane: what a gpu_lidar
 #: renders is visuals, and SDFormat 1.9 has no visibility mask for a lidar, so the window keeps the
