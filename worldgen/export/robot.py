@@ -44,7 +44,7 @@ from worldgen.export.contract import CMD_VEL, DEFAULT_GZ_RELEASE, GROUND_TRUTH, 
 from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
 
-__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "Dimensions", "dimensions", "robot_sdf",
+__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "WHEEL_ACCELERATION", "Dimensions", "dimensions", "robot_sdf",
            "robot_urdf"]
 
 #: The model's name: the ROS 2 bundle's robot (worldgen.export.ros2.DEFAULT_ROBOT_NAME).
@@ -62,6 +62,12 @@ SENSOR_FRAME_ELEMENT = "gz_frame_id"
 #: robot out of its own scan (the collision cylinder is whole).
 LIDAR_WINDOW = 0.01
 _CHASSIS_KG, _WHEEL_KG, _CASTER_KG = 10.0, 0.5, 0.2
+#: m/s^2: the DiffDrive's limit on the wheels' acceleration and braking (nav2's controllers' default
+#: ``acc_lim_x`` / ``decel_lim_x``). Without a limit a twist sets the wheels' speed in one step; the tyres
+#: (mu 1) then give the body about 6.5 m/s^2 (measured in Fortress 6.18 and Harmonic 8.14 alike), so the
+#: wheels spin on a start and the body slides on after a stop by v^2 / 13 m: 0.31 m from 2 m/s, the 0.22 m
+#: issue 39 saw after a stop. Below the tyres' grip the body follows its wheels.
+WHEEL_ACCELERATION = 2.5
 _COLOUR = "0.95 0.45 0.1 1"
 
 
@@ -230,6 +236,11 @@ def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: fl
                        ("odom_publish_frequency", fmt(odom_rate)), ("topic", CMD_VEL.gz_name), ("odom_topic", ODOM.gz_name),
                        ("tf_topic", TF.gz_name), ("frame_id", "odom"), ("child_frame_id", "base_footprint")):
         sub(drive, key, value)
+    # The same tyre acceleration for a turn: a wheel's rim moves at the turn rate times half the separation.
+    turn = WHEEL_ACCELERATION / (d.wheel_separation / 2.0)
+    for key, value in (("max_linear_acceleration", WHEEL_ACCELERATION), ("min_linear_acceleration", -WHEEL_ACCELERATION),
+                       ("max_angular_acceleration", turn), ("min_angular_acceleration", -turn)):
+        sub(drive, key, fmt(value))
     filename, cls = row.plugin("odometry-publisher", "OdometryPublisher")
     truth = sub(model, "plugin", filename=filename, name=cls)
     for key, value in (("odom_frame", "map"), ("robot_base_frame", "base_footprint"),
