@@ -238,9 +238,9 @@ def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: fl
         sub(drive, key, value)
     # The same tyre acceleration for a turn: a wheel's rim moves at the turn rate times half the separation.
     turn = WHEEL_ACCELERATION / (d.wheel_separation / 2.0)
-    for key, value in (("max_linear_acceleration", WHEEL_ACCELERATION), ("min_linear_acceleration", -WHEEL_ACCELERATION),
-                       ("max_angular_acceleration", turn), ("min_angular_acceleration", -turn)):
-        sub(drive, key, fmt(value))
+    for limit, rate in (("max_linear_acceleration", WHEEL_ACCELERATION), ("min_linear_acceleration", -WHEEL_ACCELERATION),
+                        ("max_angular_acceleration", turn), ("min_angular_acceleration", -turn)):
+        sub(drive, limit, fmt(rate))
     filename, cls = row.plugin("odometry-publisher", "OdometryPublisher")
     truth = sub(model, "plugin", filename=filename, name=cls)
     for key, value in (("odom_frame", "map"), ("robot_base_frame", "base_footprint"),
