@@ -67,9 +67,13 @@ def _exports(setup: Path, base: dict[str, str]) -> dict[str, str]:
 
 
 def _base_env() -> dict[str, str]:
-    """The caller's environment without any release's config or plugin paths: ``gz`` reads ``IGN_CONFIG_PATH``
-    too and stops at a Fortress yaml it finds there (measured: "contains a command already registered")."""
-    return {k: v for k, v in os.environ.items() if not k.startswith(("IGN_", "GZ_", "IGNITION_"))}
+    """The caller's environment without any release's tool config, plugin paths, partition or discovery ports
+    (a shell that sourced another release's setup holds them): ``gz`` reads ``IGN_CONFIG_PATH`` too and stops
+    at a Fortress yaml it finds there (measured: "contains a command already registered"). Resource paths
+    (models a user keeps) stay."""
+    owned = {v for r in GZ_RELEASES.values() for v in (r.plugin_path_var, r.partition_var, *r.discovery_vars)}
+    return {k: v for k, v in os.environ.items()
+            if k not in owned and not k.endswith(("_CONFIG_PATH", "_PHYSICS_ENGINE_PATH", "_RENDERING_PLUGIN_PATH"))}
 
 
 def _version(setup: Path, env: dict[str, str]) -> tuple[str, str]:
