@@ -126,6 +126,9 @@ def test_a_fortress_and_a_harmonic_server_at_once_each_answer_in_plain_text(inst
                 text = a._ign(["service", "-s", f"/world/{a.world}/scene/info", "--reqtype", old.release.msg("Empty"),
                                "--reptype", old.release.msg("Scene"), "--timeout", "5000", "--req", ""], 10, noise)
                 assert text.lstrip().startswith("ambient"), text[:100]
+            # A call that waits 3 s for a service nobody offers hears several listings (one in about 2 s here).
+            a._ign(["service", "-s", "/worldgen/nobody", "--reqtype", old.release.msg("Empty"), "--reptype",
+                    old.release.msg("Empty"), "--timeout", "3000", "--req", ""], 10, noise)
         finally:
             for lister in listers:
                 stop_group(lister, grace=0.5)
