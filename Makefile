@@ -53,8 +53,8 @@ test: $(TEST_STAMP)
 	$(PY) -m pytest -q
 
 ## test-gazebo: only the tests that run a real Gazebo server (every kind of world loaded and stepped, tests/sim;
-## marker `gazebo`; also part of `make test`); Gazebo from WORLDGEN_GAZEBO_SETUP or /opt/gz-fortress2
-## (docs/gazebo.md)
+## marker `gazebo`; also part of `make test`); Fortress from WORLDGEN_GAZEBO_SETUP or /opt/gz-fortress2,
+## Harmonic from /opt/gz-harmonic (a sample; WORLDGEN_GAZEBO_ALL=1 for every case) (docs/gazebo.md)
 test-gazebo: $(TEST_STAMP)
 	$(PY) -m pytest -q -m gazebo tests
 

@@ -788,3 +788,53 @@ def test_the_campaign_package_loads_its_modules_on_first_use():
     code = ("import sys, worldgen.campaign as c; assert not [m for m in sys.modules if m.startswith('worldgen.campaign.')"
             " or m == 'optuna'], sorted(sys.modules); c.run; assert 'worldgen.campaign.runner' in sys.modules")
     subprocess.run([sys.executable, "-c", code], check=True, cwd=PACKAGE.parent)
+
+
+# -- Gazebo releases: tools, messages and variables --
+
+
+def release_spellings() -> tuple[dict[str, str], tuple[str, ...]]:
+    """(exact strings -> what they are, message-package prefixes) that a release's row owns: its command-line
+    tool, its partition, plugin-path and discovery variables, and its message package (``gz.msgs.``)."""
+    from worldgen.export import contract
+
+    exact: dict[str, str] = {}
+    for row in contract.GZ_RELEASES.values():
+        exact.update({row.cli: "a release's tool", row.partition_var: "a partition variable",
+                      row.plugin_path_var: "a plugin-path variable"})
+        exact.update({v: "a discovery variable" for v in row.discovery_vars})
+    return exact, tuple(sorted({row.msgs + "." for row in contract.GZ_RELEASES.values()}))
+
+
+def release_spelled_outside_the_contract(package: Path) -> list[str]:
+    exact, prefixes = release_spellings()
+    found = []
+    for path in sorted(package.rglob("*.py")):
+        if path == package / "export" / "contract.py" or "templates" in path.relative_to(package).parts:
+            continue
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and \
+                    (node.value in exact or node.value.startswith(prefixes)):
+                what = exact.get(node.value, "a message type")
+                found.append(f"{path.relative_to(package.parent)}:{node.lineno} {node.value!r} ({what})")
+    return found
+
+
+def test_a_releases_tools_messages_and_variables_are_spelled_only_in_the_contract():
+    """The Gazebo harness, the drive bridge and the scan speak the release of the install they run through its
+    contract row (``ign``/``gz``, ``IGN_PARTITION``/``GZ_PARTITION``, ``ignition.msgs``/``gz.msgs``): a literal
+    elsewhere is code that speaks one release only (issue 39 found the harness speaking Fortress alone)."""
+    found = release_spelled_outside_the_contract(PACKAGE)
+    assert not found, "read these from the release's row in worldgen.export.contract:\n" + "\n".join(found)
+
+
+def test_the_release_spelling_check_finds_a_planted_tool_and_message(tmp_path):
+    (tmp_path / "export").mkdir()
+    (tmp_path / "sim").mkdir()
+    (tmp_path / "export" / "contract.py").write_text('CLI = "ign"\n')
+    (tmp_path / "sim" / "gazebo.py").write_text('"""Calls ign with ignition.msgs.Empty."""\n'
+                                                'run(["ign", "service"], "ignition.msgs.Empty", env["GZ_PARTITION"])\n')
+    assert sorted(release_spelled_outside_the_contract(tmp_path)) == sorted([
+        f"{tmp_path.name}/sim/gazebo.py:2 'ign' (a release's tool)",
+        f"{tmp_path.name}/sim/gazebo.py:2 'ignition.msgs.Empty' (a message type)",
+        f"{tmp_path.name}/sim/gazebo.py:2 'GZ_PARTITION' (a partition variable)"])

@@ -1,4 +1,5 @@
-"""The bundle's Gazebo server under launch's shutdown, with the real server (Fortress, ign-gazebo 6).
+"""The bundle's Gazebo server under launch's shutdown, with the real server (Fortress, ign-gazebo 6; the Harmonic
+bundle's in gz-sim 8 too).
 
 The launch file starts Gazebo as an ExecuteProcess with a command list, no shell. On shutdown launch
 signals that one process: SIGINT, SIGTERM after ``sigterm_timeout`` (5 s by default), SIGKILL after
@@ -21,9 +22,10 @@ import time
 from pathlib import Path
 
 import pytest
-from support.gazebo import gazebo_install
+from support.gazebo import gazebo_install, install_cache
 
 import worldgen
+from worldgen.export.contract import SIM_GZ_RELEASES
 from worldgen.export.robot import robot_sdf
 
 pytestmark = pytest.mark.gazebo
@@ -38,10 +40,21 @@ def install():
 
 
 @pytest.fixture(scope="module")
+def installs():
+    return install_cache()
+
+
+@pytest.fixture(scope="module")
 def run_setup(install, tmp_path_factory):
     """A Fortress bundle written; its launch file's Gazebo command and environment."""
+    return _run_setup(install, tmp_path_factory)
+
+
+def _run_setup(install, tmp_path_factory):
+    """A bundle written for the install's release; its launch file's Gazebo command and environment."""
+    rel = install.release
     world = worldgen.generate("cluttered", seed=3, size=[6, 6], n_obstacles=4)
-    folder = world.write(tmp_path_factory.mktemp("gz"), ros="fortress")
+    folder = world.write(tmp_path_factory.mktemp("gz"), ros=rel.name)
     path = next((folder / "ros2" / "launch").glob("*.launch.py"))
     spec = importlib.util.spec_from_file_location("gz_launch", path)
     launch = importlib.util.module_from_spec(spec)
@@ -50,13 +63,13 @@ def run_setup(install, tmp_path_factory):
     # a home of its own: Gazebo writes its config and logs under ~/.ignition (docs/gazebo.md); the logs
     # of this test go there too.
     cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    env = dict(install.env, IGN_PARTITION=f"worldgen-bundle-{os.getpid()}", XDG_CACHE_HOME=cache,
-               HOME=str(tmp_path_factory.mktemp("home")))
+    env = dict(install.env, XDG_CACHE_HOME=cache, HOME=str(tmp_path_factory.mktemp("home")),
+               **{rel.partition_var: f"worldgen-bundle-{os.getpid()}-{rel.name}"})
     env.update(launch.gazebo_env())
     command = launch.gazebo_command(str(folder / launch.SDF), "0")
-    robot = folder / "robot_fortress.sdf"
-    robot.write_text(robot_sdf(world, gz_release="fortress"))
-    return world, command, env, robot
+    robot = folder / f"robot_{rel.name}.sdf"
+    robot.write_text(robot_sdf(world, gz_release=rel.name))
+    return world, command, env, robot, rel
 
 
 def _descendants(pid: int) -> set[int]:
@@ -82,12 +95,12 @@ def _alive(pid: int) -> bool:
     return text[text.rfind(")") + 2:].split()[0] != "Z"
 
 
-def _up(world, env, robot) -> None:
-    """Wait until the world answers, then spawn the robot at the first task's spawn."""
+def _up(world, env, robot, rel) -> None:
+    """Wait until the world answers, then spawn the robot at the first task's spawn (``rel``'s tool and types)."""
     deadline = time.monotonic() + 60
     name = world.world_id
     while time.monotonic() < deadline:
-        listed = subprocess.run(["ign", "service", "-l"], env=env, capture_output=True, text=True, timeout=30).stdout
+        listed = subprocess.run([rel.cli, "service", "-l"], env=env, capture_output=True, text=True, timeout=30).stdout
         if f"/world/{name}/create" in listed:
             break
         time.sleep(0.5)
@@ -95,8 +108,8 @@ def _up(world, env, robot) -> None:
         pytest.fail(f"Gazebo did not offer /world/{name}/create within 60 s")
     spawn = world.tasks[0].spawn
     req = f'sdf_filename: "{robot}", name: "robot", pose: {{position: {{x: {spawn.x}, y: {spawn.y}}}}}'
-    done = subprocess.run(["ign", "service", "-s", f"/world/{name}/create", "--reqtype", "ignition.msgs.EntityFactory",
-                           "--reptype", "ignition.msgs.Boolean", "--timeout", "10000", "--req", req],
+    done = subprocess.run([rel.cli, "service", "-s", f"/world/{name}/create", "--reqtype", rel.msg("EntityFactory"),
+                           "--reptype", rel.msg("Boolean"), "--timeout", "10000", "--req", req],
                           env=env, capture_output=True, text=True, timeout=60)
     assert "data: true" in done.stdout, done.stdout + done.stderr
 
@@ -121,14 +134,15 @@ def _start(args, env, shell=False) -> tuple[subprocess.Popen, Path]:
     return proc, log
 
 
-def test_the_bundles_gazebo_server_stops_with_launch_and_leaves_nothing(run_setup):
+@pytest.mark.parametrize("release", SIM_GZ_RELEASES)
+def test_the_bundles_gazebo_server_stops_with_launch_and_leaves_nothing(release, installs, tmp_path_factory):
     from worldgen.sim.procs import group_members
 
-    world, command, env, robot = run_setup
-    assert command[:2] == ["ign", "gazebo"] and "-s" in command and "-r" in command
+    world, command, env, robot, rel = _run_setup(installs(release), tmp_path_factory)
+    assert tuple(command[:2]) == rel.server and "-s" in command and "-r" in command
     proc, log = _start(command, env)
     try:
-        _up(world, env, robot)
+        _up(world, env, robot, rel)
         seen = _descendants(proc.pid) | {proc.pid}
         ended_on = _stop_as_launch_does(proc)
         time.sleep(0.5)
@@ -145,12 +159,12 @@ def test_through_a_shell_as_ros_gz_sim_starts_it_gazebo_outlives_the_run(run_set
     test ever fails, a shell started the old way would also be fine, and the check above proves little."""
     from worldgen.sim.procs import group_members
 
-    world, command, env, robot = run_setup
+    world, command, env, robot, rel = run_setup
     # gz_sim.launch.py's ExecuteProcess: cmd=['ruby $(which ign) gazebo', gz_args, ...], shell=True
-    line = "ruby $(which ign) gazebo " + " ".join(command[2:])
+    line = f"ruby $(which {rel.server[0]}) {rel.server[1]} " + " ".join(command[2:])
     proc, log = _start(line, env, shell=True)
     try:
-        _up(world, env, robot)
+        _up(world, env, robot, rel)
         _stop_as_launch_does(proc)
         time.sleep(0.5)
         assert group_members(proc.pid), "Gazebo stopped with its shell"

@@ -108,6 +108,8 @@ def test_the_cli_drives_end_to_end_and_repeats_its_bytes(tmp_path, blocked):
     (["--sim", "webots"], "--sim"),
     (["--speed", "0"], "--speed"),
     (["--task", "task_9"], "task_9"),
+    (["--gz-release", "ionic", "--sim", "gazebo"], "--gz-release"),
+    (["--gz-release", "harmonic"], "add --sim gazebo"),
 ])
 def test_mistakes_exit_2_with_one_line(worlds, tmp_path, args, needle):
     result = run_cli("drive", worlds["minimal"], "--out", tmp_path, *args)

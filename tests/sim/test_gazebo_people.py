@@ -12,7 +12,7 @@ import json
 
 import numpy as np
 import pytest
-from support.gazebo import gazebo_install, lidar_robot_sdf, scan_ranges, scan_stamp, seen_centres
+from support.gazebo import install_cache, lidar_robot_sdf, release_cases, scan_ranges, scan_stamp, seen_centres
 
 import worldgen
 from worldgen.presets import generate_preset
@@ -27,8 +27,8 @@ STEP = 0.002  # every world's physics step (s)
 
 
 @pytest.fixture(scope="module")
-def install():
-    return gazebo_install()
+def installs():
+    return install_cache()
 
 
 def worlds():
@@ -40,10 +40,11 @@ def worlds():
     }
 
 
-@pytest.mark.parametrize("name", sorted(worlds()))
-def test_actors_play_world_json_trajectories_as_a_gpu_lidar_sees_them(name, install, tmp_path):
+@pytest.mark.parametrize(("release", "name"), release_cases(sorted(worlds()), {"person_crossing"}))
+def test_actors_play_world_json_trajectories_as_a_gpu_lidar_sees_them(release, name, installs, tmp_path):
+    install = installs(release)
     world = worlds()[name]()
-    folder = world.write(tmp_path, preview=False, ros="fortress")
+    folder = world.write(tmp_path, preview=False, ros=release)
     meta = json.loads((folder / "world.json").read_text())
     lidar = meta["sensors"]["lidar"]
     radii = {m["name"]: m["radius"] for m in meta.get("dynamic_obstacles", []) + meta.get("people", [])}

@@ -119,3 +119,65 @@ def test_a_subscription_keeps_every_complete_message_and_never_a_half_written_on
         proc = sub._proc
     assert proc.poll() is not None and not group_members(proc.pid)  # the subscriber stopped with its block
     assert len(sub.messages()) == 3 and steps == [7] * len(steps)
+
+
+def _fake_install(folder, tool: str, words: str, plugin_var: str):
+    """A setup script whose PATH holds one fake Gazebo tool that prints ``words`` for any arguments."""
+    bin_dir = folder / "bin"
+    bin_dir.mkdir(parents=True)
+    exe = bin_dir / tool
+    exe.write_text(f"#!/bin/sh\necho '{words}'\n")
+    exe.chmod(0o755)
+    setup = folder / "setup.sh"
+    setup.write_text(f"export PATH={bin_dir}:/usr/bin:/bin\nexport {plugin_var}={folder}/plugins\n")
+    return setup
+
+
+@pytest.mark.parametrize(("version", "expected"), [("8.14.0", "harmonic"), ("6.18.0", "fortress")])
+def test_locate_tells_the_release_from_the_servers_version(tmp_path, version, expected):
+    from worldgen.export.contract import release
+
+    row = release(expected)
+    setup = _fake_install(tmp_path, row.cli, f"Library error: x\n{version}", row.plugin_path_var)
+    install = locate(setup)
+    assert (install.version, install.release.name) == (version, expected)
+    assert locate(setup, release=expected).release is install.release
+    other = "fortress" if expected == "harmonic" else "harmonic"
+    with pytest.raises(GazeboMissingError, match=f"not {other}"):
+        locate(setup, release=other)
+
+
+def test_locate_refuses_a_release_it_does_not_run_and_a_version_it_does_not_know(tmp_path):
+    from worldgen.errors import ParameterError
+    from worldgen.export.contract import release
+
+    with pytest.raises(ParameterError, match="'--gz-release' must be one of fortress, harmonic, got 'ionic'"):
+        locate(release="ionic")
+    row = release("harmonic")
+    with pytest.raises(GazeboMissingError, match="Gazebo 3.1.0 is none of the releases"):
+        locate(_fake_install(tmp_path, row.cli, "3.1.0", row.plugin_path_var))
+
+
+def test_a_subscriber_and_a_service_read_the_tools_stdout_only(tmp_path):
+    # What a Fortress tool prints on stderr when a Harmonic one lists topics on its discovery ports must not
+    # land inside the text parsed (issue 39: "not protobuf text at offset 21").
+    import worldgen
+    from worldgen.export.contract import release
+    from worldgen.sim.gazebo import GazeboInstall, GazeboServer
+    from worldgen.sim.topics import Subscription
+
+    noise = "import sys; sys.stderr.write('Unknown message type [8].\\n'); sys.stderr.flush()\n"
+    script = noise + "print('stamp {\\n  sec: 4\\n}\\n', flush=True)\n" + noise + "import time; time.sleep(60)\n"
+    with Subscription("/t", _printer(script), {}, lambda n: None, lambda text: [textproto.parse(m) for m in
+                      textproto.split_messages(text)], SimulatorError) as sub:
+        assert [textproto.first(textproto.first(m, "stamp"), "sec") for m in sub.wait(1, timeout=20)] == [4]
+    row = release("fortress")
+    bin_dir = tmp_path / "bin"
+    bin_dir.mkdir()
+    (bin_dir / row.cli).write_text("#!/bin/sh\necho 'Unknown message type [8].' >&2\necho 'data: true'\n"
+                                   "echo 'Unknown message type [8].' >&2\n")
+    (bin_dir / row.cli).chmod(0o755)
+    folder = worldgen.generate("minimal", seed=0).write(tmp_path / "w", preview=False)
+    env = {"PATH": f"{bin_dir}:/usr/bin:/bin"}
+    server = GazeboServer(folder / "world.sdf", install=GazeboInstall(tmp_path / "setup.sh", env, "6.18.0", row))
+    assert server.service("/x", row.msg("Empty"), row.msg("Boolean"), "") == {"data": ["true"]}

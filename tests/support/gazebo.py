@@ -9,12 +9,14 @@ composed with the leaf link's.
 from __future__ import annotations
 
 import math
+import os
 
 import numpy as np
+import pytest
 
 from support import missing_tool
 
-__all__ = ["gazebo_install", "lidar_robot_sdf", "scan_ranges", "scan_stamp", "fit_circle", "seen_centres",
+__all__ = ["gazebo_install", "install_cache", "every_case", "release_cases", "lidar_robot_sdf", "scan_ranges", "scan_stamp", "fit_circle", "seen_centres",
            "quat_from_rpy", "compose", "world_poses", "pose_errors", "POSITION_TOL", "ANGLE_TOL"]
 
 #: How close Gazebo's poses must be to world.json: 1 mm, and 1 mrad (Gazebo prints 6 significant digits).
@@ -22,14 +24,45 @@ POSITION_TOL = 1e-3
 ANGLE_TOL = 1e-3
 
 
-def gazebo_install():
-    """The Gazebo install the tests use (worldgen.sim.gazebo.locate), or skip (laptop) / fail (CI)."""
+def gazebo_install(release: str | None = None):
+    """The Gazebo install the tests use (worldgen.sim.gazebo.locate; ``release`` one of the contract's
+    SIM_GZ_RELEASES, None for the default install), or skip (laptop) / fail (CI: every release must be there)."""
     from worldgen.sim.gazebo import GazeboMissingError, locate
 
     try:
-        return locate()
+        return locate(release=release)
     except GazeboMissingError as exc:
-        missing_tool(f"Gazebo ({exc})")
+        missing_tool(f"Gazebo {release or ''} ({exc})")
+
+
+def install_cache():
+    """``get(release)``: :func:`gazebo_install` of that release, located once per cache (a module's fixture)."""
+    found: dict = {}
+
+    def get(release: str):
+        if release not in found:
+            found[release] = gazebo_install(release)
+        return found[release]
+
+    return get
+
+
+def every_case() -> bool:
+    """Whether the later releases run every case, not only their sample (``WORLDGEN_GAZEBO_ALL=1``): the suite
+    runs each world in the default release and a sample per generator in the others, to stay in its budget."""
+    return os.environ.get("WORLDGEN_GAZEBO_ALL") == "1"
+
+
+def release_cases(cases: list[str], sample: set[str]) -> list:
+    """``(release, case)`` parameters: every case in the default release; in the others the ``sample`` cases,
+    and the rest too when :func:`every_case` says so (else they are left out of the run, not skipped)."""
+    from worldgen.export.contract import SIM_GZ_RELEASES
+
+    default, *others = SIM_GZ_RELEASES
+    out = [pytest.param(default, c, id=f"{default}-{c}") for c in cases]
+    for rel in others:
+        out += [pytest.param(rel, c, id=f"{rel}-{c}") for c in cases if c in sample or every_case()]
+    return out
 
 
 def quat_from_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:

@@ -12,6 +12,7 @@ from typing import Optional
 import click
 
 from worldgen.cli.context import CONTEXT as _CONTEXT
+from worldgen.export.contract import SIM_GZ_RELEASE, SIM_GZ_RELEASES
 
 __all__ = ["drive_command"]
 
@@ -24,11 +25,15 @@ _FOLLOWED = {"timed_path": "timed path", "movers": "schedule among the movers al
 @click.command("drive", context_settings=_CONTEXT, epilog="""\b
 Examples:
   worldgen drive worlds/cluttered-s0-55fec0f6 --sim gazebo --out runs
+  worldgen drive worlds/cluttered-s0-55fec0f6 --sim gazebo --gz-release harmonic --out runs
   worldgen drive worlds/cluttered-s0-55fec0f6 --sim mujoco --out runs --straight   (into what stands between)
 """)
 @click.argument("world", type=click.Path(path_type=Path), metavar="WORLD")
 @click.option("--sim", type=click.Choice(["gazebo", "mujoco"]), default="mujoco", show_default=True,
-              help="The simulator: Gazebo Fortress headless, or MuJoCo (docs/drive.md).")
+              help="The simulator: Gazebo headless (--gz-release), or MuJoCo (docs/drive.md).")
+@click.option("--gz-release", type=click.Choice(SIM_GZ_RELEASES), default=None, metavar="RELEASE",
+              help=f"With --sim gazebo: the Gazebo release to run, one of {', '.join(SIM_GZ_RELEASES)} "
+                   f"[default: WORLDGEN_GAZEBO_SETUP's install, else {SIM_GZ_RELEASE}].")
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Where the run's bag folder is written (DIR/<world id>__<task>__<sim>).")
 @click.option("--task", metavar="ID", help="The task to drive [default: the world's first].")
@@ -37,7 +42,8 @@ Examples:
 @click.option("--straight", is_flag=True,
               help="Drive spawn -> goal in a straight line instead of the reference path (a test hook: "
                    "it drives into whatever stands between them).")
-def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: float, straight: bool) -> None:
+def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: float, straight: bool,
+                  gz_release: Optional[str]) -> None:
     """Drive a world's task in a simulator, record the run as a rosbag2 bag and judge it.
 
     The robot (worldgen.export.robot in Gazebo, the RL environment's robot in MuJoCo) starts at the
@@ -51,7 +57,7 @@ def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: 
     from worldgen.sim.drive import drive
 
     require_rosbags()
-    outcome = drive(world, out, sim=sim, task=task, straight=straight, speed=speed)
+    outcome = drive(world, out, sim=sim, task=task, straight=straight, speed=speed, gz_release=gz_release)
     run = outcome.run
     collisions = run.get("collisions") or []
     if run.get("success"):

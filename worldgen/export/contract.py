@@ -17,8 +17,9 @@ after it may import them.
 Gazebo releases (gz-sim's and ign-gazebo's ``server.config`` for the plugin names, their ``cmdsim.rb``
 for the command line): Fortress (ROS 2 Humble's pair) keeps the ignition names; Garden and later use
 the gz ones. :data:`DEFAULT_GZ_RELEASE` is what a bundle and a robot are written for unless told
-otherwise; :data:`SIM_GZ_RELEASE` is the release ``worldgen.sim`` runs, the one installed where the
-Gazebo tests run and the one the C++ drive bridge is compiled against.
+otherwise; :data:`SIM_GZ_RELEASES` are the releases ``worldgen.sim`` runs and the Gazebo tests run in
+(:data:`SIM_GZ_RELEASE`, the first, unless told otherwise); the C++ drive bridge is compiled against the
+transport of the one it runs.
 
 The ground truth is ``nav_msgs/msg/Odometry`` on ``/ground_truth``: the robot's OdometryPublisher
 publishes the model's world pose (= the map frame's) both as ``Odometry`` on ``ground_truth/odom`` and as
@@ -35,7 +36,8 @@ from typing import Optional
 
 from worldgen.errors import ParameterError
 
-__all__ = ["GzRelease", "GZ_RELEASES", "DEFAULT_GZ_RELEASE", "SIM_GZ_RELEASE", "release",
+__all__ = ["GzRelease", "GZ_RELEASES", "DEFAULT_GZ_RELEASE", "SIM_GZ_RELEASE", "SIM_GZ_RELEASES",
+           "release", "release_of_version",
            "Topic", "TOPICS", "CLOCK", "GROUND_TRUTH", "CONTACTS", "CMD_VEL", "ODOM", "TF", "TF_STATIC", "SCAN", "IMU",
            "JOINT_STATES", "GOAL_POSE", "NAV_FEEDBACK", "NAV_STATUS", "CMD_VEL_STAMPED_TYPE", "GZ_TO_ROS", "ROS_TO_GZ",
            "BRIDGED", "RECORDED", "topic"]
@@ -54,6 +56,11 @@ class GzRelease:
     seed: bool              # whether the server takes ``--seed`` (gz-sim 8's cmdsim.rb has it; 7 and ign 6 not)
     plugin_path_var: str    # where the server looks for system plugins
     partition_var: str      # the transport partition: processes in different partitions never see each other
+    major: int              # the server's major version (``gz sim --versions`` 8.x is Harmonic)
+    transport: tuple[str, ...]  # pkg-config names of its transport and message libraries (the drive bridge)
+    cxx: str                # those libraries' C++ namespace and header folder
+    discovery_vars: tuple[str, str]  # the transport's discovery ports (messages, services)
+    home: str               # the folder the server writes under $HOME (server.config, logs)
 
     def plugin(self, file_stem: str, class_name: str) -> tuple[str, str]:
         """``(filename, name)`` of a system's ``<plugin>`` element in this release."""
@@ -64,22 +71,33 @@ class GzRelease:
         return f"{self.msgs}.{short}"
 
 
+# ign-transport and gz-transport read their discovery ports from these (their NodeShared.cc); both default to
+# 10317 and 10318 on one multicast group with one wire version (10), whatever the partition.
+_IGN_DISCOVERY = ("IGN_DISCOVERY_MSG_PORT", "IGN_DISCOVERY_SRV_PORT")
+_GZ_DISCOVERY = ("GZ_DISCOVERY_MSG_PORT", "GZ_DISCOVERY_SRV_PORT")
+
 #: Every release worldgen writes for, one row each, oldest first.
 GZ_RELEASES: dict[str, GzRelease] = {r.name: r for r in (
     GzRelease("fortress", "ignition-gazebo-{}-system", "ignition::gazebo::systems::{}", "ignition.msgs", "ign",
-              ("ign", "gazebo"), False, "IGN_GAZEBO_SYSTEM_PLUGIN_PATH", "IGN_PARTITION"),
+              ("ign", "gazebo"), False, "IGN_GAZEBO_SYSTEM_PLUGIN_PATH", "IGN_PARTITION", 6,
+              ("ignition-transport11", "ignition-msgs8"), "ignition", _IGN_DISCOVERY, ".ignition"),
     GzRelease("garden", "gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs", "gz",
-              ("gz", "sim"), False, "GZ_SIM_SYSTEM_PLUGIN_PATH", "GZ_PARTITION"),
+              ("gz", "sim"), False, "GZ_SIM_SYSTEM_PLUGIN_PATH", "GZ_PARTITION", 7,
+              ("gz-transport12", "gz-msgs9"), "gz", _GZ_DISCOVERY, ".gz"),
     GzRelease("harmonic", "gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs", "gz",
-              ("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH", "GZ_PARTITION"),
+              ("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH", "GZ_PARTITION", 8,
+              ("gz-transport13", "gz-msgs10"), "gz", _GZ_DISCOVERY, ".gz"),
     GzRelease("ionic", "gz-sim-{}-system", "gz::sim::systems::{}", "gz.msgs", "gz",
-              ("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH", "GZ_PARTITION"),
+              ("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH", "GZ_PARTITION", 9,
+              ("gz-transport14", "gz-msgs11"), "gz", _GZ_DISCOVERY, ".gz"),
 )}
 #: Harmonic pairs with ROS 2 Jazzy, the current LTS pair: what a bundle and a robot are written for by default.
 DEFAULT_GZ_RELEASE = "harmonic"
-#: What ``worldgen.sim`` runs: Fortress (ign-gazebo 6), the release installed where the Gazebo tests run;
-#: the drive bridge is compiled against its ign-transport 11 and ign-msgs 8.
+#: What ``worldgen.sim`` runs unless told otherwise: Fortress (ign-gazebo 6), the suite's default install;
+#: the drive bridge is compiled against the transport and message libraries of the release it runs.
 SIM_GZ_RELEASE = "fortress"
+#: The releases ``worldgen.sim`` runs and the Gazebo tests run in, :data:`SIM_GZ_RELEASE` first.
+SIM_GZ_RELEASES = ("fortress", "harmonic")
 
 
 def release(name: str) -> GzRelease:
@@ -87,6 +105,15 @@ def release(name: str) -> GzRelease:
     if name not in GZ_RELEASES:
         raise ParameterError(f"parameter 'gz_release' must be one of {', '.join(GZ_RELEASES)}, got {name!r}")
     return GZ_RELEASES[name]
+
+
+def release_of_version(version: str) -> GzRelease:
+    """The row of a server that says it is ``version`` (``6.18.0``: Fortress); ParameterError for none."""
+    major = version.split(".")[0]
+    for row in GZ_RELEASES.values():
+        if str(row.major) == major:
+            return row
+    raise ParameterError(f"Gazebo {version} is none of the releases worldgen knows ({', '.join(GZ_RELEASES)})")
 
 
 #: ros_gz_bridge's directions (its README's YAML keys).

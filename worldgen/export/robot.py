@@ -44,21 +44,30 @@ from worldgen.export.contract import CMD_VEL, DEFAULT_GZ_RELEASE, GROUND_TRUTH, 
 from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
 
-__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "Dimensions", "dimensions", "robot_sdf",
+__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "WHEEL_ACCELERATION", "Dimensions", "dimensions", "robot_sdf",
            "robot_urdf"]
 
 #: The model's name: the ROS 2 bundle's robot (worldgen.export.ros2.DEFAULT_ROBOT_NAME).
 DEFAULT_NAME = "robot"
 #: The element Gazebo's sensors take their message frame from. Without it a scan's frame is the scoped
 #: sensor name (``robot::base_scan::lidar``, measured in Fortress 6.18), a frame no URDF has, and AMCL and
-#: the costmaps drop the scans. ``gz_frame_id`` is read by Fortress 6.18's ign-sensors and by gz-sensors 8
-#: (Harmonic); it is a Gazebo extension, not SDFormat, so a strict libsdformat check flags it.
+#: the costmaps drop the scans. ``gz_frame_id`` is read by Fortress 6.18's ign-sensors (beside its older
+#: ``ignition_frame_id``) and is the only element gz-sensors 8 (Harmonic) reads (measured in 8.14: without it
+#: the scan's frame is the scoped name): one element serves every release. It is a Gazebo extension, not
+#: SDFormat, so a strict libsdformat check flags it and sdformat 14 warns about it on every spawn (the
+#: Gazebo harness knows that warning: worldgen.sim.gazebo_log.SENSOR_FRAME_NOTE).
 SENSOR_FRAME_ELEMENT = "gz_frame_id"
 #: Half-height (m) of the gap the chassis' visual leaves around the lidar's plane: what a gpu_lidar
 #: renders is visuals, and SDFormat 1.9 has no visibility mask for a lidar, so the window keeps the
 #: robot out of its own scan (the collision cylinder is whole).
 LIDAR_WINDOW = 0.01
 _CHASSIS_KG, _WHEEL_KG, _CASTER_KG = 10.0, 0.5, 0.2
+#: m/s^2: the DiffDrive's limit on the wheels' acceleration and braking (nav2's controllers' default
+#: ``acc_lim_x`` / ``decel_lim_x``). Without a limit a twist sets the wheels' speed in one step; the tyres
+#: (mu 1) then give the body about 6.5 m/s^2 (measured in Fortress 6.18 and Harmonic 8.14 alike), so the
+#: wheels spin on a start and the body slides on after a stop by v^2 / 13 m: 0.31 m from 2 m/s, the 0.22 m
+#: issue 39 saw after a stop. Below the tyres' grip the body follows its wheels.
+WHEEL_ACCELERATION = 2.5
 _COLOUR = "0.95 0.45 0.1 1"
 
 
@@ -227,6 +236,11 @@ def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: fl
                        ("odom_publish_frequency", fmt(odom_rate)), ("topic", CMD_VEL.gz_name), ("odom_topic", ODOM.gz_name),
                        ("tf_topic", TF.gz_name), ("frame_id", "odom"), ("child_frame_id", "base_footprint")):
         sub(drive, key, value)
+    # The same tyre acceleration for a turn: a wheel's rim moves at the turn rate times half the separation.
+    turn = WHEEL_ACCELERATION / (d.wheel_separation / 2.0)
+    for limit, rate in (("max_linear_acceleration", WHEEL_ACCELERATION), ("min_linear_acceleration", -WHEEL_ACCELERATION),
+                        ("max_angular_acceleration", turn), ("min_angular_acceleration", -turn)):
+        sub(drive, limit, fmt(rate))
     filename, cls = row.plugin("odometry-publisher", "OdometryPublisher")
     truth = sub(model, "plugin", filename=filename, name=cls)
     for key, value in (("odom_frame", "map"), ("robot_base_frame", "base_footprint"),

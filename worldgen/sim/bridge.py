@@ -5,8 +5,10 @@ Fortress's ign-transport has no Python bindings, and each ``ign service`` call s
 0.1 s), so a 20 Hz controller talks to Gazebo through one long-lived program instead: it publishes the
 twist, runs N physics steps through ``/world/<name>/control`` (the world stays paused between calls) and
 answers with the pose the robot's OdometryPublisher stamped at the end of them. The program is compiled
-against ign-transport 11 and ign-msgs 8 (``pkg-config``) into the user's cache folder under a name
-carrying a digest of its source and flags, so an edited source or another install gives a fresh build.
+against the transport and message libraries of the install's release (the contract's row: ign-transport 11
+and ign-msgs 8 for Fortress, gz-transport 13 and gz-msgs 10 for Harmonic, found by ``pkg-config``, which also
+looks in ``lib/pkgconfig`` beside the install's libraries) into the user's cache folder under a name carrying
+a digest of its source, its prelude and flags, so an edited source or another install gives a fresh build.
 """
 
 from __future__ import annotations
@@ -24,17 +26,33 @@ from typing import IO
 from lxml import etree
 
 from worldgen.errors import OutputError
-from worldgen.export.contract import CMD_VEL, GROUND_TRUTH
+from worldgen.export.contract import CMD_VEL, GROUND_TRUTH, SIM_GZ_RELEASE, GzRelease, release
 from worldgen.export.robot import DEFAULT_NAME
 from worldgen.export.xml import safe_parser
 from worldgen.files import move_into_place
-from worldgen.sim.gazebo import GazeboError, GazeboMissingError, GazeboServer, locate, user_cache
+from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboMissingError, GazeboServer, locate, user_cache
 
-__all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "GazeboBackend", "world_step"]
+__all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "prelude", "GazeboBackend", "world_step"]
 
 SOURCE_NAME = "drive_bridge.cc"
-_PACKAGES = ("ignition-transport11", "ignition-msgs8")
-_BUILD_HINT = "apt-get install g++ pkg-config libignition-transport-dev libignition-msgs-dev"
+_BUILD_HINT = ("apt-get install g++ pkg-config libignition-transport-dev libignition-msgs-dev (Fortress), or an "
+               "install that ships its .pc files (Harmonic: shared/gazebo's build)")
+#: The headers the bridge uses, under the release's folder (``ignition/``, ``gz/``).
+_HEADERS = ("msgs/boolean.pb.h", "msgs/entity_factory.pb.h", "msgs/odometry.pb.h", "msgs/twist.pb.h",
+            "msgs/world_control.pb.h", "transport/Node.hh")
+
+
+def prelude(rel: GzRelease) -> str:
+    """What the bridge's source is compiled after (g++ -include): the release's headers and namespaces."""
+    return ("".join(f"#include <{rel.cxx}/{h}>\n" for h in _HEADERS)
+            + f"namespace wgmsgs = {rel.cxx}::msgs;\nnamespace wgtransport = {rel.cxx}::transport;\n")
+
+
+def _pkg_config_path(env: dict[str, str]) -> str:
+    """PKG_CONFIG_PATH with ``pkgconfig`` folders beside the install's libraries (Harmonic's setup.sh sets none)."""
+    found = [str(Path(d) / "pkgconfig") for d in env.get("LD_LIBRARY_PATH", "").split(":")
+             if d and (Path(d) / "pkgconfig").is_dir()]
+    return ":".join(dict.fromkeys(found + [p for p in env.get("PKG_CONFIG_PATH", "").split(":") if p]))
 
 
 def cache_dir() -> Path:
@@ -42,17 +60,21 @@ def cache_dir() -> Path:
     return user_cache() / "worldgen"
 
 
-def build_bridge(env: dict[str, str] | None = None) -> Path:
-    """The compiled bridge (built now when the cache has none for this source and these flags)."""
+def build_bridge(env: dict[str, str] | None = None, rel: GzRelease | None = None) -> Path:
+    """The compiled bridge for release ``rel`` (default :data:`SIM_GZ_RELEASE`), built now when the cache has none
+    for this source, prelude and flags."""
+    rel = rel or release(SIM_GZ_RELEASE)
     env = dict(os.environ if env is None else env)
+    env["PKG_CONFIG_PATH"] = _pkg_config_path(env)
     compiler = shutil.which("g++", path=env.get("PATH"))
     if compiler is None or shutil.which("pkg-config", path=env.get("PATH")) is None:
         raise GazeboMissingError(f"driving in Gazebo builds a small C++ program and needs g++ and pkg-config: {_BUILD_HINT}")
-    flags = subprocess.run(["pkg-config", "--cflags", "--libs", *_PACKAGES], capture_output=True, text=True, env=env)
+    flags = subprocess.run(["pkg-config", "--cflags", "--libs", *rel.transport], capture_output=True, text=True, env=env)
     if flags.returncode != 0:
-        raise GazeboMissingError(f"driving in Gazebo needs the ign-transport 11 and ign-msgs 8 headers: {_BUILD_HINT}")
-    source = resources.files("worldgen.sim").joinpath(SOURCE_NAME).read_bytes()
-    digest = hashlib.sha256(source + flags.stdout.encode()).hexdigest()[:16]
+        raise GazeboMissingError(f"driving in Gazebo {rel.name} needs the {' and '.join(rel.transport)} headers: "
+                                 f"{_BUILD_HINT}")
+    source, head = resources.files("worldgen.sim").joinpath(SOURCE_NAME).read_bytes(), prelude(rel).encode()
+    digest = hashlib.sha256(source + head + flags.stdout.encode()).hexdigest()[:16]
     exe = cache_dir() / f"drive_bridge-{digest}"
     if exe.exists():
         return exe
@@ -61,8 +83,12 @@ def build_bridge(env: dict[str, str] | None = None) -> Path:
         with tempfile.TemporaryDirectory(dir=exe.parent) as tmp:
             src = Path(tmp) / SOURCE_NAME
             src.write_bytes(source)
+            (Path(tmp) / "prelude.hh").write_bytes(head)
             out = Path(tmp) / "drive_bridge"
-            cmd = [compiler, "-O2", "-std=c++17", "-pthread", str(src), "-o", str(out), *flags.stdout.split()]
+            # The libraries' folders as the binary's run path: Harmonic's are not on the system's library path.
+            rpath = [f"-Wl,-rpath,{f[2:]}" for f in flags.stdout.split() if f.startswith("-L")]
+            cmd = [compiler, "-O2", "-std=c++17", "-pthread", "-include", str(Path(tmp) / "prelude.hh"), str(src),
+                   "-o", str(out), *flags.stdout.split(), *rpath]
             built = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
             if built.returncode != 0:
                 raise GazeboError(f"building the Gazebo drive bridge failed: {built.stderr.strip()[:500]}")
@@ -86,8 +112,10 @@ class GazeboBackend:
     poses come back from the simulator, (t, x, y, yaw) in the world frame.
     """
 
-    def __init__(self, world_sdf: Path, robot_sdf: str, *, dt: float, first_steps: int = 1):
+    def __init__(self, world_sdf: Path, robot_sdf: str, *, dt: float, first_steps: int = 1,
+                 install: GazeboInstall | None = None):
         self.world_sdf = Path(world_sdf)
+        self.install = install  # the install to run (its release's tools and libraries); None: locate()'s
         self.first_steps = first_steps  # steps until the first pose: the model's OdometryPublisher's period
         self.dt = dt  # the world's physics step (world_step)
         self._robot_sdf, self._robot_name = robot_sdf, DEFAULT_NAME  # robot_sdf's model name
@@ -97,10 +125,10 @@ class GazeboBackend:
 
     def start(self, spawn: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
         """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
-        install = locate()
-        exe = build_bridge(install.env)
+        install = self.install or locate()
+        exe = build_bridge(install.env, install.release)
         self._server = GazeboServer(self.world_sdf, install=install).start()
-        # The server's environment carries its own IGN_PARTITION: the bridge must share it.
+        # The server's environment carries its own partition and discovery ports: the bridge must share them.
         env = self._server.env
         self._model = model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
         model.write(self._robot_sdf)

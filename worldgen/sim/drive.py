@@ -162,7 +162,7 @@ def _on_schedule(plan: Plan, t: float, x: float, y: float) -> bool:
     return math.hypot(x - float(np.interp(t, r[:, 0], r[:, 1])), y - float(np.interp(t, r[:, 0], r[:, 2]))) < LAG
 
 
-def _backend(sim: str, world: WorldFolder):
+def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None):
     meta = world.metadata
     if sim == "mujoco":
         from worldgen.sim.mujoco import MujocoBackend
@@ -170,9 +170,9 @@ def _backend(sim: str, world: WorldFolder):
         people = meta.get("people") or []
         return MujocoBackend(world.file_bytes("mjcf"), meta,
                              _scene_of(world) if any(p.get("behaviour") for p in people) else None)
-    from worldgen.export.contract import SIM_GZ_RELEASE
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.bridge import GazeboBackend, world_step
+    from worldgen.sim.gazebo_install import locate
 
     sdf = world.file("sdf")
     # The ground truth is published once a command, at its last step: OdometryPublisher publishes when the
@@ -180,21 +180,26 @@ def _backend(sim: str, world: WorldFolder):
     # lands on every command's end (the first at the end of the first), and no other message wakes the bridge.
     dt = world_step(sdf)
     per = steps_per_command(dt)
-    robot = robot_sdf(meta, gz_release=SIM_GZ_RELEASE, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
-    return GazeboBackend(sdf, robot, dt=dt, first_steps=per)
+    # The robot is written for the release that runs it: its plugins' names are that release's.
+    install = locate(release=gz_release)
+    robot = robot_sdf(meta, gz_release=install.release.name, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
+    return GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install)
 
 
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,
-          speed: float = SPEED) -> Outcome:
+          speed: float = SPEED, gz_release: Optional[str] = None) -> Outcome:
     """Drive ``world`` in ``sim``, write the bag into the new folder ``out``/<bag name>, judge it.
 
     ``world`` is a world folder, a :class:`~worldgen.World` or a pack's world (read through
     :func:`worldgen.groundtruth.folder.open_world`); Gazebo loads world.sdf from disk, so there it must
-    be written (a World) or in a pack folder (not an archive)."""
+    be written (a World) or in a pack folder (not an archive). ``gz_release`` picks the Gazebo release
+    (:func:`worldgen.sim.gazebo_install.locate`: ``WORLDGEN_GAZEBO_SETUP``'s install, else Fortress's)."""
     from worldgen.judge import judge
 
     if sim not in SIMS:
         raise ParameterError(f"option '--sim' must be one of {', '.join(SIMS)}, got {sim!r}")
+    if gz_release is not None and sim != "gazebo":
+        raise ParameterError(f"option '--gz-release' {gz_release} names a Gazebo release: add --sim gazebo")
     if not (0 < speed <= 2.0):
         raise ParameterError(f"option '--speed' must be in (0, 2] m/s, got {speed!r}")
     opened = open_world(world, "argument WORLD")
@@ -212,7 +217,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     started = time.perf_counter()
     plan = plan_for(meta, chosen, speed, straight, lambda: _scene_of(opened))
     wall["plan"] = time.perf_counter() - started
-    backend = _backend(sim, opened)
+    backend = _backend(sim, opened, gz_release)
     try:
         trajectory, commands, ended = run_loop(backend, chosen, straight, speed, plan)
     finally:

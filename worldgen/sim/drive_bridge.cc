@@ -1,8 +1,8 @@
-// drive_bridge: a lockstep link between a Python controller and a paused Gazebo (Fortress) server.
+// drive_bridge: a lockstep link between a Python controller and a paused Gazebo (Fortress or Harmonic) server.
 //
 //   drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW
 //
-// Fortress's ign-transport has no Python bindings, and one `ign service` call costs a process start
+// Fortress's ign-transport has no Python bindings (Harmonic's Python bindings are not in every install), and one `ign service` call costs a process start
 // (about 0.1 s), so a controller at 20 Hz cannot drive through the `ign` command. This program stays up
 // for a whole run. It first spawns the model in MODEL_SDF (a file) as NAME at (X, Y, Z, YAW) through
 // /world/WORLD/create (one request, answered within 30 s; the server is up and paused), which saves the
@@ -12,12 +12,16 @@
 //                    (WorldControl multi_step on /world/WORLD/control, the world stays paused), wait
 //                    for the pose message stamped at the end of those steps
 //   out: "p T X Y YAW"  that pose: simulation time (s) and the model's world pose from POSE_TOPIC (an
-//                    ignition.msgs.Odometry, e.g. the OdometryPublisher system's, one per step)
+//                    Odometry message, e.g. the OdometryPublisher system's, one per step)
 //   in:  "q"         quit
 //   out: "ready" once the Twist publisher is connected to its subscriber; "error: ..." then exit 1.
 //
 // STEP_NS is the world's physics step in nanoseconds: the pose waited for is the first stamped at or
 // after the last one plus N steps (half a step of slack for rounding).
+//
+// The release's message and transport headers come from a prelude that worldgen/sim/bridge.py passes with
+// g++'s -include: it includes them (ignition/ for Fortress, gz/ for Harmonic) and names their namespaces
+// wgmsgs and wgtransport, so this one source builds against either release.
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -29,12 +33,6 @@
 #include <string>
 #include <thread>
 
-#include <ignition/msgs/boolean.pb.h>
-#include <ignition/msgs/entity_factory.pb.h>
-#include <ignition/msgs/odometry.pb.h>
-#include <ignition/msgs/twist.pb.h>
-#include <ignition/msgs/world_control.pb.h>
-#include <ignition/transport/Node.hh>
 
 namespace
 {
@@ -43,7 +41,7 @@ std::condition_variable arrived;
 int64_t stampNs = -1;
 double x = 0, y = 0, yaw = 0;
 
-void OnPose(const ignition::msgs::Odometry &_msg)
+void OnPose(const wgmsgs::Odometry &_msg)
 {
   const auto &q = _msg.pose().orientation();
   std::lock_guard<std::mutex> guard(lock);
@@ -55,12 +53,12 @@ void OnPose(const ignition::msgs::Odometry &_msg)
 }
 
 // Run _steps physics steps and stay paused; false when the world refuses.
-bool Step(ignition::transport::Node &_node, const std::string &_service, long _steps)
+bool Step(wgtransport::Node &_node, const std::string &_service, long _steps)
 {
-  ignition::msgs::WorldControl request;
+  wgmsgs::WorldControl request;
   request.set_pause(true);
   request.set_multi_step(static_cast<uint32_t>(_steps));
-  ignition::msgs::Boolean reply;
+  wgmsgs::Boolean reply;
   bool result = false;
   return _node.Request(_service, request, 5000, reply, result) && result && reply.data();
 }
@@ -74,12 +72,12 @@ int Fail(const std::string &_why)
 // Create the model through the world's create service; false when it refuses or does not answer in 30 s.
 // One request only: a request given up early could still be served, and a second one would then be
 // refused for the name taken.
-bool Spawn(ignition::transport::Node &_node, const std::string &_world, char **_argv)
+bool Spawn(wgtransport::Node &_node, const std::string &_world, char **_argv)
 {
   std::ifstream file(_argv[5]);
   std::stringstream text;
   text << file.rdbuf();
-  ignition::msgs::EntityFactory request;
+  wgmsgs::EntityFactory request;
   request.set_sdf(text.str());
   request.set_name(_argv[6]);
   request.set_allow_renaming(false);
@@ -91,7 +89,7 @@ bool Spawn(ignition::transport::Node &_node, const std::string &_world, char **_
   pose->mutable_orientation()->set_z(std::sin(yaw / 2));
   pose->mutable_orientation()->set_w(std::cos(yaw / 2));
   const std::string service = "/world/" + _world + "/create";
-  ignition::msgs::Boolean reply;
+  wgmsgs::Boolean reply;
   bool result = false;
   return _node.Request(service, request, 30000, reply, result) && result && reply.data();
 }
@@ -106,10 +104,10 @@ int main(int argc, char **argv)
   }
   const std::string world = argv[1];
   const int64_t stepNs = std::stoll(argv[4]);
-  ignition::transport::Node node;
+  wgtransport::Node node;
   if (!Spawn(node, world, argv))
     return Fail(std::string("the world did not create the model ") + argv[6]);
-  auto publisher = node.Advertise<ignition::msgs::Twist>(argv[2]);
+  auto publisher = node.Advertise<wgmsgs::Twist>(argv[2]);
   if (!publisher || !node.Subscribe(argv[3], OnPose))
     return Fail("cannot advertise or subscribe");
   // A message published before discovery connects the subscriber is dropped: wait for it.
@@ -133,7 +131,7 @@ int main(int argc, char **argv)
     double v = 0, w = 0;
     if (op != "s" || !(in >> steps >> v >> w) || steps < 1)
       return Fail("bad command: " + line);
-    ignition::msgs::Twist twist;
+    wgmsgs::Twist twist;
     twist.mutable_linear()->set_x(v);
     twist.mutable_angular()->set_z(w);
     publisher.Publish(twist);

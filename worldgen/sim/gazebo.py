@@ -1,4 +1,4 @@
-"""Running a world in a real Gazebo Sim server (Fortress, ``ign gazebo``), headless, from Python.
+"""Running a world in a real Gazebo Sim server (Fortress's ``ign gazebo`` or Harmonic's ``gz sim``), headless.
 
 The API (stable; the robot-driving loop builds on it)::
 
@@ -12,25 +12,28 @@ The API (stable; the robot-driving loop builds on it)::
         with gz.subscribe("/scan") as scans: ...      # a subscriber kept while the world steps (sim/topics)
     gz.problems()                                     # Gazebo's errors and warnings, known harmless ones removed
 
-- :func:`locate` finds an install (``WORLDGEN_GAZEBO_SETUP``, else ``/opt/gz-fortress2/setup.sh``) and reads its
-  setup script's exports into an environment (no shell runs it); :class:`GazeboMissingError` says how to install.
-  Both live in :mod:`worldgen.sim.gazebo_install` and are importable from here too.
+- :func:`locate` finds an install (``WORLDGEN_GAZEBO_SETUP``, else the default place of the release asked for,
+  Fortress's without one), reads its setup script's exports into an environment (no shell runs it) and knows
+  its release; :class:`GazeboMissingError` says how to install. Both live in :mod:`worldgen.sim.gazebo_install`
+  and are importable from here too. The server, its tools (``ign``/``gz``), its message package and its
+  partition variable are that release's row of :mod:`worldgen.export.contract`.
 - The server is a direct child (an argument list, never a shell) in its own process group; leaving the block
   stops it (SIGINT, SIGTERM, then SIGKILL 3 s later: with a render engine it may ignore the polite signals) and
   checks that no process of its group survives.
-- ``ign`` exits 0 even when it fails, so every call here judges by what it printed, not by its status.
+- ``ign`` exits 0 even when it fails, so every call here judges by what it printed, not by its status; a reply
+  is read from the tool's stdout only (its transport prints other processes' discovery noise on stderr).
 """
 
 from __future__ import annotations
 
 import os
-import re
 import subprocess
 import tempfile
 import time
 from pathlib import Path
 
 from worldgen.errors import SimulatorError
+from worldgen.export.contract import GzRelease
 from worldgen.sim import textproto
 from worldgen.sim.gazebo_install import (
     DEFAULT_SETUP,
@@ -41,22 +44,15 @@ from worldgen.sim.gazebo_install import (
     locate,
     user_cache,
 )
+from worldgen.sim.gazebo_log import ACTOR_NOTES, ANSI, HARMLESS, problems_in
+from worldgen.sim.gazebo_log import without_harmless as _without_harmless
 from worldgen.sim.procs import group_members, run_tool, stop_group
 from worldgen.sim.topics import Subscription
 
 __all__ = ["GazeboMissingError", "GazeboError", "GazeboInstall", "GazeboServer", "locate", "SETUP_ENV",
-           "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name", "user_cache"]
+           "DEFAULT_SETUP", "INSTALL_HINT", "HARMLESS", "ACTOR_NOTES", "problems_in", "world_name", "user_cache",
+           "discovery_ports"]
 
-#: Lines Gazebo prints that say nothing about the world, each with why it is harmless.
-HARMLESS: dict[str, str] = {
-    "Library error: libignition-tools-backward.so not found":
-        "ign-tools' optional backtrace helper, absent from Debian's ign-tools; printed by every ign call",
-    "Error launching Remotery: Can't bind a socket for the server":
-        "ign-common's profiler (Remotery, compiled into the 6.18 build) listens on TCP port 1500 (measured: "
-        "whatever RMT_PORT says) and finds it taken when another Gazebo runs on the machine; profiling only",
-}
-
-_ANSI = re.compile(r"\x1b\[[0-9;]*m")
 #: The plugin Gazebo 6 asks for by default, and the file Debian 12's ign-physics5 ships instead (no unversioned link).
 _DART_DEFAULT = "libignition-physics-dartsim-plugin.so"
 _DART_DEBIAN = Path("/usr/lib/x86_64-linux-gnu/ign-physics-5/engine-plugins/libignition-physics5-dartsim-plugin.so.5")
@@ -66,8 +62,11 @@ class GazeboError(SimulatorError):
     """Gazebo ran but did not do what was asked (the world did not come up, a service did not answer)."""
 
 
-def _physics_args(env: dict[str, str]) -> list[str]:
-    """``--physics-engine`` naming Debian's DART plugin when Gazebo's default name exists on none of its paths."""
+def _physics_args(env: dict[str, str], release: GzRelease | None = None) -> list[str]:
+    """``--physics-engine`` naming Debian's DART plugin when Gazebo 6's default name exists on none of its paths
+    (a later release's install brings its own plugin under its default name)."""
+    if release is not None and release.major != 6:
+        return []
     dirs = [Path(d) for d in env.get("IGN_GAZEBO_PHYSICS_ENGINE_PATH", "").split(":") if d]
     dirs += [Path(d) for d in env.get("LD_LIBRARY_PATH", "").split(":") if d] + [_DART_DEBIAN.parent]
     if any((d / _DART_DEFAULT).exists() for d in dirs) or not _DART_DEBIAN.exists():
@@ -75,42 +74,21 @@ def _physics_args(env: dict[str, str]) -> list[str]:
     return ["--physics-engine", _DART_DEBIAN.name]
 
 
-#: Lines a skin-less actor (worldgen's movers and people) makes Gazebo 6.18 print, once per actor, each with
-#: why it says nothing wrong about the world; :func:`problems_in` drops each at most once per actor.
-ACTOR_NOTES: dict[str, str] = {
-    "Link's parent entity": "the Physics system visits an actor's link, finds no model for it and skips it: "
-                            "actors have no physics in Gazebo Sim (the script moves them)",
-    "Collision's parent entity": "the same for the actor link's collision element",
-    "Invalid mesh filename extension": "the rendering scene tries the actor's skin, sdformat's placeholder name "
-                                       "__default__ (worldgen writes no skin), then draws the actor's links along "
-                                       "the script instead (gz-sim pull request 1947)",
-    "Actor skin mesh": "the same skin lookup, reported a second time",
-}
+def discovery_ports(release: GzRelease) -> tuple[int, int]:
+    """The transport's discovery ports (messages, services) for the harness's processes of ``release``.
 
-
-def problems_in(log: str, actors: int = 0) -> list[str]:
-    """The error and warning lines of a Gazebo log, without colour codes, without :data:`HARMLESS` lines and
-    without up to ``actors`` of each :data:`ACTOR_NOTES` line."""
-    out, left = [], {note: actors for note in ACTOR_NOTES}
-    for line in _ANSI.sub("", log).splitlines():
-        if any(known in line for known in HARMLESS):
-            continue
-        note = next((n for n in ACTOR_NOTES if n in line), None)
-        if note is not None and left[note] > 0:
-            left[note] -= 1
-            continue
-        if "[Err]" in line or "[Wrn]" in line or "error" in line.lower():
-            out.append(line.strip())
-    return out
+    Every ign-transport 11 and gz-transport 13 process on the machine meets on one multicast group and, by
+    default, ports 10317/10318, with the same wire version: partitions are compared only after a discovery
+    message is decoded. A Harmonic tool listing topics (``gz topic -l``) sends a SUBSCRIBERS_REQ (type 8),
+    which Fortress's transport does not know: each Fortress process then prints "Unknown message type [8]."
+    (measured here, in any partition). Ports of their own per release keep each release's discovery apart,
+    and apart from any Gazebo the user runs on the default ports."""
+    return 11017 + 20 * release.major, 11018 + 20 * release.major
 
 
 def _accepted(reply: dict) -> bool:
     """Whether an ``ignition.msgs.Boolean`` reply says yes (protobuf text: ``data: true``)."""
     return textproto.first(reply, "data") == "true"
-
-
-def _without_harmless(text: str) -> str:
-    return "\n".join(x for x in text.splitlines() if not any(k in x for k in HARMLESS))
 
 
 def world_name(sdf_path: Path) -> tuple[str, int]:
@@ -126,7 +104,8 @@ def world_name(sdf_path: Path) -> tuple[str, int]:
 
 
 class GazeboServer:
-    """One headless ``ign gazebo -s`` run of one world; a context manager (see the module's docstring).
+    """One headless server run (``ign gazebo -s``, ``gz sim -s``: the install's release) of one world; a context
+    manager (see the module's docstring).
 
     ``headless_rendering`` loads the render engine through EGL (a gpu_lidar or camera in the world needs it);
     ``verbosity`` is Gazebo's ``-v``; ``real_time_factor`` None runs unthrottled. The server starts paused:
@@ -145,8 +124,12 @@ class GazeboServer:
         # A home of its own: Gazebo writes ~/.ignition/gazebo/6/server.config on its first run (6.18 writes
         # gz::sim plugin names, which a 6.7 install then cannot load: measured) and a log folder per run; a
         # test run must not change the user's Gazebo. The cache stays the user's (Mesa's compiled shaders).
-        self.env = dict(self.install.env, IGN_PARTITION=f"worldgen-{os.getpid()}-{id(self):x}", HOME=str(home),
-                        XDG_CACHE_HOME=str(user_cache()))
+        # The release's discovery ports too (discovery_ports says why).
+        self.release = self.install.release
+        rel = self.release
+        self.env = dict(self.install.env, HOME=str(home), XDG_CACHE_HOME=str(user_cache()),
+                        **{rel.partition_var: f"worldgen-{os.getpid()}-{id(self):x}"},
+                        **{var: str(port) for var, port in zip(rel.discovery_vars, discovery_ports(rel))})
         self.world, self.actors = world_name(self.world_sdf)
         self.headless_rendering = headless_rendering
         self.verbosity = verbosity
@@ -159,10 +142,10 @@ class GazeboServer:
     # -- life cycle --------------------------------------------------------------------------------------------
     def command(self) -> list[str]:
         """The server's argument list."""
-        args = ["ign", "gazebo", "-s", "-v", str(self.verbosity), "-z", str(self.real_time_factor or 1000000)]
+        args = [*self.release.server, "-s", "-v", str(self.verbosity), "-z", str(self.real_time_factor or 1000000)]
         if self.headless_rendering:
             args.append("--headless-rendering")
-        return args + _physics_args(self.install.env) + [str(self.world_sdf)]
+        return args + _physics_args(self.install.env, self.release) + [str(self.world_sdf)]
 
     def start(self) -> GazeboServer:
         """Start the server and wait for its world; one that runs but has not served it within ``start_timeout``
@@ -195,8 +178,8 @@ class GazeboServer:
             # "error sending response: Host unreachable"); half the time at most, to ask again if a reply is lost.
             remaining = self.start_timeout - (time.monotonic() - started)
             try:
-                reply = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty", "ignition.msgs.Scene",
-                                     "", timeout=max(1.0, min(remaining, self.start_timeout / 2)))
+                reply = self.service(f"/world/{self.world}/scene/info", self.release.msg("Empty"),
+                                     self.release.msg("Scene"), "", timeout=max(1.0, min(remaining, self.start_timeout / 2)))
             except GazeboError:
                 continue
             if reply:
@@ -224,7 +207,7 @@ class GazeboServer:
     def log(self) -> tuple[str, str]:
         """The server's (stdout, stderr) so far, colour codes removed."""
         logdir = Path(self._logdir.name)
-        out, err = (_ANSI.sub("", (logdir / s).read_text(errors="replace")) if (logdir / s).exists() else ""
+        out, err = (ANSI.sub("", (logdir / s).read_text(errors="replace")) if (logdir / s).exists() else ""
                     for s in ("stdout", "stderr"))
         return out, err
 
@@ -235,11 +218,14 @@ class GazeboServer:
         return problems_in(out + "\n" + err, self.actors)
 
     # -- talking to it ---------------------------------------------------------------------------------------
-    def _ign(self, args: list[str], timeout: float) -> str:
+    def _ign(self, args: list[str], timeout: float, errors: list[str] | None = None) -> str:
+        """The release's tool (``ign``/``gz``) run with ``args``: its stdout (its stderr appended to ``errors``)."""
+        errors = [] if errors is None else errors
         try:
-            return run_tool(["ign"] + args, self.env, timeout=timeout)
+            return run_tool([self.release.cli] + args, self.env, timeout=timeout, errors=errors)
         except subprocess.TimeoutExpired:
-            raise GazeboError(f"'ign {' '.join(args[:3])}' got no answer within {timeout:.0f} s ({self._state()})") from None
+            raise GazeboError(f"'{self.release.cli} {' '.join(args[:3])}' got no answer within {timeout:.0f} s "
+                              f"({self._state()})") from None
 
     def _state(self) -> str:
         """Whether the server still runs, for an error message: a live server that stopped answering is stuck."""
@@ -261,7 +247,7 @@ class GazeboServer:
 
     def subscribe(self, topic: str) -> Subscription:
         """A subscriber to ``topic`` that stays until closed (a context manager): :class:`Subscription`."""
-        return Subscription(topic, ["ign", "topic", "-e", "-t", topic], self.env, self.step, self._parse_echo,
+        return Subscription(topic, [self.release.cli, "topic", "-e", "-t", topic], self.env, self.step, self._parse_echo,
                             GazeboError)
 
     @staticmethod
@@ -271,11 +257,13 @@ class GazeboServer:
     def service(self, name: str, reqtype: str, reptype: str, req: str, timeout: float = 10.0) -> dict:
         """Call a service; its reply parsed. Raises :class:`GazeboError` when it does not answer."""
         ms = str(int(timeout * 1000))
+        errors: list[str] = []
         text = self._ign(["service", "-s", name, "--reqtype", reqtype, "--reptype", reptype, "--timeout", ms,
-                          "--req", req], timeout + 5)
+                          "--req", req], timeout + 5, errors)
         body = _without_harmless(text).strip()
         if not body or "timed out" in body.lower() or "error" in body.lower():
-            raise GazeboError(f"service {name} did not answer: {body[:200]!r}")
+            said = (body + " " + _without_harmless("".join(errors))).strip()
+            raise GazeboError(f"service {name} did not answer: {said[:200]!r}")
         return textproto.parse(body)
 
     def stats(self) -> dict:
@@ -290,8 +278,8 @@ class GazeboServer:
     def step(self, iterations: int, timeout: float = 120.0) -> int:
         """Run ``iterations`` physics steps, then stay paused; returns the world's iteration count."""
         target = self._iterations + int(iterations)
-        reply = self.service(f"/world/{self.world}/control", "ignition.msgs.WorldControl", "ignition.msgs.Boolean",
-                             f"pause: true, multi_step: {int(iterations)}")
+        reply = self.service(f"/world/{self.world}/control", self.release.msg("WorldControl"),
+                             self.release.msg("Boolean"), f"pause: true, multi_step: {int(iterations)}")
         if not _accepted(reply):
             raise GazeboError(f"world control refused {iterations} steps: {reply}")
         deadline = time.monotonic() + timeout
@@ -306,8 +294,8 @@ class GazeboServer:
         """Entity id -> scoped name (``model``, ``model::link``) of every model and link, from ``scene/info``
         (asked once, and again after a spawn)."""
         if self._scene is None:
-            self._scene = self.service(f"/world/{self.world}/scene/info", "ignition.msgs.Empty",
-                                       "ignition.msgs.Scene", "")
+            self._scene = self.service(f"/world/{self.world}/scene/info", self.release.msg("Empty"),
+                                       self.release.msg("Scene"), "")
         scene = self._scene
         names: dict[int, str] = {}
 
@@ -348,6 +336,7 @@ class GazeboServer:
         req = (f"sdf: {json.dumps(sdf)}, name: {json.dumps(name)}, allow_renaming: false, pose: {{position: "
                f"{{x: {x!r}, y: {y!r}, z: {z!r}}}, orientation: {{z: {math.sin(yaw / 2)!r}, w: {math.cos(yaw / 2)!r}}}}}")
         self._scene = None
-        reply = self.service(f"/world/{self.world}/create", "ignition.msgs.EntityFactory", "ignition.msgs.Boolean", req)
+        reply = self.service(f"/world/{self.world}/create", self.release.msg("EntityFactory"),
+                             self.release.msg("Boolean"), req)
         if not _accepted(reply):
             raise GazeboError(f"Gazebo refused to create {name!r}: {reply}")

@@ -15,13 +15,16 @@ from pathlib import Path
 __all__ = ["run_tool", "stop_group", "group_members"]
 
 
-def run_tool(args: list[str], env: dict[str, str], timeout: float) -> str:
-    """A tool's stdout + stderr (an argument list, no shell); on time-out its whole group is killed, then
+def run_tool(args: list[str], env: dict[str, str], timeout: float, errors: list[str] | None = None) -> str:
+    """A tool's stdout + stderr (an argument list, no shell), or its stdout alone with its stderr appended to
+    ``errors`` when that list is given; on time-out its whole group is killed, then
     :class:`subprocess.TimeoutExpired` is raised."""
-    proc = subprocess.Popen(args, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            start_new_session=True)
+    proc = subprocess.Popen(args, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
+                            stderr=subprocess.STDOUT if errors is None else subprocess.PIPE, start_new_session=True)
     try:
-        out, _ = proc.communicate(timeout=timeout)
+        out, err = proc.communicate(timeout=timeout)
+        if errors is not None:
+            errors.append(err.decode("utf-8", errors="replace"))
     except subprocess.TimeoutExpired:
         stop_group(proc, grace=0.5)
         raise

@@ -27,24 +27,25 @@ __all__ = ["gazebo_scan", "read_scan", "edge_rays", "EDGE_JUMP"]
 EDGE_JUMP = 0.1
 
 
-def _world_with_sensors(folder: Path, sdf: Path) -> str:
-    from worldgen.export.contract import SIM_GZ_RELEASE
+def _world_with_sensors(folder: Path, sdf: Path, gz_release: str) -> str:
     from worldgen.export.ros2 import with_plugins
 
     text = sdf.read_text(encoding="utf-8")
-    return with_plugins(text, SIM_GZ_RELEASE, str(folder.resolve()) + "/").decode()
+    return with_plugins(text, gz_release, str(folder.resolve()) + "/").decode()
 
 
-def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> np.ndarray:
+def gazebo_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0, gz_release: str | None = None) -> np.ndarray:
     """The ranges (m) of the first scan the robot's gpu_lidar publishes at the first task's spawn in ``world``."""
-    return read_scan(world, lidar_noise=lidar_noise, timeout=timeout)[0]
+    return read_scan(world, lidar_noise=lidar_noise, timeout=timeout, gz_release=gz_release)[0]
 
 
-def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> tuple[np.ndarray, str]:
+def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0,
+              gz_release: str | None = None) -> tuple[np.ndarray, str]:
     """(ranges, m; the message's header ``frame_id``) of the first scan the robot's gpu_lidar publishes at the
     first task's spawn in ``world`` (a world folder, a written World or a pack folder's world: Gazebo loads
-    its world.sdf from disk). The frame is what a ROS 2 bridge passes on."""
-    from worldgen.export.contract import SCAN, SIM_GZ_RELEASE
+    its world.sdf from disk). The frame is what a ROS 2 bridge passes on. ``gz_release`` picks the Gazebo
+    release (:func:`~worldgen.sim.gazebo_install.locate`); the world's systems and the robot are written for it."""
+    from worldgen.export.contract import SCAN
     from worldgen.export.robot import robot_sdf
     from worldgen.sim.textproto import first
 
@@ -52,11 +53,13 @@ def read_scan(world, *, lidar_noise: float = 0.0, timeout: float = 60.0) -> tupl
     meta = opened.metadata
     spawn = opened.task()["spawn"]
     source = opened.file("sdf")
+    install = locate(release=gz_release)
+    rel = install.release.name
     with tempfile.TemporaryDirectory(prefix="worldgen-scan-") as tmp:
         sdf = Path(tmp) / source.name  # the world folder is left untouched; its meshes are named absolutely
-        sdf.write_text(_world_with_sensors(opened.file("json").parent, source), encoding="utf-8")
-        with GazeboServer(sdf, install=locate(), headless_rendering=True) as gz:
-            gz.spawn(robot_sdf(meta, gz_release=SIM_GZ_RELEASE, lidar_noise=lidar_noise), name="robot",
+        sdf.write_text(_world_with_sensors(opened.file("json").parent, source, rel), encoding="utf-8")
+        with GazeboServer(sdf, install=install, headless_rendering=True) as gz:
+            gz.spawn(robot_sdf(meta, gz_release=rel, lidar_noise=lidar_noise), name="robot",
                      pose=(spawn[0], spawn[1], spawn[2], spawn[5]))
             got = gz.echo(SCAN.gazebo_topic, 1, timeout, step=50)  # the world is paused: stepped until the scan came
     if not got:

@@ -39,11 +39,12 @@ class Subscription:
         self._folder = tempfile.TemporaryDirectory(prefix="worldgen-topic-")
         path = Path(self._folder.name) / "messages.txt"
         # The subscriber appends through a file object of its own: one shared with the reader would share its
-        # offset too, and a seek to read would move where the subscriber writes.
-        with open(path, "ab") as out:
+        # offset too, and a seek to read would move where the subscriber writes. Its stderr goes elsewhere: the
+        # transport prints there what it makes of other processes' discovery ("Unknown message type [8].", sent
+        # by a Harmonic tool to a Fortress one), in the middle of a message's text if it shared the file.
+        with open(path, "ab") as out, open(path.with_name("stderr.txt"), "ab") as err:
             self._proc: subprocess.Popen | None = subprocess.Popen(
-                command, env=env, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT,
-                start_new_session=True)
+                command, env=env, stdin=subprocess.DEVNULL, stdout=out, stderr=err, start_new_session=True)
         self._reader = open(path, "rb")
         self._read = 0  # bytes of the file parsed into self._got
         self._got: list[dict] = []
