@@ -14,7 +14,8 @@ from typing import Any, Mapping, Optional, Sequence
 from worldgen.errors import ParameterError, did_you_mean, quoted
 from worldgen.floats import round_float
 
-__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "PEOPLE_PARAMS", "describe_range"]
+__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "PEOPLE_PARAMS", "describe_range",
+           "CLIMB_PARAMS"]
 
 _KINDS = ("float", "int", "bool", "choice", "pair", "range", "triple", "list", "words")
 #: Most items a ``list`` or ``words`` parameter may hold.
@@ -270,4 +271,14 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("map_height", "float", 0.1,
           "height of the horizontal slice the occupancy map is made from (above the floor slab)", 0.001, 50.0, unit="m"),
     Param("map_resolution", "float", 0.05, "edge of one occupancy map cell", 0.005, 10.0, unit="m"),
+)
+
+
+#: The robot's climbing limits (docs/terrain.md), taken by generators that make terrain: not common, so that
+#: a flat world's params (and bytes) stay as they were. Defaults: worldgen.scene.terrain.CLIMB_DEFAULTS.
+CLIMB_PARAMS: tuple[Param, ...] = (
+    Param("robot_max_incline", "float", 10.0, "steepest ground the robot drives on", 0.0, 45.0, unit="deg"),
+    Param("robot_max_step_up", "float", 0.02, "highest step edge the robot climbs", 0.0, 0.5, unit="m"),
+    Param("robot_max_step_down", "float", 0.02, "deepest step edge the robot drives down", 0.0, 0.5, unit="m"),
+    Param("robot_ground_clearance", "float", 0.03, "height of the chassis above flat ground", 0.0, 0.5, unit="m"),
 )

@@ -24,7 +24,7 @@ from worldgen.params import Param
 from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene, Shape
 from worldgen.scene.footprint import FootprintIndex, robot_footprints
 
-__all__ = ["SPEC", "KNOB", "build"]
+__all__ = ["SPEC", "KNOB", "build", "place_obstacles", "obstacle_count"]
 
 #: Tries to place one obstacle before the draw counts as overcrowded.
 PLACEMENT_TRIES = 60
@@ -95,7 +95,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     nodes = [floor_node(size, params["wall_thickness"] if params["walls"] else 0.5, friction)]
     if params["walls"]:
         nodes += wall_nodes(size, params["wall_height"], params["wall_thickness"], friction)
-    obstacles = _place_obstacles(params, obstacle_rng, bounds, obstacle_count(params))
+    obstacles = place_obstacles(params, obstacle_rng, bounds, obstacle_count(params))
     if obstacles is None:
         return Draft(None, rejected="obstacle_placement",
                      detail=f"could not place {obstacle_count(params)} obstacles with min_gap {params['min_gap']:g} m")
@@ -111,7 +111,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     return Draft(scene, tuple(tasks))
 
 
-def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
+def place_obstacles(params, rng: np.random.Generator, bounds, count: int):
     """Obstacle nodes placed with the minimum gap, or None when the room is too full."""
     (x0, y0), (x1, y1) = bounds
     gap = params["min_gap"]
