@@ -3,14 +3,14 @@
 Every element is a rectangle on the floor (centre, yaw, ``length`` along its own x, ``width`` along its
 own y) with a height inside it and zero outside; elements may not overlap, so the ground's height at a
 point is the height of the one element that holds it (0 elsewhere) and :meth:`Terrain.heights` is exact
-for the analytic elements (a ramp's straight inclines, a step's plateau) and for the rough patch's grid
-(bilinear between its nodes, which is what the exported meshes and height fields carry).
+for every element: a ramp's straight inclines, a step's plateau, and the rough patch's triangles, the
+surface the exported height fields carry.
 
 - :class:`Ramp`: up over ``run``, flat for ``landing`` at ``rise``, down over ``run`` (a speed bump is
   a ramp with no landing; driven across its width it is a cross-slope);
 - :class:`Step`: a plateau ``height`` above the floor (a kerb), or below it when negative (a pothole);
 - :class:`Rough`: a seeded grid of heights every ``cell`` metres, zero on its border so it meets the
-  floor without an edge.
+  floor without an edge, linear on each cell's two triangles.
 
 Plain frozen data like the rest of the scene: no limits, no drivability (that is feasibility's).
 """
@@ -144,7 +144,8 @@ class Step(_Rect):
 @dataclass(frozen=True)
 class Rough(_Rect):
     """Heights on a grid every ``cell`` m (``grid[j][i]`` at u = -length/2 + i cell, v = -width/2 + j cell),
-    zero on the border, bilinear between the nodes."""
+    zero on the border, linear on the two triangles of each cell split by its diagonal from (i, j) to
+    (i + 1, j + 1): the surface a height field's engines build from the same nodes (MuJoCo's, checked by ray)."""
 
     cx: float
     cy: float
@@ -183,29 +184,24 @@ class Rough(_Rect):
 
     def heights(self, xy: np.ndarray) -> np.ndarray:
         mask, g, i, j, a, b = self._cell_of(xy)
-        h = (g[j, i] * (1 - a) * (1 - b) + g[j, i + 1] * a * (1 - b) + g[j + 1, i] * (1 - a) * b
-             + g[j + 1, i + 1] * a * b)
+        h00, h10, h01, h11 = g[j, i], g[j, i + 1], g[j + 1, i], g[j + 1, i + 1]
+        h = np.where(a >= b, h00 + a * (h10 - h00) + b * (h11 - h10), h00 + b * (h01 - h00) + a * (h11 - h01))
         return np.where(mask, h, 0.0)
 
     def gradients(self, xy: np.ndarray) -> np.ndarray:
         mask, g, i, j, a, b = self._cell_of(xy)
-        du = ((g[j, i + 1] - g[j, i]) * (1 - b) + (g[j + 1, i + 1] - g[j + 1, i]) * b) / self.cell
-        dv = ((g[j + 1, i] - g[j, i]) * (1 - a) + (g[j + 1, i + 1] - g[j, i + 1]) * a) / self.cell
+        h00, h10, h01, h11 = g[j, i], g[j, i + 1], g[j + 1, i], g[j + 1, i + 1]
+        du = np.where(a >= b, h10 - h00, h11 - h01) / self.cell
+        dv = np.where(a >= b, h11 - h10, h01 - h00) / self.cell
         return np.where(mask, np.hypot(du, dv), 0.0)
 
     def steepest(self) -> float:
-        """The largest gradient anywhere in the patch (exact: within a bilinear cell |grad|^2 is
-        du(v)^2 + dv(u)^2, each linear in one coordinate, so it is largest at a corner)."""
+        """The largest gradient anywhere in the patch (exact: each triangle is a plane)."""
         g = self.array
-        du = np.diff(g, axis=1) / self.cell  # (ny, nx-1): along u, at each row of nodes
-        dv = np.diff(g, axis=0) / self.cell  # (ny-1, nx)
-        best = 0.0
-        for dj in (0, 1):
-            for di in (0, 1):
-                gu = du[dj: dj + g.shape[0] - 1, :]
-                gv = dv[:, di: di + g.shape[1] - 1]
-                best = max(best, float(np.hypot(gu, gv).max()))
-        return best
+        h00, h10, h01, h11 = g[:-1, :-1], g[:-1, 1:], g[1:, :-1], g[1:, 1:]
+        lower = np.hypot(h10 - h00, h11 - h10)  # a >= b: below the diagonal
+        upper = np.hypot(h11 - h01, h01 - h00)
+        return float(max(lower.max(), upper.max())) / self.cell
 
     def params(self) -> dict:
         return {"cell": self.cell, "grid": [list(row) for row in self.grid]}

@@ -1,0 +1,125 @@
+"""The terrain as pieces an engine's collision geometry carries: convex solids and height fields.
+
+Every piece's top is the model's ground (worldgen.scene.terrain) where it lies:
+
+- a ramp is one convex solid, its trapezoid profile extruded across its width;
+- a kerb is a box standing on the floor;
+- a pothole is a box sunk to its depth, and the floor slab around it is cut into triangular prisms
+  (a constrained Delaunay triangulation of the floor's rectangle less every pothole), since a slab has
+  no holes;
+- a rough patch is a height field with the patch's grid as its nodes, cut into the same triangles as
+  the model's, and cut out of the floor like a pothole where it dips below it.
+
+Solids are given by their corner points only: MuJoCo makes a mesh without faces into its convex hull,
+and every solid here is convex.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Optional, Union
+
+import numpy as np
+import shapely
+
+from worldgen.scene import Box, Scene
+from worldgen.scene.terrain import Ramp, Rough, Step
+
+__all__ = ["Solid", "Field", "Piece", "ground_pieces", "FLOOR_NAME", "yaw_quat"]
+
+#: The scene's floor node, the one slab potholes are cut out of.
+FLOOR_NAME = "floor"
+#: How far below the floor's top a solid standing on it reaches (m): it overlaps the slab instead of
+#: touching it, so no ray or contact finds a seam.
+_SINK = 0.001
+
+
+@dataclass(frozen=True, eq=False)
+class Solid:
+    """A convex solid: ``points`` (k, 3) world corners."""
+
+    name: str
+    points: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class Field:
+    """A height field: ``grid`` (ny, nx) heights (m) over a ``length`` x ``width`` rectangle centred at
+    (cx, cy) turned by ``yaw``, ``grid[j][i]`` at local x = -length/2 + i cell, y = -width/2 + j cell."""
+
+    name: str
+    cx: float
+    cy: float
+    yaw: float
+    length: float
+    width: float
+    grid: np.ndarray
+    base: float
+
+
+Piece = Union[Solid, Field]
+
+
+def _box(e, u0: float, u1: float, v0: float, v1: float, z0: float, z1: float) -> np.ndarray:
+    corners = np.array([[u, v] for u in (u0, u1) for v in (v0, v1)])
+    xy = e.to_world(corners)
+    return np.vstack([np.column_stack([xy, np.full(4, z)]) for z in (z0, z1)])
+
+
+def ground_pieces(scene: Scene, floor_thickness: Optional[float] = None) -> tuple[bool, list[Piece]]:
+    """(whether the floor slab is replaced by the pieces, the pieces) of ``scene``'s terrain."""
+    terrain = scene.terrain
+    if terrain is None:
+        return False, []
+    floor = next((n for n in scene.nodes if n.name == FLOOR_NAME and isinstance(n.shape, Box)), None)
+    thickness = floor_thickness or (floor.shape.size[2] if floor is not None and isinstance(floor.shape, Box) else 0.1)
+    pieces: list[Piece] = []
+    holes = []
+    for k, e in enumerate(terrain.elements):
+        name = f"terrain_{k}"
+        hl, hw = e.length / 2, e.width / 2
+        if isinstance(e, Ramp):
+            profile = [(-hl, 0.0), (-hl + e.run, e.rise), (hl - e.run, e.rise), (hl, 0.0)]
+            if e.landing == 0:
+                profile = [profile[0], (0.0, e.rise), profile[3]]
+            pts = [(u, v, z) for u, z in profile for v in (-hw, hw)] + [(u, v, -_SINK) for u in (-hl, hl)
+                                                                        for v in (-hw, hw)]
+            local = np.array(pts)
+            pieces.append(Solid(name, np.column_stack([e.to_world(local[:, :2]), local[:, 2]])))
+        elif isinstance(e, Step) and e.height > 0:
+            pieces.append(Solid(name, _box(e, -hl, hl, -hw, hw, -_SINK, e.height)))
+        elif isinstance(e, Step):
+            pieces.append(Solid(name, _box(e, -hl, hl, -hw, hw, e.height - thickness, e.height)))
+            holes.append(e.outline())
+        elif isinstance(e, Rough):
+            pieces.append(Field(name, e.cx, e.cy, e.yaw, e.length, e.width, e.array, thickness))
+            if e.array.min() < 0:  # dips below the floor's top: the slab gives way to it
+                holes.append(e.outline())
+    if not holes or floor is None:
+        return False, pieces
+    return True, _cut_floor(scene, floor, holes, thickness) + pieces
+
+
+def _cut_floor(scene: Scene, floor, holes, thickness: float) -> list[Piece]:
+    """The floor slab less the potholes, as triangular prisms."""
+    m = scene.world_matrix(floor.name)
+    sx, sy, _ = floor.shape.size
+    slab = shapely.Polygon((m[:2, :2] @ np.array([[-sx / 2, -sy / 2], [sx / 2, -sy / 2], [sx / 2, sy / 2],
+                                                   [-sx / 2, sy / 2]]).T).T + m[:2, 3])
+    top = float(m[2, 3] + thickness / 2)
+    left = slab.difference(shapely.union_all(holes))
+    triangles = shapely.constrained_delaunay_triangles(left)
+    out: list[Piece] = []
+    for k, tri in enumerate(getattr(triangles, "geoms", [triangles])):
+        xy = np.array(tri.exterior.coords)[:3]
+        if abs(shapely.area(tri)) < 1e-12:
+            continue
+        out.append(Solid(f"{FLOOR_NAME}_{k}", np.vstack([np.column_stack([xy, np.full(3, z)])
+                                                          for z in (top - thickness, top)])))
+    return out
+
+
+def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
+    """(w, x, y, z) of a turn by ``yaw`` about z."""
+    return (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
