@@ -2,6 +2,8 @@
 (within 1 cm; mj_ray straight down), on every kind of element and on the floor between them; a world with
 terrain steps in MuJoCo without warnings; a flat world's MJCF has no trace of it."""
 
+import json
+
 import numpy as np
 import pytest
 from support.reftools_mujoco import load_and_step
@@ -51,3 +53,53 @@ def test_a_terrain_world_steps_in_mujoco_without_warnings():
 def test_a_flat_world_has_no_terrain_in_its_mjcf():
     xml = to_mjcf(worldgen.generate("cluttered", 0, size=[6, 6], n_obstacles=3).scene).decode()
     assert "terrain_" not in xml and "hfield" not in xml
+
+
+def mesh_top(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The highest point of the (k, 3, 3) triangles straight above or below each (x, y) point (nan where none
+    covers it): what a ray cast straight down onto the mesh meets first."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    e1, e2 = b[:, :2] - a[:, :2], c[:, :2] - a[:, :2]
+    det = e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0]
+    flat = np.abs(det) < 1e-12  # upright faces (walls) are met edge-on by a vertical ray
+    out = np.full(len(points), np.nan)
+    for k, p in enumerate(points):
+        d = p - a[:, :2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            s = (d[:, 0] * e2[:, 1] - d[:, 1] * e2[:, 0]) / det
+            t = (e1[:, 0] * d[:, 1] - e1[:, 1] * d[:, 0]) / det
+            inside = ~flat & (s >= -1e-9) & (t >= -1e-9) & (s + t <= 1 + 1e-9)
+            if inside.any():
+                out[k] = (a[:, 2] + s * (b[:, 2] - a[:, 2]) + t * (c[:, 2] - a[:, 2]))[inside].max()
+    return out
+
+
+def test_the_sdf_and_urdf_terrain_mesh_is_world_json_height_and_both_files_load(tmp_path):
+    import io
+
+    import trimesh
+    from support.reftools_sdf import check_sdf, dump_sdf
+    from support.reftools_urdf import check_urdf
+
+    from worldgen.files import SDF_NAME, TERRAIN_MESH_NAME, URDF_NAME
+
+    world = worldgen.generate("terrain", 4, size=[12, 12], n_ramps=2, n_kerbs=4, pothole_share=0.5, n_rough=2,
+                              rough_amplitude=0.03, n_obstacles=3)
+    folder = world.write(tmp_path)
+    ok, messages = check_sdf(folder / SDF_NAME)
+    assert ok, messages
+    collisions = dump_sdf(folder / SDF_NAME)["collisions"]
+    assert [v for k, v in collisions.items() if k.startswith("terrain::")][0][0] == "mesh"
+    assert not any(k.startswith("floor::") for k in collisions)  # potholes: the slab is in the mesh, cut
+    check_urdf(folder / URDF_NAME)
+    assert TERRAIN_MESH_NAME in (folder / URDF_NAME).read_text()
+    mesh = trimesh.load(io.BytesIO((folder / TERRAIN_MESH_NAME).read_bytes()), file_type="stl")
+    meta = json.loads((folder / "world.json").read_text())
+    assert meta["files"][f"mesh:{TERRAIN_MESH_NAME}"]["path"] == TERRAIN_MESH_NAME
+    terrain = world.scene.terrain
+    rng = np.random.default_rng(1)
+    points = np.vstack([e.to_world(rng.uniform([-e.length / 2, -e.width / 2], [e.length / 2, e.width / 2], (60, 2)))
+                        for e in terrain.elements] + [rng.uniform(-5.8, 5.8, (150, 2))])
+    got = mesh_top(np.asarray(mesh.triangles), points)
+    assert not np.isnan(got).any()
+    assert np.abs(got - terrain.heights(points)).max() < TOLERANCE

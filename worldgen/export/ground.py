@@ -23,10 +23,14 @@ from typing import Optional, Union
 import numpy as np
 import shapely
 
-from worldgen.scene import Box, Scene
+from worldgen.files import TERRAIN_MESH_NAME
+from worldgen.scene import Box, Material, Mesh, Node, Scene
 from worldgen.scene.terrain import Ramp, Rough, Step
 
-__all__ = ["Solid", "Field", "Piece", "ground_pieces", "FLOOR_NAME", "yaw_quat"]
+__all__ = ["Solid", "Field", "Piece", "ground_pieces", "FLOOR_NAME", "yaw_quat", "ground_scene", "TERRAIN_NODE"]
+
+#: The node that carries the terrain's one mesh in the formats that refer to mesh files.
+TERRAIN_NODE = "terrain"
 
 #: The scene's floor node, the one slab potholes are cut out of.
 FLOOR_NAME = "floor"
@@ -123,3 +127,67 @@ def _cut_floor(scene: Scene, floor, holes, thickness: float) -> list[Piece]:
 def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
     """(w, x, y, z) of a turn by ``yaw`` about z."""
     return (math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2))
+
+
+def _solid_triangles(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, faces) of the convex hull of ``points``, faces turned outward."""
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(points)
+    faces = hull.simplices.copy()
+    centre = points[hull.vertices].mean(axis=0)
+    for k, (a, b, c) in enumerate(faces):
+        if np.dot(np.cross(points[b] - points[a], points[c] - points[a]), points[a] - centre) < 0:
+            faces[k] = (a, c, b)
+    return points, faces
+
+
+def _field_triangles(f: Field) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices, faces) of a height field's top, split as the model splits each cell, over a flat bottom
+    ``base`` below its lowest node, walled round."""
+    ny, nx = f.grid.shape
+    cell = f.length / (nx - 1)
+    u, v = np.meshgrid(-f.length / 2 + cell * np.arange(nx), -f.width / 2 + cell * np.arange(ny))
+    xy = _Frame(f).to_world(np.column_stack([u.ravel(), v.ravel()]))
+    bottom = float(f.grid.min()) - f.base
+    top = np.column_stack([xy, f.grid.ravel()])
+    low = np.column_stack([xy, np.full(len(xy), bottom)])
+    vertices = np.vstack([top, low])
+    n = nx * ny
+    idx = np.arange(n).reshape(ny, nx)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
+    faces = [np.column_stack([a, b, d]), np.column_stack([a, d, c]),  # the diagonal (i, j)-(i+1, j+1)
+             np.column_stack([a + n, d + n, b + n]), np.column_stack([a + n, c + n, d + n])]
+    ring = np.concatenate([idx[0, :], idx[1:, -1], idx[-1, -2::-1], idx[-2:0:-1, 0]])
+    nxt = np.roll(ring, -1)
+    faces += [np.column_stack([ring, ring + n, nxt]), np.column_stack([nxt, ring + n, nxt + n])]
+    return vertices, np.vstack(faces)
+
+
+class _Frame:
+    def __init__(self, f: Field):
+        self.cx, self.cy, self.yaw = f.cx, f.cy, f.yaw
+
+    def to_world(self, uv: np.ndarray) -> np.ndarray:
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return np.column_stack([self.cx + c * uv[:, 0] - s * uv[:, 1], self.cy + s * uv[:, 0] + c * uv[:, 1]])
+
+
+def ground_scene(scene: Scene) -> Scene:
+    """``scene`` as the formats that refer to mesh files write it: every terrain piece in one mesh
+    (:data:`~worldgen.files.TERRAIN_MESH_NAME`) on a static floor node, the floor slab dropped when the
+    pieces replace it; ``scene`` itself on flat ground."""
+    replaced, pieces = ground_pieces(scene)
+    if not pieces:
+        return scene
+    vertices, faces, offset = [], [], 0
+    for piece in pieces:
+        v, f = _field_triangles(piece) if isinstance(piece, Field) else _solid_triangles(piece.points)
+        vertices.append(v)
+        faces.append(f + offset)
+        offset += len(v)
+    floor = next((n for n in scene.nodes if n.name == FLOOR_NAME), None)
+    material = floor.material if floor is not None else Material()
+    mesh = Mesh(TERRAIN_MESH_NAME, np.vstack(vertices), np.vstack(faces))
+    nodes = [n for n in scene.nodes if not (replaced and n.name == FLOOR_NAME)]
+    return scene.with_nodes(nodes + [Node(TERRAIN_NODE, "floor", mesh, material=material)])

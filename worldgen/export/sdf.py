@@ -74,6 +74,7 @@ import numpy as np
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.export.actor_path import TENSION, actor_waypoints
 from worldgen.export.formats import SDF_VERSIONS
+from worldgen.export.ground import ground_scene
 from worldgen.export.xml import XmlText, escape_text, fill, load_template
 from worldgen.files import SDF_NAME
 from worldgen.floats import fmt, fmt_seq
@@ -101,6 +102,7 @@ def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> bytes:
     skeleton is filled with lxml; the models and actors are written as text
     (:class:`~worldgen.export.xml.XmlText`).
     """
+    scene = ground_scene(scene)  # the terrain as one mesh; the scene itself on flat ground
     if version not in SDF_VERSIONS:
         raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
     if not name or name == "world" or name.startswith("__"):

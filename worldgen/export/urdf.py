@@ -48,6 +48,7 @@ import numpy as np
 
 from worldgen.errors import SceneError
 from worldgen.export.bodies import RESERVED_NAME, joints_by_child, mass_properties
+from worldgen.export.ground import ground_scene
 from worldgen.export.xml import XmlText, escape_attr, fill, load_template, sub
 from worldgen.files import URDF_NAME
 from worldgen.floats import fmt, fmt_seq
@@ -80,6 +81,7 @@ def to_urdf(scene: Scene, name: str = "world") -> bytes:
     The skeleton is filled with lxml; the materials, links, joints and
     ``<gazebo>`` blocks are written as text (:class:`~worldgen.export.xml.XmlText`).
     """
+    scene = ground_scene(scene)  # the terrain as one mesh; the scene itself on flat ground
     joints = joints_by_child(scene)
     _check_joint_names(scene, joints)
     tree = load_template(TEMPLATE)
