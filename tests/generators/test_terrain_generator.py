@@ -93,3 +93,16 @@ def test_bad_input_is_one_line_and_exit_2(tmp_path, setting, message):
 def test_a_rough_patch_smaller_than_two_cells_is_refused():
     with pytest.raises(ParameterError, match="rough_size"):
         get("terrain").resolve({"rough_size": [0.3, 0.4], "rough_cell": 0.25})
+
+
+def test_worldgen_check_re_proves_a_terrain_world_and_catches_a_changed_limit(tmp_path):
+    got = run("generate", "terrain", "--seed", "4", "--set", "n_kerbs=4", "--set", "pothole_share=0.5", "--out", tmp_path)
+    assert got.returncode == 0, got.stderr
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir()]
+    assert run("check", folder).returncode == 0
+    meta_path = folder / "world.json"
+    meta = json.loads(meta_path.read_text())
+    meta["robot"]["max_step_up"] = 0.5  # a robot that could climb anything: not the world that was proven
+    meta_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
+    checked = run("check", folder)
+    assert checked.returncode == 1 and "FAIL" in checked.stdout + checked.stderr
