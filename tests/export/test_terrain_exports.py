@@ -3,6 +3,7 @@
 terrain steps in MuJoCo without warnings; a flat world's MJCF has no trace of it."""
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -103,3 +104,33 @@ def test_the_sdf_and_urdf_terrain_mesh_is_world_json_height_and_both_files_load(
     got = mesh_top(np.asarray(mesh.triangles), points)
     assert not np.isnan(got).any()
     assert np.abs(got - terrain.heights(points)).max() < TOLERANCE
+
+
+def test_the_lidar_truth_over_terrain_is_mujocos_ray_casts_and_marks_the_ground_it_meets():
+    """A ramp higher than the scan plane reads as a wall where it rises through it: world.json's ranges agree
+    with MuJoCo's horizontal rays from the lidar's pose within 1 cm, and the rays that meet the ground are
+    marked."""
+    world = worldgen.generate("terrain", 3, size=[10, 10], n_ramps=3, ramp_rise=[0.25, 0.3], ramp_incline=[8, 9],
+                              n_kerbs=2, kerb_height=[0.15, 0.2], pothole_share=0.0, n_rough=0, n_obstacles=4,
+                              lidar_height=0.1, robot_max_incline=20, robot_max_step_up=0.3, robot_max_step_down=0.3,
+                              robot_ground_clearance=0.2)
+    lidar = json.loads(world.folder_blobs(formats=["mjcf"])["world.json"])["sensors"]["lidar"]
+    assert lidar["terrain_returns"], "no ray met the ground: the test would prove nothing"
+    model = mujoco.MjModel.from_xml_string(to_mjcf(world.scene).decode())
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    x, y, z, _, _, yaw = lidar["pose"]
+    n = lidar["samples"]
+    geom = np.zeros(1, dtype=np.int32)
+    step = (lidar["angle_max"] - lidar["angle_min"]) / (n - 1)
+    got, met = [], []
+    for i in range(n):
+        a = yaw + lidar["angle_min"] + i * step
+        d = np.array([math.cos(a), math.sin(a), 0.0])
+        start = np.array([x, y, z]) + lidar["range_min"] * d
+        hit = mujoco.mj_ray(model, data, start, d, None, 1, -1, geom)
+        got.append(lidar["range_max"] if hit < 0 else min(hit + lidar["range_min"], lidar["range_max"]))
+        met.append(hit >= 0 and mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, int(geom[0])).startswith("terrain_"))
+    assert np.abs(np.array(got) - np.array(lidar["ranges"])).max() < TOLERANCE
+    # The marked rays are exactly those whose first hit in MuJoCo is a piece of the terrain.
+    assert lidar["terrain_returns"] == np.flatnonzero(met).tolist()

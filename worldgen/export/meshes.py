@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 
 from worldgen.errors import SceneError
-from worldgen.export.ground import ground_scene
 from worldgen.floats import DECIMALS
 from worldgen.scene import Mesh, Scene
+from worldgen.scene.ground import ground_scene
 
 __all__ = ["mesh_files", "stl_bytes"]
 

@@ -38,11 +38,11 @@ from typing import Optional
 
 from worldgen.errors import SceneError
 from worldgen.export.bodies import joints_by_child, mass_properties
-from worldgen.export.ground import FLOOR_NAME, Field, ground_pieces, yaw_quat
 from worldgen.export.xml import XmlText, fill, load_template, sub
 from worldgen.files import MJCF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere
+from worldgen.scene.ground import FLOOR_NAME, Field, ground_pieces, yaw_quat
 from worldgen.scene.mover import MOVER_RGBA
 
 __all__ = ["to_mjcf", "TEMPLATE"]
@@ -164,7 +164,7 @@ def _write_geom(out: XmlText, node: Node, mesh_assets, pose_attrs: str) -> None:
 
 
 def _write_ground(out: XmlText, asset, scene: Scene, pieces) -> None:
-    """The terrain's pieces (worldgen.export.ground): a mesh asset of corner points (MuJoCo takes their
+    """The terrain's pieces (worldgen.scene.ground): a mesh asset of corner points (MuJoCo takes their
     convex hull) or a height field each, and a static geom of the floor's material for it."""
     floor = next((n for n in scene.nodes if n.name == FLOOR_NAME), None)
     rgba, friction = (floor.material.rgba, floor.material.friction) if floor is not None else ((0.7,) * 3 + (1.0,), 1.0)

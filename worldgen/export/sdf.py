@@ -74,12 +74,12 @@ import numpy as np
 from worldgen.errors import ParameterError, WorldgenError
 from worldgen.export.actor_path import TENSION, actor_waypoints
 from worldgen.export.formats import SDF_VERSIONS
-from worldgen.export.ground import ground_scene
 from worldgen.export.xml import XmlText, escape_text, fill, load_template
 from worldgen.files import SDF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose
 from worldgen.scene.graph import Joint
+from worldgen.scene.ground import ground_scene
 from worldgen.scene.mover import MOVER_RGBA, Mover
 
 __all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "HOLD_SECONDS", "script_rows", "to_sdf"]

@@ -48,11 +48,11 @@ import numpy as np
 
 from worldgen.errors import SceneError
 from worldgen.export.bodies import RESERVED_NAME, joints_by_child, mass_properties
-from worldgen.export.ground import ground_scene
 from worldgen.export.xml import XmlText, escape_attr, fill, load_template, sub
 from worldgen.files import URDF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose
+from worldgen.scene.ground import ground_scene
 
 __all__ = ["to_urdf", "TEMPLATE", "link_offset", "joint_origin"]
 
