@@ -87,7 +87,9 @@ def ground_pieces(scene: Scene, floor_thickness: Optional[float] = None) -> tupl
             profile = [(-hl, 0.0), (-hl + e.run, e.rise), (hl - e.run, e.rise), (hl, 0.0)]
             if e.landing == 0:
                 profile = [profile[0], (0.0, e.rise), profile[3]]
-            pts = [(u, v, z) for u, z in profile for v in (-hw, hw)] + [(u, v, -_SINK) for u in (-hl, hl)
+            # The inclines go on below the floor's top to the solid's sunk bottom: no lip at the foot.
+            foot = hl + _SINK * e.run / e.rise
+            pts = [(u, v, z) for u, z in profile for v in (-hw, hw)] + [(u, v, -_SINK) for u in (-foot, foot)
                                                                         for v in (-hw, hw)]
             local = np.array(pts)
             pieces.append(Solid(name, np.column_stack([e.to_world(local[:, :2]), local[:, 2]])))
