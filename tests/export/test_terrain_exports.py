@@ -90,8 +90,9 @@ def test_the_sdf_and_urdf_terrain_mesh_is_world_json_height_and_both_files_load(
     ok, messages = check_sdf(folder / SDF_NAME)
     assert ok, messages
     collisions = dump_sdf(folder / SDF_NAME)["collisions"]
-    assert [v for k, v in collisions.items() if k.startswith("terrain::")][0][0] == "mesh"
-    assert not any(k.startswith("floor::") for k in collisions)  # potholes: the slab is in the mesh, cut
+    # Potholes: the cut slab is in the mesh, which stands in the floor's place under its name.
+    assert [v[0] for k, v in collisions.items() if k.startswith("floor::")] == ["mesh"]
+    assert not any(k.startswith("terrain::") for k in collisions)
     check_urdf(folder / URDF_NAME)
     assert TERRAIN_MESH_NAME in (folder / URDF_NAME).read_text()
     mesh = trimesh.load(io.BytesIO((folder / TERRAIN_MESH_NAME).read_bytes()), file_type="stl")
@@ -134,3 +135,28 @@ def test_the_lidar_truth_over_terrain_is_mujocos_ray_casts_and_marks_the_ground_
     assert np.abs(np.array(got) - np.array(lidar["ranges"])).max() < TOLERANCE
     # The marked rays are exactly those whose first hit in MuJoCo is a piece of the terrain.
     assert lidar["terrain_returns"] == np.flatnonzero(met).tolist()
+
+
+def test_the_usd_stage_carries_the_terrain_as_a_static_triangle_mesh_collider_at_world_json_height():
+    pytest.importorskip("pxr")
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    from worldgen.export.usd import to_usd
+
+    world = worldgen.generate("terrain", 4, size=[12, 12], n_ramps=2, n_kerbs=4, pothole_share=0.5, n_rough=2,
+                              rough_amplitude=0.03, n_obstacles=3)
+    stage = Usd.Stage.CreateInMemory()
+    stage.GetRootLayer().ImportFromString(to_usd(world.scene).decode())
+    (mesh,) = [c for c in stage.GetPrimAtPath("/World/floor").GetChildren() if c.GetTypeName() == "Mesh"]
+    assert mesh.HasAPI(UsdPhysics.CollisionAPI) and mesh.HasAPI(UsdPhysics.MeshCollisionAPI)
+    assert mesh.GetAttribute("physics:approximation").Get() == "none"  # the triangles, not a hull
+    points = np.array(mesh.GetAttribute("points").Get(), dtype=float)
+    faces = np.array(mesh.GetAttribute("faceVertexIndices").Get()).reshape(-1, 3)
+    xform = np.array(UsdGeom.Xformable(mesh).ComputeLocalToWorldTransform(Usd.TimeCode.Default())).T
+    points = points @ xform[:3, :3].T + xform[:3, 3]
+    rng = np.random.default_rng(2)
+    terrain = world.scene.terrain
+    samples = np.vstack([e.to_world(rng.uniform([-e.length / 2, -e.width / 2], [e.length / 2, e.width / 2], (40, 2)))
+                         for e in terrain.elements] + [rng.uniform(-5.8, 5.8, (100, 2))])
+    got = mesh_top(points[faces], samples)
+    assert np.abs(got - terrain.heights(samples)).max() < TOLERANCE

@@ -10,8 +10,8 @@ Every piece's top is the model's ground (worldgen.scene.terrain) where it lies:
 - a rough patch is a height field with the patch's grid as its nodes, cut into the same triangles as
   the model's, and cut out of the floor like a pothole where it dips below it.
 
-Solids are given by their corner points only: MuJoCo makes a mesh without faces into its convex hull,
-and every solid here is convex.
+Every solid is a convex prism, given as two rings of corners: MuJoCo makes a mesh of the corners alone
+into their convex hull; the formats that read triangles get the prism's caps and sides.
 """
 
 from __future__ import annotations
@@ -41,7 +41,8 @@ _SINK = 0.001
 
 @dataclass(frozen=True, eq=False)
 class Solid:
-    """A convex solid: ``points`` (k, 3) world corners."""
+    """A convex prism: ``points`` (2k, 3) world corners, two rings of k in order round the same convex
+    polygon, corner i of the first joined to corner i of the second."""
 
     name: str
     points: np.ndarray
@@ -66,7 +67,7 @@ Piece = Union[Solid, Field]
 
 
 def _box(e, u0: float, u1: float, v0: float, v1: float, z0: float, z1: float) -> np.ndarray:
-    corners = np.array([[u, v] for u in (u0, u1) for v in (v0, v1)])
+    corners = np.array([[u0, v0], [u1, v0], [u1, v1], [u0, v1]])
     xy = e.to_world(corners)
     return np.vstack([np.column_stack([xy, np.full(4, z)]) for z in (z0, z1)])
 
@@ -84,14 +85,11 @@ def ground_pieces(scene: Scene, floor_thickness: Optional[float] = None) -> tupl
         name = f"terrain_{k}"
         hl, hw = e.length / 2, e.width / 2
         if isinstance(e, Ramp):
-            profile = [(-hl, 0.0), (-hl + e.run, e.rise), (hl - e.run, e.rise), (hl, 0.0)]
-            if e.landing == 0:
-                profile = [profile[0], (0.0, e.rise), profile[3]]
             # The inclines go on below the floor's top to the solid's sunk bottom: no lip at the foot.
             foot = hl + _SINK * e.run / e.rise
-            pts = [(u, v, z) for u, z in profile for v in (-hw, hw)] + [(u, v, -_SINK) for u in (-foot, foot)
-                                                                        for v in (-hw, hw)]
-            local = np.array(pts)
+            top = [(-hl + e.run, e.rise), (hl - e.run, e.rise)] if e.landing > 0 else [(0.0, e.rise)]
+            ring = [(-foot, -_SINK)] + top + [(foot, -_SINK)]
+            local = np.array([(u, v, z) for v in (-hw, hw) for u, z in ring])
             pieces.append(Solid(name, np.column_stack([e.to_world(local[:, :2]), local[:, 2]])))
         elif isinstance(e, Step) and e.height > 0:
             pieces.append(Solid(name, _box(e, -hl, hl, -hw, hw, -_SINK, e.height)))
@@ -132,15 +130,19 @@ def yaw_quat(yaw: float) -> tuple[float, float, float, float]:
 
 
 def _solid_triangles(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(vertices, faces) of the convex hull of ``points``, faces turned outward."""
-    from scipy.spatial import ConvexHull
-
-    hull = ConvexHull(points)
-    faces = hull.simplices.copy()
-    centre = points[hull.vertices].mean(axis=0)
-    for k, (a, b, c) in enumerate(faces):
-        if np.dot(np.cross(points[b] - points[a], points[c] - points[a]), points[a] - centre) < 0:
-            faces[k] = (a, c, b)
+    """(vertices, faces) of a prism given as two rings of corners (the first half of ``points`` and the
+    second, each in order round a convex polygon, corner i of one joined to corner i of the other), faces
+    turned outward."""
+    k = len(points) // 2
+    i = np.arange(k)
+    j = (i + 1) % k
+    faces = np.vstack([np.column_stack([np.zeros(k - 2, int), i[1:-1], i[2:]]),  # the two caps, as fans
+                       np.column_stack([np.full(k - 2, k), k + i[2:], k + i[1:-1]]),
+                       np.column_stack([i, j, k + j]), np.column_stack([i, k + j, k + i])])
+    centre = points.mean(axis=0)
+    a, b, c = points[faces[:, 0]], points[faces[:, 1]], points[faces[:, 2]]
+    inward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a - centre) < 0
+    faces[inward] = faces[inward][:, ::-1]
     return points, faces
 
 
@@ -176,9 +178,10 @@ class _Frame:
 
 
 def ground_scene(scene: Scene) -> Scene:
-    """``scene`` as the formats that refer to mesh files write it: every terrain piece in one mesh
-    (:data:`~worldgen.files.TERRAIN_MESH_NAME`) on a static floor node, the floor slab dropped when the
-    pieces replace it; ``scene`` itself on flat ground."""
+    """``scene`` as the formats with mesh colliders write it: every terrain piece in one mesh
+    (:data:`~worldgen.files.TERRAIN_MESH_NAME`) on a static node :data:`TERRAIN_NODE` beside the floor,
+    or, where potholes cut the floor slab (which is then in the mesh), on the floor node itself, so every
+    entity of world.json is still a body of the file; ``scene`` itself on flat ground."""
     replaced, pieces = ground_pieces(scene)
     if not pieces:
         return scene
@@ -191,5 +194,7 @@ def ground_scene(scene: Scene) -> Scene:
     floor = next((n for n in scene.nodes if n.name == FLOOR_NAME), None)
     material = floor.material if floor is not None else Material()
     mesh = Mesh(TERRAIN_MESH_NAME, np.vstack(vertices), np.vstack(faces))
-    nodes = [n for n in scene.nodes if not (replaced and n.name == FLOOR_NAME)]
-    return scene.with_nodes(nodes + [Node(TERRAIN_NODE, "floor", mesh, material=material)])
+    if replaced:  # the cut slab is in the mesh: it stands in the floor's place, under the floor's name
+        return scene.with_nodes([Node(FLOOR_NAME, "floor", mesh, material=material) if n.name == FLOOR_NAME else n
+                                 for n in scene.nodes])
+    return scene.with_nodes(list(scene.nodes) + [Node(TERRAIN_NODE, "floor", mesh, material=material)])
