@@ -37,6 +37,9 @@ class Param:
       - ``words``: 1 to MAX_ITEMS words, each one of ``choices``, kept as one
         comma-joined string (``"left,right"``) so world.json's params stay plain.
     ``default`` None means "unset" and is allowed only where ``optional``.
+    ``option_of`` names the bool parameter that switches on the option it belongs to (the switch names
+    itself): while the switch is off, the option's parameters are refused when given and not recorded, so
+    that worlds made before the option existed keep their params and bytes (cluttered's ``terrain``).
     """
 
     name: str
@@ -48,6 +51,7 @@ class Param:
     choices: tuple = ()
     optional: bool = False
     unit: str = ""
+    option_of: str = ""
 
     def __post_init__(self):
         assert self.kind in _KINDS, self.kind
@@ -164,6 +168,7 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
         # people existed keeps its params, content_hash and bytes (docs/people.md).
         for name in PEOPLE_PARAMS:
             resolved.pop(name, None)
+    _drop_idle_options(by_name, given, resolved)
     if resolved.get("people_behaviour") == "impassive":
         # Recorded only when people react to the robot: worlds made before reactions keep their bytes.
         resolved.pop("people_behaviour")
@@ -178,6 +183,21 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
                 f"got {resolved['lidar_range_min']!r}"
             )
     return resolved
+
+
+def _drop_idle_options(by_name: Mapping[str, Param], given: Mapping[str, Any], resolved: dict) -> None:
+    """An option switched off: its parameters refused when given (they would do nothing), then not recorded."""
+    for switch in sorted({p.option_of for p in by_name.values() if p.option_of}):
+        if resolved.get(switch):
+            continue
+        members = [p for p in by_name.values() if p.option_of == switch and p.name != switch]
+        idle = [p.name for p in members if given.get(p.name) is not None and resolved[p.name] != p.check(p.default)]
+        if idle:
+            raise ParameterError(f"parameter '{idle[0]}' belongs to the {switch} option, which is off: set "
+                                 f"{switch}=true too, or leave it out; got {idle[0]}={quoted(given[idle[0]])}")
+        for p in members:
+            resolved.pop(p.name, None)
+        resolved.pop(switch, None)
 
 
 #: The people's parameters: recorded in a world's params only when it has people (n_people > 0).

@@ -106,3 +106,28 @@ def test_worldgen_check_re_proves_a_terrain_world_and_catches_a_changed_limit(tm
     meta_path.write_text(json.dumps(meta, indent=2, sort_keys=True) + "\n")
     checked = run("check", folder)
     assert checked.returncode == 1 and "FAIL" in checked.stdout + checked.stderr
+
+
+def test_cluttered_takes_terrain_as_an_option_and_keeps_its_obstacles():
+    flat = worldgen.generate("cluttered", 2, size=[10, 10], n_obstacles=10)
+    bumpy = worldgen.generate("cluttered", 2, size=[10, 10], n_obstacles=10, terrain=True, n_kerbs=3,
+                              robot_max_incline=12)
+    assert flat.scene.terrain is None and "terrain" not in flat.params and "n_kerbs" not in flat.params
+    assert bumpy.params["terrain"] is True and bumpy.params["n_kerbs"] == 3
+    assert bumpy.robot.max_incline == pytest.approx(math.radians(12), abs=1e-6)
+    kinds = [type(e).__name__ for e in bumpy.scene.terrain.elements]
+    assert kinds.count("Step") == 3
+    assert flat.attempts == bumpy.attempts == 1
+    obstacles = [n for n in flat.scene.nodes if n.role == "obstacle"]
+    assert obstacles == [n for n in bumpy.scene.nodes if n.role == "obstacle"]  # the terrain has its own stream
+    assert bumpy.feasibility.check("terrain_drivable").ok
+    meta = json.loads(bumpy.folder_blobs(formats=["mjcf"])["world.json"])
+    metadata.validate(meta)
+    assert meta["schema"] == metadata.SCHEMA_TERRAIN_ID
+
+
+def test_a_terrain_parameter_without_the_option_is_one_line_and_exit_2(tmp_path):
+    got = run("generate", "cluttered", "--set", "n_kerbs=3", "--out", tmp_path)
+    assert got.returncode == 2
+    assert got.stderr.strip() == ("error: parameter 'n_kerbs' belongs to the terrain option, which is off: set "
+                                  "terrain=true too, or leave it out; got n_kerbs=3")
