@@ -61,3 +61,11 @@ def test_terrain_enters_the_content_hash_and_a_flat_scene_keeps_its_own():
     assert bumpy.content_hash() != flat.content_hash()
     assert bumpy.with_nodes(bumpy.nodes).terrain is bumpy.terrain
     assert bumpy.with_terrain(None).content_hash() == flat.content_hash()
+
+
+def test_the_robot_still_imports_from_where_it_was():
+    import worldgen.scene
+    import worldgen.scene.graph
+    import worldgen.scene.robot
+
+    assert worldgen.scene.Robot is worldgen.scene.graph.Robot is worldgen.scene.robot.Robot
