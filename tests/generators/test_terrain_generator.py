@@ -137,3 +137,15 @@ def test_a_generator_without_the_terrain_option_refuses_it_in_one_line(tmp_path)
     got = run("generate", "corridor", "--set", "terrain=true", "--out", tmp_path)
     assert got.returncode == 2 and len(got.stderr.strip().splitlines()) == 1
     assert got.stderr.startswith("error: unknown parameter 'terrain'")
+
+
+def test_a_terrain_world_is_the_same_bytes_in_another_process(tmp_path):
+    params = {"size": [12, 12], "n_ramps": 2, "n_kerbs": 3, "n_rough": 2, "pothole_share": 0.5}
+    sets = [a for k, v in params.items() for a in ("--set", f"{k}={','.join(map(str, v)) if isinstance(v, list) else v}")]
+    got = run("generate", "terrain", "--seed", "8", *sets, "--out", tmp_path)
+    assert got.returncode == 0, got.stderr
+    (folder,) = [p for p in tmp_path.iterdir() if p.is_dir()]
+    blobs = worldgen.generate("terrain", 8, **params).folder_blobs()
+    written = {p.relative_to(folder).as_posix(): p.read_bytes() for p in folder.rglob("*") if p.is_file()}
+    assert set(blobs) <= set(written)
+    assert {k: v for k, v in written.items() if k in blobs} == blobs
