@@ -160,3 +160,28 @@ def test_the_usd_stage_carries_the_terrain_as_a_static_triangle_mesh_collider_at
                          for e in terrain.elements] + [rng.uniform(-5.8, 5.8, (100, 2))])
     got = mesh_top(points[faces], samples)
     assert np.abs(got - terrain.heights(samples)).max() < TOLERANCE
+
+
+def test_the_preview_draws_the_terrain_and_its_undrivable_ground_as_no_go():
+    from worldgen.export.preview import draw
+    from worldgen.export.preview_frame import layout
+    from worldgen.export.topdown import COLOURS
+    from worldgen.scene.drivable import terrain_footprints
+
+    world = worldgen.generate("terrain", 2, size=[12, 12], n_kerbs=4, kerb_height=[0.01, 0.08], n_ramps=2,
+                              ramp_incline=[8, 14], n_rough=1)
+    meta = json.loads(world.folder_blobs(formats=["mjcf"])["world.json"])
+    image = draw(meta)
+    lay = layout(meta, image.width)
+    forbidden = {f.name.split("_edge")[0] for f in terrain_footprints(world.scene, world.robot)}
+    drivable = [e for k, e in enumerate(world.scene.terrain.elements) if f"terrain_{k}" not in forbidden]
+    undrivable = [e for k, e in enumerate(world.scene.terrain.elements) if f"terrain_{k}" in forbidden]
+    assert drivable and undrivable
+    for e in drivable:
+        assert image.getpixel(tuple(round(v) for v in lay.px(e.cx, e.cy))) == COLOURS["terrain"]
+    for e in undrivable:  # the whole element, or the ring round its edges, is tinted as a no-go zone
+        u, v = lay.px(*e.to_world(np.array([[e.length / 2 - 0.01, 0.0]]))[0])
+        assert image.getpixel((round(u), round(v))) != COLOURS["terrain"]
+    flat = dict(meta)
+    flat.pop("terrain")
+    assert np.asarray(draw(flat)).tobytes() != np.asarray(image).tobytes()

@@ -256,6 +256,22 @@ class Terrain:
                 highs.append(float(e.array.max()))
         return min(lows), max(highs)
 
+    @classmethod
+    def from_canonical(cls, entries) -> "Terrain":
+        """The terrain :meth:`canonical` (world.json's ``terrain.elements``) describes."""
+        out: list[Element] = []
+        for e in entries:
+            (cx, cy), yaw = e["centre"], e["yaw"]
+            if e["kind"] == "ramp":
+                out.append(Ramp(cx, cy, yaw, e["width"], e["rise"], e["run"], e["landing"]))
+            elif e["kind"] == "step":
+                out.append(Step(cx, cy, yaw, e["length"], e["width"], e["height"]))
+            elif e["kind"] == "rough":
+                out.append(Rough(cx, cy, yaw, e["cell"], tuple(tuple(row) for row in e["grid"])))
+            else:
+                raise SceneError(f"terrain element kind must be one of {', '.join(KINDS)}, got {e['kind']!r}")
+        return cls(tuple(out))
+
     def canonical(self) -> list[dict]:
         out = []
         for e in self.elements:
