@@ -85,7 +85,7 @@ def test_a_level_with_people_walks_them_once_per_landed_draw_and_is_the_same_in_
     ("cluttered", {"difficulty": "11/10"}, "parameter 'difficulty' must be a level 'k/10' with k in 1..10 (or the integer k), got '11/10'"),
     ("cluttered", {"difficulty": "3/5"}, "parameter 'difficulty' must be a level 'k/10'"),
     ("cluttered", {"difficulty": "7/10", "n_obstacles": 5}, "parameter 'difficulty' sets n_obstacles itself; leave out 'n_obstacles'"),
-    ("minimal", {"difficulty": "2/10"}, "parameter 'difficulty' is offered by the generators barn, cluttered, corridor, door, "
+    ("minimal", {"difficulty": "2/10"}, "parameter 'difficulty' is offered by the generators barn, cluttered, corridor, door, terrain, "
      "not by 'minimal' (it has no random draws"),
     ("door", {"difficulty": "1/10"}, "parameter 'difficulty' 1/10 is out of reach of 'door': it reaches levels 2-10"),
     ("corridor", {"difficulty": "7/10", "shape": "U"}, "parameter 'difficulty' sets n_obstacles and shape itself; "

@@ -24,7 +24,8 @@ __all__ = ["METADATA_NAME", "SCENARIO_NAME", "PREVIEW_NAME", "MAP_IMAGE_NAME", "
            "REPORT_JSON_NAME", "REPORT_CSV_NAME", "REPORT_MD_NAME", "REPORT_RUNS_DIR", "CAMPAIGN_RECIPE_NAME",
            "VERDICTS_NAME", "FAILURES_NAME", "STRATEGY_NAME", "FAILURE_MAP_NAME", "CAMPAIGN_STATE_DIR", "RUNS_DIR",
            "SHRUNK_DIR", "PLOTS_DIR", "creation_mode", "safe_relative", "write_atomically", "atomic_folder",
-           "write_folder_atomically", "move_into_place", "refuse_other_world", "recorded_content_hash"]
+           "write_folder_atomically", "move_into_place", "refuse_other_world", "recorded_content_hash",
+           "TERRAIN_MESH_NAME"]
 
 #: A world folder: its ground truth, scenario, picture and nav2 map.
 METADATA_NAME = "world.json"
@@ -39,6 +40,8 @@ MJCF_NAME = "world.mjcf.xml"
 URDF_NAME = "world.urdf"
 USDA_NAME = "world.usda"
 USDC_NAME = "world.usdc"
+#: The terrain's ground as one triangle mesh, for the formats that refer to mesh files (docs/terrain.md).
+TERRAIN_MESH_NAME = "meshes/terrain.stl"
 #: A pack folder: the manifest (written last: its presence means the build finished), the index, the worlds.
 MANIFEST_NAME = "manifest.json"
 INDEX_NAME = "index.csv"

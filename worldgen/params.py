@@ -14,7 +14,8 @@ from typing import Any, Mapping, Optional, Sequence
 from worldgen.errors import ParameterError, did_you_mean, quoted
 from worldgen.floats import round_float
 
-__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "PEOPLE_PARAMS", "describe_range"]
+__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "PEOPLE_PARAMS", "describe_range",
+           "CLIMB_PARAMS"]
 
 _KINDS = ("float", "int", "bool", "choice", "pair", "range", "triple", "list", "words")
 #: Most items a ``list`` or ``words`` parameter may hold.
@@ -36,6 +37,9 @@ class Param:
       - ``words``: 1 to MAX_ITEMS words, each one of ``choices``, kept as one
         comma-joined string (``"left,right"``) so world.json's params stay plain.
     ``default`` None means "unset" and is allowed only where ``optional``.
+    ``option_of`` names the bool parameter that switches on the option it belongs to (the switch names
+    itself): while the switch is off, the option's parameters are refused when given and not recorded, so
+    that worlds made before the option existed keep their params and bytes (cluttered's ``terrain``).
     """
 
     name: str
@@ -47,6 +51,7 @@ class Param:
     choices: tuple = ()
     optional: bool = False
     unit: str = ""
+    option_of: str = ""
 
     def __post_init__(self):
         assert self.kind in _KINDS, self.kind
@@ -163,6 +168,7 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
         # people existed keeps its params, content_hash and bytes (docs/people.md).
         for name in PEOPLE_PARAMS:
             resolved.pop(name, None)
+    _drop_idle_options(by_name, given, resolved)
     if resolved.get("people_behaviour") == "impassive":
         # Recorded only when people react to the robot: worlds made before reactions keep their bytes.
         resolved.pop("people_behaviour")
@@ -177,6 +183,21 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
                 f"got {resolved['lidar_range_min']!r}"
             )
     return resolved
+
+
+def _drop_idle_options(by_name: Mapping[str, Param], given: Mapping[str, Any], resolved: dict) -> None:
+    """An option switched off: its parameters refused when given (they would do nothing), then not recorded."""
+    for switch in sorted({p.option_of for p in by_name.values() if p.option_of}):
+        if resolved.get(switch):
+            continue
+        members = [p for p in by_name.values() if p.option_of == switch and p.name != switch]
+        idle = [p.name for p in members if given.get(p.name) is not None and resolved[p.name] != p.check(p.default)]
+        if idle:
+            raise ParameterError(f"parameter '{idle[0]}' belongs to the {switch} option, which is off: set "
+                                 f"{switch}=true too, or leave it out; got {idle[0]}={quoted(given[idle[0]])}")
+        for p in members:
+            resolved.pop(p.name, None)
+        resolved.pop(switch, None)
 
 
 #: The people's parameters: recorded in a world's params only when it has people (n_people > 0).
@@ -274,4 +295,14 @@ COMMON_PARAMS: tuple[Param, ...] = (
     Param("map_height", "float", 0.1,
           "height of the horizontal slice the occupancy map is made from (above the floor slab)", 0.001, 50.0, unit="m"),
     Param("map_resolution", "float", 0.05, "edge of one occupancy map cell", 0.005, 10.0, unit="m"),
+)
+
+
+#: The robot's climbing limits (docs/terrain.md), taken by generators that make terrain: not common, so that
+#: a flat world's params (and bytes) stay as they were. Defaults: worldgen.scene.terrain.CLIMB_DEFAULTS.
+CLIMB_PARAMS: tuple[Param, ...] = (
+    Param("robot_max_incline", "float", 10.0, "steepest ground the robot drives on", 0.0, 45.0, unit="deg"),
+    Param("robot_max_step_up", "float", 0.02, "highest step edge the robot climbs", 0.0, 0.5, unit="m"),
+    Param("robot_max_step_down", "float", 0.02, "deepest step edge the robot drives down", 0.0, 0.5, unit="m"),
+    Param("robot_ground_clearance", "float", 0.03, "height of the chassis above flat ground", 0.0, 0.5, unit="m"),
 )

@@ -19,7 +19,7 @@ def test_every_episode_is_a_world_at_the_level_asked_for():
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"generator": "cluttered", "difficulty": "12/10"}, "parameter 'difficulty' must be a level 'k/10'"),
-    ({"generator": "minimal", "difficulty": "3/10"}, "parameter 'difficulty' is offered by the generators barn, cluttered, corridor, door, not by 'minimal'"),
+    ({"generator": "minimal", "difficulty": "3/10"}, "parameter 'difficulty' is offered by the generators barn, cluttered, corridor, door, terrain, not by 'minimal'"),
 ])
 def test_a_bad_level_fails_when_the_env_is_made(kwargs, message):
     with pytest.raises(ParameterError, match=message):

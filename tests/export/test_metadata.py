@@ -83,7 +83,7 @@ def test_schema_is_valid_draft_2020_12_and_shipped_with_the_package():
     schema = metadata.schema()
     jsonschema.Draft202012Validator.check_schema(schema)
     assert schema["$schema"] == "https://json-schema.org/draft/2020-12/schema"
-    assert schema["properties"]["schema"]["const"] == metadata.SCHEMA_ID
+    assert schema["properties"]["schema"]["enum"] == [metadata.SCHEMA_ID, metadata.SCHEMA_TERRAIN_ID]
 
 
 def _walk_properties(node, path="$"):
@@ -254,7 +254,8 @@ MUTATIONS = {
     "absolute file path": lambda m: m["files"]["sdf"].update(path="/etc/passwd"),
     "file path escaping": lambda m: m["files"]["sdf"].update(path="../world.sdf"),
     "unknown file key": lambda m: m["files"].update(obj={"path": "w.obj", "sha256": "c" * 64}),
-    "wrong schema id": lambda m: m.update(schema="worldgen.world/2"),
+    "wrong schema id": lambda m: m.update(schema="worldgen.world/3"),
+    "a flat world saying it has terrain": lambda m: m.update(schema="worldgen.world/2"),
     "content hash without prefix": lambda m: m.update(content_hash="0" * 64),
     "huge number": lambda m: m["robot"].update(radius=1e301),
     "free_area_ratio above 1": lambda m: m["metrics"].update(free_area_ratio=1.5),

@@ -17,6 +17,7 @@ import numpy as np
 from worldgen.errors import SceneError
 from worldgen.floats import DECIMALS
 from worldgen.scene import Mesh, Scene
+from worldgen.scene.ground import ground_scene
 
 __all__ = ["mesh_files", "stl_bytes"]
 
@@ -42,6 +43,7 @@ def mesh_files(scene: Scene) -> dict[str, bytes]:
     Two nodes may share a uri only when they share the geometry (their scales
     may differ); anything else would make one file stand for two shapes.
     """
+    scene = ground_scene(scene)  # the terrain's mesh, where there is terrain
     files: dict[str, bytes] = {}
     owners: dict[str, tuple[str, Mesh]] = {}
     for node in scene.nodes:

@@ -25,10 +25,14 @@ from worldgen.groundtruth import difficulty, truth
 from worldgen.scene.doors import door_records
 from worldgen.scene.footprint import scene_footprints
 
-__all__ = ["SCHEMA_ID", "build", "dumps", "schema", "validate", "free_area_ratio", "mover_entry", "person_entry"]
+__all__ = ["SCHEMA_ID", "SCHEMA_TERRAIN_ID", "build", "dumps", "schema", "validate", "free_area_ratio", "mover_entry",
+           "person_entry"]
 
 #: The value of world.json's ``schema`` field; a breaking change bumps the number.
 SCHEMA_ID = "worldgen.world/1"
+#: The ``schema`` of a world with terrain: a reader of /1 would take its ground for flat, so terrain
+#: worlds say /2 (docs/terrain.md); flat worlds keep /1 and their bytes.
+SCHEMA_TERRAIN_ID = "worldgen.world/2"
 
 #: Segments per quarter circle when a disc footprint becomes a polygon for area sums:
 #: the polygon's area is within 0.1 % of the disc's.
@@ -97,7 +101,21 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
     people = [m for m in scene.movers if m.person]
     if people:  # only then, so that every world without people keeps its bytes
         _add_people(meta, world, people)
+    if scene.terrain is not None:  # only then, so that every flat world keeps its bytes
+        _add_terrain(meta, world)
     return _plain(meta)
+
+
+def _add_terrain(meta: dict, world) -> None:
+    """world.json's ``terrain``, the robot's climbing limits and each task's ``terrain`` (docs/terrain.md)."""
+    terrain = world.scene.terrain
+    meta["schema"] = SCHEMA_TERRAIN_ID
+    meta["robot"].update(world.robot.limits())
+    meta["terrain"] = {"elements": terrain.canonical(), "height_range": list(terrain.extent())}
+    figures = list(getattr(world.feasibility, "terrain", ()))
+    figures += [None] * max(0, len(meta["tasks"]) - len(figures))
+    for entry, fig in zip(meta["tasks"], figures):
+        entry["terrain"] = None if fig is None else fig.entry()
 
 
 def _add_people(meta: dict, world, people) -> None:

@@ -42,6 +42,7 @@ from worldgen.export.xml import XmlText, fill, load_template, sub
 from worldgen.files import MJCF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere
+from worldgen.scene.ground import FLOOR_NAME, Field, ground_pieces, yaw_quat
 from worldgen.scene.mover import MOVER_RGBA
 
 __all__ = ["to_mjcf", "TEMPLATE"]
@@ -73,8 +74,12 @@ def to_mjcf(scene: Scene, name: str = "world") -> bytes:
     for node in scene.nodes:  # one pass, keeping the scene's node order
         children.setdefault(node.parent, []).append(node)
     out = XmlText(depth=2)
+    replaced, pieces = ground_pieces(scene)  # nothing on flat ground
     for node in children.get(None, ()):
-        _write_node(out, node, joints, children, mesh_assets)
+        if not (replaced and node.name == FLOOR_NAME):
+            _write_node(out, node, joints, children, mesh_assets)
+    if pieces:
+        _write_ground(out, root.find("asset"), scene, pieces)
     _write_mocap(out, scene)
     return fill(tree, root.find("worldbody"), out)
 
@@ -156,6 +161,27 @@ def _write_geom(out: XmlText, node: Node, mesh_assets, pose_attrs: str) -> None:
     visual = "" if node.collision else ' contype="0" conaffinity="0" group="2"'
     out.empty("geom", f' name="{node.name}"{kind}{pose_attrs} rgba="{fmt_seq(node.material.rgba)}"'
                       f' friction="{friction}"{visual}')
+
+
+def _write_ground(out: XmlText, asset, scene: Scene, pieces) -> None:
+    """The terrain's pieces (worldgen.scene.ground): a mesh asset of corner points (MuJoCo takes their
+    convex hull) or a height field each, and a static geom of the floor's material for it."""
+    floor = next((n for n in scene.nodes if n.name == FLOOR_NAME), None)
+    rgba, friction = (floor.material.rgba, floor.material.friction) if floor is not None else ((0.7,) * 3 + (1.0,), 1.0)
+    look = f' rgba="{fmt_seq(rgba)}" friction="{fmt_seq((friction, TORSIONAL_FRICTION, ROLLING_FRICTION))}"'
+    for piece in pieces:
+        if isinstance(piece, Field):
+            low, high = float(piece.grid.min()), float(piece.grid.max())
+            rise = max(high - low, 1e-6)  # MuJoCo scales the elevations to [0, 1] of this
+            sub(asset, "hfield", name=piece.name, nrow=str(piece.grid.shape[0]), ncol=str(piece.grid.shape[1]),
+                size=fmt_seq((piece.length / 2, piece.width / 2, rise, piece.base)),
+                # MuJoCo's first row of elevations lies at the largest y: the grid's rows go in reversed.
+                elevation=fmt_seq(((piece.grid - low) / rise)[::-1].ravel()))
+            out.empty("geom", f' name="{piece.name}" type="hfield" hfield="{piece.name}"'
+                              f' pos="{fmt_seq((piece.cx, piece.cy, low))}" quat="{fmt_seq(yaw_quat(piece.yaw))}"{look}')
+        else:
+            sub(asset, "mesh", name=piece.name, vertex=fmt_seq(piece.points.ravel()))
+            out.empty("geom", f' name="{piece.name}" type="mesh" mesh="{piece.name}"{look}')
 
 
 def _write_mocap(out: XmlText, scene: Scene) -> None:

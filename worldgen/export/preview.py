@@ -123,6 +123,7 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
     for ring in unreachable:
         pen.shape("poly", ring, fill=COLOURS["unreachable"])
     _grid(pen, (bx0, by0, bx1, by1), _grid_step(lay.scale))
+    undrivable = _terrain(pen, meta)
 
     for e in entities:  # colliders the robot passes under (a door head): a thin outline, beneath the rest
         if e["role"] not in HIDDEN_ROLES and e["role"] != "door" and not blocking(e, robot):
@@ -135,6 +136,8 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
     for e in entities:
         if blocking(e, robot):
             mask_pen.shape(*_inflated(*_outline(e), grow), fill=255)
+    for ring in undrivable:  # ground the robot cannot drive is a no-go zone like an obstacle's
+        mask_pen.shape(*_inflated("poly", ring, grow), fill=255)
     big.paste(COLOURS["nogo"], mask=mask.point(lambda v: round(v * NOGO_ALPHA)))
 
     layer_order = {"marker": 0, "obstacle": 1, "door_frame": 2, "wall": 3}
@@ -169,6 +172,26 @@ def draw(meta: Mapping[str, Any], width: int = DEFAULT_WIDTH) -> Image.Image:
     title(image, meta, lay)
     footer(image, lay, legend(meta, bool(unreachable)))
     return image
+
+
+def _terrain(pen: Pen, meta: Mapping[str, Any]) -> list[np.ndarray]:
+    """Draw world.json's terrain (each element's outline, filled) and return the rings of the ground its
+    robot cannot drive (worldgen.scene.drivable); nothing on flat ground."""
+    if not meta.get("terrain"):
+        return []
+    from worldgen.groundtruth.folder import robot_of
+    from worldgen.scene import Scene
+    from worldgen.scene.drivable import terrain_footprints
+    from worldgen.scene.terrain import Terrain
+
+    terrain = Terrain.from_canonical(meta["terrain"]["elements"])
+    for e in terrain.elements:
+        pen.shape("poly", np.asarray(e.outline().exterior.coords)[:-1], fill=COLOURS["terrain"],
+                  outline=COLOURS["terrain_edge"], width=1)
+    (x0, y0), (x1, y1) = meta["bounds"]["min"], meta["bounds"]["max"]
+    scene = Scene((), bounds=((x0, y0), (x1, y1)), terrain=terrain)
+    return [np.asarray(f.polygon.exterior.coords)[:-1] for f in terrain_footprints(scene, robot_of(meta))
+            if f.polygon is not None]
 
 
 def _unreachable(meta: Mapping[str, Any], entities) -> list[np.ndarray]:

@@ -79,6 +79,7 @@ from worldgen.files import SDF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Mesh, Node, Pose, Scene, Sphere, matrix_to_pose
 from worldgen.scene.graph import Joint
+from worldgen.scene.ground import ground_scene
 from worldgen.scene.mover import MOVER_RGBA, Mover
 
 __all__ = ["SDF_VERSIONS", "TEMPLATE", "MIN_MOMENT", "TRAJECTORY_TYPE", "HOLD_SECONDS", "script_rows", "to_sdf"]
@@ -101,6 +102,7 @@ def to_sdf(scene: Scene, version: str = "1.9", name: str = "default") -> bytes:
     skeleton is filled with lxml; the models and actors are written as text
     (:class:`~worldgen.export.xml.XmlText`).
     """
+    scene = ground_scene(scene)  # the terrain as one mesh; the scene itself on flat ground
     if version not in SDF_VERSIONS:
         raise ParameterError(f"parameter 'sdf_version' must be one of {', '.join(SDF_VERSIONS)}, got {version!r}")
     if not name or name == "world" or name.startswith("__"):

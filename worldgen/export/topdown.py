@@ -40,6 +40,8 @@ COLOURS = {
     "nogo": (232, 72, 64),          # blended at preview_frame.NOGO_ALPHA over what lies beneath
     "wall": (45, 45, 55),
     "obstacle": (84, 104, 140),
+    "terrain": (222, 206, 170),     # ramps, kerbs, potholes, rough patches (docs/terrain.md)
+    "terrain_edge": (160, 130, 80),
     "overhead": (150, 160, 180),    # outline of colliders the robot passes under
     "frame": (105, 80, 60),
     "door": (176, 112, 48),

@@ -52,6 +52,7 @@ from worldgen.export.xml import XmlText, escape_attr, fill, load_template, sub
 from worldgen.files import URDF_NAME
 from worldgen.floats import fmt, fmt_seq
 from worldgen.scene import Box, Cylinder, Joint, Mesh, Node, Scene, Sphere, matrix_to_pose
+from worldgen.scene.ground import ground_scene
 
 __all__ = ["to_urdf", "TEMPLATE", "link_offset", "joint_origin"]
 
@@ -80,6 +81,7 @@ def to_urdf(scene: Scene, name: str = "world") -> bytes:
     The skeleton is filled with lxml; the materials, links, joints and
     ``<gazebo>`` blocks are written as text (:class:`~worldgen.export.xml.XmlText`).
     """
+    scene = ground_scene(scene)  # the terrain as one mesh; the scene itself on flat ground
     joints = joints_by_child(scene)
     _check_joint_names(scene, joints)
     tree = load_template(TEMPLATE)

@@ -44,6 +44,7 @@ from worldgen.files import USDC_NAME
 from worldgen.floats import fmt, round_float
 from worldgen.scene import Mesh, Node, Scene
 from worldgen.scene.graph import Joint, Task
+from worldgen.scene.ground import ground_scene
 
 __all__ = ["to_usd", "to_usdc", "RESERVED", "SHAPE_PRIM", "MIN_MOMENT", "material_name"]
 
@@ -82,6 +83,7 @@ def to_usdc(scene: Scene, name: str = "default", tasks: Sequence[Task] = (), dur
 
 def _layer(scene: Scene, name: str, tasks: Sequence[Task], duration: float):
     pxr = require_pxr()
+    scene = ground_scene(scene)  # the terrain as one mesh collider; the scene itself on flat ground
     taken = [n.name for n in scene.nodes if n.name in RESERVED] + [j.name for j in scene.joints if j.name == SHAPE_PRIM]
     if taken:
         raise WorldgenError(f"the USD exporter reserves the names {', '.join(RESERVED)}; "

@@ -29,10 +29,12 @@ from worldgen.feasibility.geometry import Obstacles2D
 from worldgen.feasibility.passage import narrowest_passage
 from worldgen.feasibility.report import CHECKER, Check, FeasibilityReport, TaskPath
 from worldgen.feasibility.route import waypoints
+from worldgen.feasibility.terrain import terrain_check
 from worldgen.feasibility.verify import verify_path
 from worldgen.floats import DECIMALS
 from worldgen.scene import Robot, Scene, Task
 from worldgen.scene.doors import door_joints, fixed_scene, open_scene
+from worldgen.scene.drivable import terrain_footprints
 from worldgen.scene.footprint import SAFETY, robot_footprints
 
 __all__ = ["check"]
@@ -67,12 +69,17 @@ def check(scene: Scene, tasks: Sequence[Task], robot: Robot) -> FeasibilityRepor
     free = {label: _free(label, tasks, robot, pts, colliders, initial_colliders)
             for label, pts in (("spawn", spawns), ("goal", goals))}
     plans = _Plans.of(scene, tasks, robot, colliders, spawns, goals)
-    checks = (inside, free["spawn"], free["goal"], plans.path_exists(), plans.path_clearance(tasks, robot))
+    checks: tuple[Check, ...] = (inside, free["spawn"], free["goal"], plans.path_exists(),
+                                 plans.path_clearance(tasks, robot))
+    on_terrain: tuple = ()
+    if scene.terrain is not None:  # only then, so that flat worlds keep their reports
+        drivable, figures = terrain_check(scene, tasks, robot, plans.paths)
+        checks, on_terrain = checks + (drivable,), tuple(figures)
     narrowest = min(plans.passages) if plans.passages and not plans.no_path else None
     informational: tuple[Check, ...] = ()
     if door_joints(initial):
         informational = (_reachable_initial(initial, tasks, robot),)
-    return FeasibilityReport(checks, tuple(plans.paths), narrowest, CHECKER, informational)
+    return FeasibilityReport(checks, tuple(plans.paths), narrowest, CHECKER, informational, terrain=on_terrain)
 
 
 def _inside_bounds(bounds, tasks, robot: Robot, spawns: np.ndarray, goals: np.ndarray) -> Check:
@@ -111,7 +118,8 @@ class _Plans:
     @classmethod
     def of(cls, scene: Scene, tasks, robot: Robot, colliders, spawns: np.ndarray, goals: np.ndarray) -> "_Plans":
         bounds = scene.bounds
-        obstacles = Obstacles2D.from_footprints(robot_footprints(scene, robot))
+        # Ground the robot cannot drive is an obstacle like any other (worldgen.scene.drivable).
+        obstacles = Obstacles2D.from_footprints(robot_footprints(scene, robot) + terrain_footprints(scene, robot))
         cspace = ConfigSpace.build(obstacles, robot.inflation + SAFETY, bounds)
         planner = exact_planner(cspace, len(tasks))
         slack = cspace.points_clearance(np.vstack([spawns, goals]))

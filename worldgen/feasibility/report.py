@@ -62,6 +62,9 @@ class FeasibilityReport:
     #: With people: per task, the certificate among them (a TimedPath of
     #: :mod:`worldgen.people.timed`, None where there is none); () without people.
     timed_paths: tuple = ()
+    #: On terrain: per task, the terrain along its path (a PathTerrain of
+    #: :mod:`worldgen.feasibility.terrain`, None where there is no path); () on flat ground.
+    terrain: tuple = ()
 
     @property
     def feasible(self) -> bool:

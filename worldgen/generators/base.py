@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from typing import Any, Callable, Mapping, Optional
@@ -9,9 +10,11 @@ from typing import Any, Callable, Mapping, Optional
 import numpy as np
 
 from worldgen.errors import ParameterError
+from worldgen.floats import round_float
 from worldgen.generators.knob import Knob
 from worldgen.params import COMMON_PARAMS, Param, validate_params
 from worldgen.scene import Robot, Scene, Task
+from worldgen.scene.robot import CLIMB_DEFAULTS
 
 __all__ = ["Draft", "GeneratorSpec", "robot_from_params"]
 
@@ -80,4 +83,7 @@ class GeneratorSpec:
 
 
 def robot_from_params(params: Mapping[str, Any]) -> Robot:
-    return Robot(params["robot_radius"], params["robot_height"], params["clearance"])
+    limits = {name: params[f"robot_{name}"] for name in CLIMB_DEFAULTS if f"robot_{name}" in params}
+    if "max_incline" in limits:  # given in degrees, kept in radians as every angle of a world
+        limits["max_incline"] = round_float(math.radians(limits["max_incline"]))
+    return Robot(params["robot_radius"], params["robot_height"], params["clearance"], **limits)

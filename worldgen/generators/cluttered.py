@@ -10,6 +10,7 @@ more tasks does not move a single obstacle.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any, Mapping
 
 import numpy as np
@@ -20,11 +21,12 @@ from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.knob import Knob
 from worldgen.generators.room import floor_node, room_bounds, wall_nodes
 from worldgen.generators.tasks import TASK_PARAMS, check_task_params, sample_tasks
-from worldgen.params import Param
+from worldgen.generators.terrain_layout import TERRAIN_PARAMS, check_terrain, with_terrain
+from worldgen.params import CLIMB_PARAMS, Param
 from worldgen.scene import Box, Cylinder, Material, Node, Physics, Pose, Scene, Shape
 from worldgen.scene.footprint import FootprintIndex, robot_footprints
 
-__all__ = ["SPEC", "KNOB", "build"]
+__all__ = ["SPEC", "KNOB", "build", "place_obstacles", "obstacle_count", "BASE_PARAMS"]
 
 #: Tries to place one obstacle before the draw counts as overcrowded.
 PLACEMENT_TRIES = 60
@@ -36,7 +38,7 @@ OBSTACLE_DENSITY = 300.0
 BOX_RGBA = (0.80, 0.52, 0.25, 1.0)
 CYLINDER_RGBA = (0.25, 0.50, 0.75, 1.0)
 
-PARAMS = (
+BASE_PARAMS = (
     Param("size", "pair", [10.0, 10.0], "inner extents (x, y) of the room, centred on the origin", 1.0, 500.0, unit="m"),
     Param("n_obstacles", "int", 20, "number of obstacles (ignored when density is set)", 0, MAX_OBSTACLES),
     Param("density", "float", None, "obstacles per square metre of floor; replaces n_obstacles when set",
@@ -53,6 +55,13 @@ PARAMS = (
     Param("wall_thickness", "float", 0.1, "thickness of the walls", 0.01, 10.0, unit="m"),
     Param("min_spawn_goal_distance", "float", 3.0, "smallest straight-line distance from spawn to goal", 0.0, 1000.0, unit="m"),
 ) + TASK_PARAMS
+
+#: The terrain option (docs/terrain.md): off by default, and then neither refused nor recorded, so every
+#: cluttered world made before it keeps its params and bytes.
+PARAMS = BASE_PARAMS + (
+    Param("terrain", "bool", False, "add ramps, kerbs, potholes and rough patches among the obstacles (the terrain "
+          "generator's parameters below; docs/terrain.md)", option_of="terrain"),
+) + tuple(replace(p, option_of="terrain") for p in TERRAIN_PARAMS + CLIMB_PARAMS)
 
 
 def check(params: Mapping[str, Any]) -> None:
@@ -78,6 +87,8 @@ def check(params: Mapping[str, Any]) -> None:
             f"parameter 'density' gives {count} obstacles on this {sx:g} x {sy:g} m floor; at most {MAX_OBSTACLES} "
             f"(density <= {MAX_OBSTACLES / (sx * sy):.4g} here), got {params['density']!r}")
     check_task_params(params, room_bounds(params["size"]))
+    if params.get("terrain"):
+        check_terrain(params)
 
 
 def obstacle_count(params: Mapping[str, Any]) -> int:
@@ -95,14 +106,20 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     nodes = [floor_node(size, params["wall_thickness"] if params["walls"] else 0.5, friction)]
     if params["walls"]:
         nodes += wall_nodes(size, params["wall_height"], params["wall_thickness"], friction)
-    obstacles = _place_obstacles(params, obstacle_rng, bounds, obstacle_count(params))
+    obstacles = place_obstacles(params, obstacle_rng, bounds, obstacle_count(params))
     if obstacles is None:
         return Draft(None, rejected="obstacle_placement",
                      detail=f"could not place {obstacle_count(params)} obstacles with min_gap {params['min_gap']:g} m")
     nodes += obstacles
     scene = Scene(tuple(nodes), (), bounds, Physics(params["step_size"], params["real_time_factor"]))
     robot = robot_from_params(params)
-    index = FootprintIndex(robot_footprints(scene, robot))
+    off_terrain: list = []
+    if params.get("terrain"):  # a third stream, spawned only then: the obstacles and tasks keep theirs
+        made = with_terrain(scene, params, rng.spawn(1)[0], robot)
+        if isinstance(made, str):
+            return Draft(None, rejected="terrain_placement", detail=made)
+        scene, off_terrain = made
+    index = FootprintIndex(robot_footprints(scene, robot) + off_terrain)
     tasks, reason = sample_tasks(task_rng, index, bounds, robot, params["n_tasks"],
                                  params["min_spawn_goal_distance"], params["goal_tolerance"],
                                  params["spawn"], params["goal"], params["task_region"])
@@ -111,7 +128,7 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     return Draft(scene, tuple(tasks))
 
 
-def _place_obstacles(params, rng: np.random.Generator, bounds, count: int):
+def place_obstacles(params, rng: np.random.Generator, bounds, count: int):
     """Obstacle nodes placed with the minimum gap, or None when the room is too full."""
     (x0, y0), (x1, y1) = bounds
     gap = params["min_gap"]

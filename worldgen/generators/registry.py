@@ -36,8 +36,9 @@ def _load_builtins() -> None:
     from worldgen.generators.corridor import SPEC as CORRIDOR
     from worldgen.generators.door import SPEC as DOOR
     from worldgen.generators.minimal import SPEC as MINIMAL
+    from worldgen.generators.terrain import SPEC as TERRAIN
 
-    for spec in (CLUTTERED, DOOR, MINIMAL, CORRIDOR, BARN):
+    for spec in (CLUTTERED, DOOR, MINIMAL, CORRIDOR, BARN, TERRAIN):
         register(spec)
 
 

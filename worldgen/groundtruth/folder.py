@@ -29,6 +29,7 @@ from typing import Any, Callable, Mapping, Optional
 from worldgen.errors import ParameterError
 from worldgen.files import METADATA_NAME
 from worldgen.scene import Robot
+from worldgen.scene.robot import CLIMB_DEFAULTS
 
 __all__ = ["WorldFolder", "open_world", "is_world_folder", "task_of", "robot_of"]
 
@@ -56,7 +57,8 @@ def robot_of(meta: Mapping[str, Any]) -> Robot:
     """The footprint of world.json's ``robot`` (radius, height, clearance) as the :class:`~worldgen.scene.Robot`
     a World carries."""
     r = meta["robot"]
-    return Robot(float(r["radius"]), float(r["height"]), float(r["clearance"]))
+    limits = {k: float(r[k]) for k in CLIMB_DEFAULTS if k in r}  # on terrain only (docs/terrain.md)
+    return Robot(float(r["radius"]), float(r["height"]), float(r["clearance"]), **limits)
 
 
 class WorldFolder:

@@ -62,7 +62,7 @@ class Ground:
                 kept = tuple(n for n in scene.nodes if not _on_leaf(scene, n, leaves))
                 names = {n.name for n in kept} | {"world"}
                 joints = tuple(j for j in scene.joints if j.parent in names and j.child in names)
-                self._fixed_colliders = Colliders(Scene(kept, joints, scene.bounds, scene.physics, scene.movers))
+                self._fixed_colliders = Colliders(Scene(kept, joints, scene.bounds, scene.physics, scene.movers, scene.terrain))
             else:
                 meta = dict(self.meta, entities=[e for e in self.meta["entities"] if e["name"] not in leaves])
                 self._fixed_colliders = _entity_colliders(meta, self._read)

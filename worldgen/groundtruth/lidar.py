@@ -29,6 +29,7 @@ from typing import Mapping
 import numpy as np
 
 from worldgen.scene import Pose, Scene
+from worldgen.scene.ground import ground_scene
 
 __all__ = ["LidarSpec", "spec_from_params", "angles", "directions", "cast", "scan", "describe", "FULL_CIRCLE"]
 
@@ -93,16 +94,23 @@ def scan(scene: Scene, spec: LidarSpec) -> np.ndarray:
 
 
 def describe(scene: Scene, spec: LidarSpec) -> dict:
-    """world.json's ``sensors.lidar`` block."""
-    return {
+    """world.json's ``sensors.lidar`` block. On terrain the rays meet the ground too (its pieces as the
+    exported mesh carries them, worldgen.scene.ground): a slope rising into the scan plane reads as a wall,
+    and ``terrain_returns`` lists the rays whose return is the ground's, not an obstacle's."""
+    ground = ground_scene(scene)
+    ranges = scan(ground, spec)
+    out = {
         "pose": spec.pose.as_list(),
         "angle_min": spec.angle_min,
         "angle_max": spec.angle_max,
         "samples": spec.samples,
         "range_min": spec.range_min,
         "range_max": spec.range_max,
-        "ranges": scan(scene, spec).tolist(),
+        "ranges": ranges.tolist(),
     }
+    if ground is not scene:  # only on terrain, so that flat worlds keep their bytes
+        out["terrain_returns"] = np.flatnonzero(ranges < scan(scene, spec) - 1e-9).tolist()
+    return out
 
 
 def cast(scene: Scene, origin: np.ndarray, dirs: np.ndarray, start: float = 0.0) -> np.ndarray:

@@ -14,6 +14,7 @@ from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME
 from worldgen.groundtruth import barn as barn_grid
 from worldgen.groundtruth import lidar, metrics, occupancy
+from worldgen.groundtruth.terrain import with_undrivable
 from worldgen.params import COMMON_PARAMS
 from worldgen.scene import Pose
 from worldgen.scene.doors import open_scene
@@ -65,8 +66,9 @@ def planning_scene(world):
 
 def occupancy_map(world) -> occupancy.OccupancyMap:
     if world not in _MAPS:
-        _MAPS[world] = occupancy.build(planning_scene(world), float(_param(world, "map_height")),
-                                       float(_param(world, "map_resolution")))
+        grid = occupancy.build(planning_scene(world), float(_param(world, "map_height")),
+                               float(_param(world, "map_resolution")))
+        _MAPS[world] = with_undrivable(grid, world.scene, world.robot)  # on terrain: ground it cannot drive
     return _MAPS[world]
 
 
@@ -82,7 +84,8 @@ def start_occupancy_map(world) -> occupancy.OccupancyMap:
     """The occupancy map of the scene as it starts (every door leaf where it starts), with map.pgm's
     height, resolution and extent: what a localiser meets at the spawn. world.json's map stays
     :func:`occupancy_map` (the planning scene); the ROS 2 bundle gives nav2 this one."""
-    return occupancy.build(world.scene, float(_param(world, "map_height")), float(_param(world, "map_resolution")))
+    grid = occupancy.build(world.scene, float(_param(world, "map_height")), float(_param(world, "map_resolution")))
+    return with_undrivable(grid, world.scene, world.robot)
 
 
 def occupancy_block(world) -> dict:

@@ -196,4 +196,4 @@ def _with_common_extras(request: Request, draft: Draft, number: int):
 def _infeasible_on_purpose(report) -> bool:
     """A world asked to be infeasible: its start and goal are fine, and the route is what fails."""
     failed = {c.name for c in report.failed()}
-    return bool(failed) and failed <= {"path_exists", "path_clearance", "timed_path"}
+    return bool(failed) and failed <= {"path_exists", "path_clearance", "timed_path", "terrain_drivable"}

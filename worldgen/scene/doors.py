@@ -168,7 +168,7 @@ def fixed_scene(scene: Scene) -> Scene:
     if not doors:
         return scene
     joints = tuple(Joint(j.name, "fixed", j.parent, j.child, j.pose) if j.name in doors else j for j in scene.joints)
-    return Scene(scene.nodes, joints, scene.bounds, scene.physics, scene.movers)
+    return Scene(scene.nodes, joints, scene.bounds, scene.physics, scene.movers, scene.terrain)
 
 
 def leaves_in_the_way(scene: Scene, waypoints, radius: float, height: float) -> list[str]:

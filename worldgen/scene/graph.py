@@ -12,7 +12,7 @@ import json
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Iterable, Optional
+from typing import TYPE_CHECKING, Iterable, Optional
 
 import numpy as np
 
@@ -21,9 +21,15 @@ from worldgen.floats import round_float
 from worldgen.scene.mover import Mover
 from worldgen.scene.names import NAME_PATTERN
 from worldgen.scene.pose import Pose
+from worldgen.scene.robot import CLIMB_DEFAULTS, Robot
 from worldgen.scene.shapes import Box, Cylinder, Mesh, Shape, Sphere, canonical_shape, unit_inertia
 
-__all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN", "Mover"]
+if TYPE_CHECKING:
+    from worldgen.scene.terrain import Terrain
+
+# Robot lives in worldgen.scene.robot; it is still importable from here, where it was first.
+__all__ = ["ROLES", "Material", "Node", "Joint", "Scene", "Task", "Robot", "Physics", "NAME_PATTERN", "Mover",
+           "CLIMB_DEFAULTS"]
 
 #: Every role a node may have. Markers carry no collision geometry.
 ROLES = ("floor", "wall", "obstacle", "door", "door_frame", "marker")
@@ -127,23 +133,6 @@ class Task:
 
 
 @dataclass(frozen=True)
-class Robot:
-    """The footprint every feasibility figure is computed for: a vertical cylinder.
-
-    ``clearance`` is the margin kept between the footprint's edge and any obstacle.
-    """
-
-    radius: float
-    height: float
-    clearance: float
-
-    @property
-    def inflation(self) -> float:
-        """Radius of the disc that must never touch an obstacle: radius + clearance."""
-        return self.radius + self.clearance
-
-
-@dataclass(frozen=True)
 class Physics:
     """World-level simulation settings, written into every format that can hold them.
 
@@ -177,6 +166,7 @@ class Scene:
     bounds: tuple[tuple[float, float], tuple[float, float]] = ((-5.0, -5.0), (5.0, 5.0))
     physics: Physics = Physics()
     movers: tuple[Mover, ...] = ()
+    terrain: Optional["Terrain"] = None
 
     def __post_init__(self):
         object.__setattr__(self, "nodes", tuple(self.nodes))
@@ -326,6 +316,8 @@ class Scene:
             },
             # Only where there are movers, so that worlds without any keep their hashes.
             **({"movers": [m.canonical() for m in self.movers]} if self.movers else {}),
+            # Only on terrain, so that flat worlds keep their hashes.
+            **({"terrain": self.terrain.canonical()} if self.terrain is not None else {}),
         }
 
     def content_hash(self) -> str:
@@ -334,10 +326,13 @@ class Scene:
         return "sha256:" + hashlib.sha256(text.encode()).hexdigest()
 
     def with_nodes(self, nodes: Iterable[Node]) -> "Scene":
-        return Scene(tuple(nodes), self.joints, self.bounds, self.physics, self.movers)
+        return Scene(tuple(nodes), self.joints, self.bounds, self.physics, self.movers, self.terrain)
 
     def with_movers(self, movers: Iterable[Mover]) -> "Scene":
-        return Scene(self.nodes, self.joints, self.bounds, self.physics, tuple(movers))
+        return Scene(self.nodes, self.joints, self.bounds, self.physics, tuple(movers), self.terrain)
+
+    def with_terrain(self, terrain: Optional["Terrain"]) -> "Scene":
+        return Scene(self.nodes, self.joints, self.bounds, self.physics, self.movers, terrain)
 
 
 def _canonical_node(n: Node) -> dict:
