@@ -279,8 +279,9 @@ def test_a_budget_of_seconds_stops_asking_when_it_is_spent(tmp_path):
     assert 1 <= s.runs <= 4 and s.stopped == "the budget's 1 s", s.lines()
 
 
-def test_a_scheduler_out_of_reach_is_one_line_and_leaves_nothing_written(tmp_path):
+def test_a_scheduler_out_of_reach_is_one_line_and_leaves_nothing_written(tmp_path, monkeypatch):
     pytest.importorskip("distributed")
+    monkeypatch.setattr("worldgen.campaign.runner.CONNECT_TIMEOUT", "1s")  # nothing listens: no need to wait 10 s
     with pytest.raises(ParameterError, match="cannot reach the dask scheduler"):
         run(parse_campaign(SHRINKABLE), tmp_path / "new" / "out", scheduler="tcp://127.0.0.1:9", system=WEAK)
     assert not (tmp_path / "new").exists()

@@ -39,11 +39,13 @@ from worldgen.campaign.strategies import Strategy
 from worldgen.errors import InfeasibleError, ParameterError, WorldgenError
 from worldgen.files import RUNS_DIR, WORLDS_DIR
 
-__all__ = ["run", "evaluate", "CampaignSummary", "CampaignInterrupted", "MAX_JOBS", "MAX_BARREN"]
+__all__ = ["run", "evaluate", "CampaignSummary", "CampaignInterrupted", "MAX_JOBS", "MAX_BARREN", "CONNECT_TIMEOUT"]
 
 MAX_JOBS = 256
 #: Points in a row without a world after which a campaign stops: its space holds (almost) no worlds.
 MAX_BARREN = 100
+#: How long a campaign waits for a Dask scheduler to answer before it says it cannot reach it.
+CONNECT_TIMEOUT = "10s"
 _progress = logging.getLogger("worldgen.progress")
 _VERDICT_ORDER = ("failed", "passed", "unjudged")
 
@@ -239,7 +241,7 @@ class _Loop:
             if scheduler is None:
                 cluster = LocalCluster(n_workers=jobs, threads_per_worker=1, processes=True, dashboard_address=None,
                                        silence_logs=logging.ERROR)
-            client = Client(scheduler or cluster, timeout="10s")
+            client = Client(scheduler or cluster, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError) as exc:
             if cluster is not None:
                 cluster.close()
