@@ -14,12 +14,7 @@ from typing import Any, Optional
 
 from worldgen.errors import ParameterError
 
-__all__ = ["Outcome", "RECORDED", "bag_of", "record", "as_walked", "judged", "unjudged", "said"]
-
-#: The topics a run the campaign records itself (a policy's episode) is written with: what `worldgen drive`
-#: records, the simulator's own pose (``/ground_truth``) first among them.
-RECORDED = ("clock", "odom", "tf", "cmd_vel", "ground_truth")
-
+__all__ = ["Outcome", "bag_of", "as_walked", "judged", "unjudged", "said"]
 
 @dataclass(frozen=True)
 class Outcome:
@@ -50,20 +45,6 @@ def bag_of(world: Path, task: str, run: str, workdir: Path) -> Path:
         bag.unlink()
     bag.parent.mkdir(parents=True, exist_ok=True)
     return bag
-
-
-def record(bag: Path, trajectory, commands, meta: dict, task: dict, run: str) -> Path:
-    """The (n, 4) ``t, x, y, yaw`` trajectory and (m, 3) ``t, v, w`` commands as a rosbag2 folder at ``bag``
-    naming its world, task and run, complete or absent: written aside, then moved in whole."""
-    from worldgen.files import write_folder_atomically
-    from worldgen.ros import write_run
-
-    spawn = task["spawn"]
-    with tempfile.TemporaryDirectory(prefix="worldgen-campaign-") as tmp:
-        written = write_run(Path(tmp) / bag.name, trajectory, spawn=(spawn[0], spawn[1], spawn[5]), commands=commands,
-                            topics=RECORDED, world_id=meta["world_id"], task=task["id"], run=run)
-        blobs = {str(p.relative_to(written)): p.read_bytes() for p in sorted(written.rglob("*")) if p.is_file()}
-    return write_folder_atomically(bag.parent, bag.name, blobs)
 
 
 def as_walked(world: Path, meta: dict, walked: dict, into: Path) -> Path:

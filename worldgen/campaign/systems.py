@@ -44,7 +44,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping, Optional, Protocol
 
 from worldgen.campaign.command import DEFAULT_TIMEOUT, PLACEHOLDERS, CommandSystem, check_template, check_timeout
-from worldgen.campaign.judging import Outcome, as_walked, bag_of, judged, record, said, unjudged
+from worldgen.campaign.judging import Outcome, as_walked, bag_of, judged, said, unjudged
 from worldgen.errors import ParameterError, SimulatorError, quoted
 
 __all__ = ["Outcome", "System", "PolicySystem", "DriveSystem", "CommandSystem", "SYSTEM_KEYS", "PLACEHOLDERS",
@@ -169,6 +169,7 @@ class PolicySystem:
 
         import worldgen.envs  # noqa: F401  (registers worldgen/Navigation-v0)
         from worldgen.envs.source import FolderSource
+        from worldgen.sim.drive import record_run
 
         started = time.perf_counter()
         bag = bag_of(world, task, run, workdir)
@@ -196,7 +197,7 @@ class PolicySystem:
             walked = walkers.reacted if walkers is not None else {}
         finally:
             env.close()
-        record(bag, trajectory, commands, meta, chosen, run)
+        record_run(bag, trajectory, commands, meta, chosen, run)
         # People who react to the robot walked elsewhere than world.json has them: the run is judged against
         # where they went, as the environment judges its episodes (a person who stepped aside is not hit).
         truth = as_walked(Path(world), meta, walked, bag.parent.parent / "walked" / bag.name) if walked else Path(world)

@@ -21,7 +21,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any, Callable, Mapping, Optional
 
 from worldgen.errors import ParameterError, quoted
@@ -229,27 +228,13 @@ class PackSource:
         return longest, True
 
     def world(self, index: int) -> EpisodeWorld:
-        from lxml import etree
-
-        from worldgen.export.xml import safe_parser
         from worldgen.groundtruth.ground import load as ground_of
 
         pw = self.pack[index]
         meta = pw.metadata
-        task = _checked_task(pw.world_id, pw.task())
-        if "mjcf" in meta.get("files", {}):
-            root = etree.fromstring(pw.reader.file_bytes("mjcf"), safe_parser())
-        else:
-            root = self._regenerated_mjcf(pw, meta)
-        params = dict(meta.get("params", {}))
-        return EpisodeWorld(
-            world_id=pw.world_id, mjcf=root, robot=pw.robot,
-            task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
-            floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
-            lidar_height=float(params.get("lidar_height", 0.3)), params=params,
-            _ground=lambda: ground_of(pw), _metadata=lambda: meta, _scene=lambda: self._regenerated(pw, meta).scene,
-            bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
-            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
+        mjcf = pw.reader.file_bytes("mjcf") if "mjcf" in meta.get("files", {}) else None
+        return _episode_world(pw.reader, pw.task(), mjcf or self._regenerated(pw, meta).to_mjcf().encode(),
+                              ground=lambda: ground_of(pw), scene=lambda: self._regenerated(pw, meta).scene)
 
     @staticmethod
     def _regenerated(pw, meta):
@@ -264,12 +249,6 @@ class PackSource:
                                  "and, for the geodesic reward, its scene")
         return world
 
-    @classmethod
-    def _regenerated_mjcf(cls, pw, meta):
-        from worldgen.export.xml import parse_bytes
-
-        return parse_bytes(cls._regenerated(pw, meta).to_mjcf().encode()).getroot()
-
 
 class FolderSource:
     """One written world folder for every episode, driving ``task`` (a task id of its world.json; None: the
@@ -279,16 +258,17 @@ class FolderSource:
     (:func:`worldgen.groundtruth.ground.load`); the MJCF must be there (a campaign writes it)."""
 
     def __init__(self, folder, task: Optional[str] = None):
+        from worldgen.groundtruth.folder import open_world
         from worldgen.groundtruth.ground import load
 
         self.folder = Path(folder)
         self.ground = load(self.folder)
-        meta = self.ground.meta
-        ids = [str(t["id"]) for t in meta["tasks"]]
+        self.reader = open_world(self.folder)
+        ids = list(self.reader.task_ids)
         if task is not None and task not in ids:
             raise ParameterError(f"parameter 'task' must be one of the world's tasks ({', '.join(ids)}), got {task!r}")
         self.task = task if task is not None else ids[0]
-        if "mjcf" not in meta.get("files", {}):
+        if "mjcf" not in self.reader.metadata.get("files", {}):
             raise ParameterError(f"world folder '{folder}' has no MJCF file; write the world with format mjcf "
                                  "to run it in the environment")
 
@@ -296,43 +276,32 @@ class FolderSource:
         return 0
 
     def world(self, seed) -> EpisodeWorld:
-        from lxml import etree
+        from worldgen.verify import load_world
 
-        from worldgen.export.xml import safe_parser
-
-        meta = self.ground.meta
-        world_id = str(meta["world_id"])
-        task = _checked_task(world_id, next(t for t in meta["tasks"] if t["id"] == self.task))
-        root = etree.fromstring((self.folder / meta["files"]["mjcf"]["path"]).read_bytes(), safe_parser())
-        r = meta["robot"]
-        params = dict(meta.get("params", {}))
-        return EpisodeWorld(
-            world_id=world_id, mjcf=root, robot=Robot(float(r["radius"]), float(r["height"]), float(r["clearance"])),
-            task=task, movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
-            floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
-            lidar_height=float(params.get("lidar_height", 0.3)), params=params,
-            _ground=lambda: self.ground, _metadata=lambda: meta,
-            _scene=lambda: _edited_scene(world_id, meta),
-            bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
-            door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
+        # The scene (reacting people, the geodesic reward): the world rebuilt with its recorded edits (a shrunk
+        # world, an edited level) and proven the one recorded.
+        return _episode_world(self.reader, self.reader.task(self.task), self.reader.file_bytes("mjcf"),
+                              ground=lambda: self.ground, scene=lambda: load_world(self.folder).scene)
 
 
-def _edited_scene(world_id: str, meta: dict):
-    """The scene of a written world (what reacting people and the geodesic reward need): regenerated from its
-    recorded generator, seed and parameters, its recorded ``edits`` applied (a shrunk world, an edited
-    level), and checked against its ``content_hash``."""
-    if not meta.get("edits"):
-        return PackSource._regenerated(SimpleNamespace(world_id=world_id), meta).scene
-    from worldgen.api import generate
-    from worldgen.verify.edits import with_edits
+def _episode_world(reader, task: dict, mjcf: bytes, ground: Callable[[], Any], scene: Callable[[], Any]) -> EpisodeWorld:
+    """The episode world of a written world (``reader``: :func:`worldgen.groundtruth.folder.open_world`'s)
+    driving ``task``, with its MJCF bytes; its ground truth and scene are made on first use."""
+    from lxml import etree
 
-    base = generate(meta["generator"], meta["seed"], allow_infeasible=meta["feasibility"].get("allow_infeasible", False),
-                    **meta["params"])
-    world = with_edits(base, meta["edits"])  # proven once, the world replay_edits rebuilds edit by edit
-    if world is None or world.content_hash != meta["content_hash"]:
-        raise ParameterError(f"world {world_id} does not regenerate with its edits with this worldgen version; "
-                             "the environment needs its scene for reacting people and the geodesic reward")
-    return world.scene
+    from worldgen.export.xml import safe_parser
+
+    meta = reader.metadata
+    params = dict(meta.get("params", {}))
+    return EpisodeWorld(
+        world_id=reader.world_id, mjcf=etree.fromstring(mjcf, safe_parser()), robot=reader.robot,
+        task=_checked_task(reader.world_id, task),
+        movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
+        floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
+        lidar_height=float(params.get("lidar_height", 0.3)), params=params,
+        _ground=ground, _metadata=lambda: meta, _scene=scene,
+        bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
+        door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):

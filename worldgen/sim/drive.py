@@ -39,8 +39,12 @@ from worldgen.groundtruth.folder import WorldFolder, open_world
 from worldgen.sim.schedule import Plan, plan_for
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "CATCH_UP",
-           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "ON_THE_SPOT", "Outcome", "controller", "drive", "run_loop", "steps_per_command"]
+           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "ON_THE_SPOT", "RUN_TOPICS", "Outcome", "controller", "drive",
+           "record_run", "run_loop", "steps_per_command"]
 
+#: The topics a simulated run is recorded with (write_run's names), the simulator's own pose (``/ground_truth``)
+#: among them.
+RUN_TOPICS = ("clock", "odom", "tf", "cmd_vel", "ground_truth")
 #: Simulators ``worldgen drive --sim`` knows.
 SIMS = ("gazebo", "mujoco")
 SPEED = 0.5            # m/s forward
@@ -223,7 +227,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     finally:
         backend.close()
     wall["drive"] = time.perf_counter() - started - wall["plan"]
-    _write_bag(bag, trajectory, commands, meta, chosen, run_part)
+    record_run(bag, trajectory, commands, meta, chosen, run_part)
     wall["record"] = time.perf_counter() - started - wall["plan"] - wall["drive"]
     result = judge([bag], world=world)
     wall["judge"] = time.perf_counter() - started - sum(wall.values())
@@ -250,21 +254,21 @@ def _scene_of(world: WorldFolder):
     return again.scene
 
 
-def _write_bag(bag: Path, trajectory, commands, meta: dict, task: dict, run: str) -> None:
-    """The run as a rosbag2 folder at ``bag``, complete or absent: written aside, then moved in whole."""
+def record_run(bag: Path, trajectory, commands, meta: dict, task: dict, run: str) -> Path:
+    """The (n, 4) ``t, x, y, yaw`` trajectory and (m, 3) ``t, v, w`` commands of a simulated run as a rosbag2
+    folder at ``bag`` naming its world, task and run (the topics :data:`RUN_TOPICS`), complete or absent:
+    written aside, then moved in whole. What `worldgen drive` and a campaign's policy episode record."""
     import tempfile
 
     from worldgen.files import write_folder_atomically
     from worldgen.ros import write_run
 
     spawn = task["spawn"]
-    with tempfile.TemporaryDirectory(prefix="worldgen-drive-") as tmp:
-        write_run(Path(tmp) / bag.name, trajectory, spawn=(spawn[0], spawn[1], spawn[5]), commands=commands,
-                  topics=("clock", "odom", "tf", "cmd_vel", "ground_truth"), world_id=meta["world_id"],
-                  task=task["id"], run=run)
-        blobs = {str(p.relative_to(Path(tmp) / bag.name)): p.read_bytes()
-                 for p in sorted((Path(tmp) / bag.name).rglob("*")) if p.is_file()}
-    write_folder_atomically(bag.parent, bag.name, blobs)
+    with tempfile.TemporaryDirectory(prefix="worldgen-run-") as tmp:
+        written = write_run(Path(tmp) / bag.name, trajectory, spawn=(spawn[0], spawn[1], spawn[5]), commands=commands,
+                            topics=RUN_TOPICS, world_id=meta["world_id"], task=task["id"], run=run)
+        blobs = {str(p.relative_to(written)): p.read_bytes() for p in sorted(written.rglob("*")) if p.is_file()}
+    return write_folder_atomically(bag.parent, bag.name, blobs)
 
 
 def _verdict(run: dict, ended: str) -> str:
