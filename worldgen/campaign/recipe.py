@@ -34,8 +34,7 @@ from typing import Any, Mapping, Optional
 import yaml
 
 from worldgen.errors import ParameterError, WorldgenError, did_you_mean, quoted, read_user_text
-from worldgen.pack.recipe import _NAME, PHYSICS_PARAMS, RecipeError
-from worldgen.pack.recipe import _Reader as _PackReader
+from worldgen.pack.recipe import _NAME, PHYSICS_PARAMS, RecipeError, RecipeReader
 from worldgen.seeding import check_seed
 
 __all__ = ["CampaignRecipe", "Entry", "Range", "load_campaign", "parse_campaign", "identity_of", "without_idle_people",
@@ -142,7 +141,7 @@ def parse_campaign(text: str, source: str = "<campaign>", default_name: str = "c
     return CampaignRecipe(name, entries, system, verdict, runs, seconds, strategy, seed, r.value(root))
 
 
-class _Reader(_PackReader):
+class _Reader(RecipeReader):
     """The pack recipe's reader (mapping, value, fail, difficulty, _check, _check_level) with the campaign's keys."""
 
     # long: one space entry's keys checked in order, each with its own message (as a pack entry's)

@@ -50,7 +50,8 @@ from worldgen.export.formats import ALL_FORMATS, FORMATS, SDF_VERSIONS, normalis
 from worldgen.floats import round_float
 from worldgen.seeding import MAX_SEED, recipe_rng
 
-__all__ = ["Job", "Recipe", "load_recipe", "parse_recipe", "TOP_KEYS", "ENTRY_KEYS", "DIFFICULTY_KEYS", "PHYSICS_PARAMS"]
+__all__ = ["Job", "Recipe", "load_recipe", "parse_recipe", "TOP_KEYS", "ENTRY_KEYS", "DIFFICULTY_KEYS", "PHYSICS_PARAMS",
+           "RecipeReader"]
 
 TOP_KEYS = ("name", "formats", "sdf_version", "preview", "ros", "seeds", "worlds")
 ENTRY_KEYS = ("generator", "preset", "params", "physics", "seeds", "difficulty")
@@ -124,7 +125,7 @@ def parse_recipe(text: str, source: str = "<recipe>", default_name: str = "pack"
         line = f":{mark.line + 1}" if mark is not None else ""
         what = " ".join(str(getattr(exc, "problem", None) or exc).split())
         raise RecipeError(f"{source}{line}: not valid YAML: {what}") from None
-    r = _Reader(source)
+    r = RecipeReader(source)
     if root is None:
         raise RecipeError(f"{source}:1: the recipe is empty; it needs at least 'worlds'")
     top = r.mapping(root, "recipe", TOP_KEYS)
@@ -184,8 +185,9 @@ def _osc_needs_ros(r, top, formats, ros) -> None:
         r.fail(top["formats"], "formats", "osc writes scenarios that start each world's ROS 2 bundle: add 'ros: true'")
 
 
-class _Reader:
-    """Walks composed YAML nodes; every complaint names the key and the node's line."""
+class RecipeReader:
+    """Walks composed YAML nodes; every complaint names the key and the node's line (pack recipes, and the
+    campaign recipes built on it)."""
 
     def __init__(self, source: str):
         self.source = source
