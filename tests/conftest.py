@@ -18,3 +18,21 @@ if ON_CI:
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+# The Gazebo installs the gazebo group runs in (tests/sim, the bundle's Gazebo test): each located once a
+# session; a missing one skips on a laptop and fails on CI (support.gazebo).
+@pytest.fixture(scope="session")
+def install():
+    """The default Gazebo install."""
+    from support.gazebo import gazebo_install
+
+    return gazebo_install()
+
+
+@pytest.fixture(scope="session")
+def installs():
+    """``installs(release)``: the install of that release."""
+    from support.gazebo import install_cache
+
+    return install_cache()

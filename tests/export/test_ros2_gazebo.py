@@ -22,7 +22,6 @@ import time
 from pathlib import Path
 
 import pytest
-from support.gazebo import gazebo_install, install_cache
 
 import worldgen
 from worldgen.export.contract import SIM_GZ_RELEASES
@@ -34,14 +33,6 @@ pytestmark = pytest.mark.gazebo
 SIGTERM_TIMEOUT = SIGKILL_TIMEOUT = 5.0
 
 
-@pytest.fixture(scope="module")
-def install():
-    return gazebo_install()
-
-
-@pytest.fixture(scope="module")
-def installs():
-    return install_cache()
 
 
 @pytest.fixture(scope="module")

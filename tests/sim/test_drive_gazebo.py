@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from support.cli import run as run_cli
-from support.gazebo import gazebo_install, install_cache, release_cases, scan_stamp
+from support.gazebo import gazebo_install, release_cases, scan_stamp
 
 import worldgen
 from worldgen import oracles
@@ -30,10 +30,6 @@ GENERATORS = ("barn", "cluttered", "corridor", "door", "minimal")
 def gazebo():
     return gazebo_install()  # the gazebo group's one finder: skips on a laptop, fails on CI
 
-
-@pytest.fixture(scope="module")
-def installs():
-    return install_cache()
 
 
 @pytest.fixture(scope="module")

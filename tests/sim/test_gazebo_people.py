@@ -12,7 +12,7 @@ import json
 
 import numpy as np
 import pytest
-from support.gazebo import install_cache, lidar_robot_sdf, release_cases, scan_ranges, scan_stamp, seen_centres
+from support.gazebo import lidar_robot_sdf, release_cases, scan_ranges, scan_stamp, seen_centres
 
 import worldgen
 from worldgen.presets import generate_preset
@@ -25,10 +25,6 @@ pytestmark = pytest.mark.gazebo
 CENTRE_TOL = 0.01
 STEP = 0.002  # every world's physics step (s)
 
-
-@pytest.fixture(scope="module")
-def installs():
-    return install_cache()
 
 
 def worlds():

@@ -10,17 +10,13 @@ import math
 
 import numpy as np
 import pytest
-from support.gazebo import install_cache, lidar_robot_sdf, scan_ranges
+from support.gazebo import lidar_robot_sdf, scan_ranges
 
 import worldgen
 from worldgen.sim.gazebo import GazeboServer
 
 pytestmark = pytest.mark.gazebo
 
-
-@pytest.fixture(scope="module")
-def installs():
-    return install_cache()
 
 
 @pytest.mark.parametrize(("release", "server"), [("fortress", "fortress"), ("harmonic", "fortress"),

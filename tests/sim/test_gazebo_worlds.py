@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
-from support.gazebo import gazebo_install, install_cache, pose_errors, release_cases
+from support.gazebo import pose_errors, release_cases
 
 import worldgen
 from worldgen.export.contract import SIM_GZ_RELEASES
@@ -52,14 +52,6 @@ CASES = [f"generator:{g}" for g in GENERATORS] + [f"preset:{p}" for p in names()
 SAMPLE = {f"generator:{g}" for g in GENERATORS} | {"movers"}
 
 
-@pytest.fixture(scope="module")
-def install():
-    return gazebo_install()
-
-
-@pytest.fixture(scope="module")
-def installs():
-    return install_cache()
 
 
 @pytest.mark.parametrize(("release", "case"), release_cases(CASES, SAMPLE))
