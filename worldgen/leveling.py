@@ -217,10 +217,12 @@ def _scale(knob: Knob, params: Mapping[str, Any]) -> float:
 
 
 def _without_people(params: Mapping[str, Any]) -> dict:
-    """``params`` with every people parameter left out (a world without people refuses them)."""
-    from worldgen.params import PEOPLE_PARAMS
+    """``params`` with every people parameter left out (a world without people refuses them), and the robot's
+    motion limits too unless it has movers (only people or movers have a certificate they bound)."""
+    from worldgen.params import MOTION_PARAMS, PEOPLE_PARAMS
 
-    return {k: v for k, v in params.items() if k not in PEOPLE_PARAMS}
+    drop = PEOPLE_PARAMS + (() if params.get("n_movers") else MOTION_PARAMS)
+    return {k: v for k, v in params.items() if k not in drop}
 
 
 def _last(draws: list) -> str:

@@ -14,7 +14,7 @@ from typing import Any, Mapping, Optional, Sequence
 from worldgen.errors import ParameterError, did_you_mean, quoted
 from worldgen.floats import round_float
 
-__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "PEOPLE_PARAMS", "describe_range",
+__all__ = ["Param", "validate_params", "parse_value", "COMMON_PARAMS", "PEOPLE_PARAMS", "MOTION_PARAMS", "describe_range",
            "CLIMB_PARAMS"]
 
 _KINDS = ("float", "int", "bool", "choice", "pair", "range", "triple", "list", "words")
@@ -156,17 +156,20 @@ def validate_params(specs: Sequence[Param], given: Mapping[str, Any]) -> dict[st
     for name in sorted(by_name):
         p = by_name[name]
         resolved[name] = p.check(given.get(name, p.default))
+    moving = bool(resolved.get("n_people") or resolved.get("n_movers"))
     if not resolved.get("n_people"):
         # People's parameters without people would be accepted and do nothing: a mistake to say.
-        idle = [n for n in PEOPLE_PARAMS if n != "n_people" and n in by_name and given.get(n) is not None
-                and resolved[n] != by_name[n].check(by_name[n].default)]
-        if idle:
-            raise ParameterError(f"parameter '{idle[0]}' sets how people walk, and this world has none: set n_people "
-                                 f"(1 or more) too, or leave it out; got {idle[0]}={quoted(given[idle[0]])} and "
-                                 f"n_people={quoted(resolved.get('n_people', 0))}")
+        _refuse_idle(by_name, given, resolved, [n for n in PEOPLE_PARAMS if n != "n_people"],
+                     "sets how people walk, and this world has none: set n_people (1 or more) too", "n_people")
         # A world without people records none of their parameters, so that every world made before
         # people existed keeps its params, content_hash and bytes (docs/people.md).
         for name in PEOPLE_PARAMS:
+            resolved.pop(name, None)
+    if not moving:
+        # The robot's motion limits bound the timed certificate, which only a world with people or movers has.
+        _refuse_idle(by_name, given, resolved, list(MOTION_PARAMS), "bounds the timed path among people and "
+                     "movers, and this world has neither: set n_people or n_movers (1 or more) too", "n_people")
+        for name in MOTION_PARAMS:
             resolved.pop(name, None)
     _drop_idle_options(by_name, given, resolved)
     if resolved.get("people_behaviour") == "impassive":
@@ -202,7 +205,19 @@ def _drop_idle_options(by_name: Mapping[str, Param], given: Mapping[str, Any], r
 
 #: The people's parameters: recorded in a world's params only when it has people (n_people > 0).
 PEOPLE_PARAMS = ("n_people", "person_radius", "person_speed", "people_duration", "people_scenario", "group_size",
-                 "people_behaviour", "robot_turn_rate", "robot_acceleration")
+                 "people_behaviour")
+#: The robot's motion limits the timed certificate keeps to: recorded only in a world with people or movers.
+MOTION_PARAMS = ("robot_turn_rate", "robot_acceleration")
+
+
+def _refuse_idle(by_name, given, resolved, names, what: str, switch: str) -> None:
+    """One line naming the first of ``names`` given a value other than its default, which ``what`` says
+    does nothing in this world."""
+    idle = [n for n in names if n in by_name and given.get(n) is not None
+            and resolved[n] != by_name[n].check(by_name[n].default)]
+    if idle:
+        raise ParameterError(f"parameter '{idle[0]}' {what}, or leave it out; got {idle[0]}={quoted(given[idle[0]])}"
+                             f" and {switch}={quoted(resolved.get(switch, 0))}")
 
 
 def parse_value(p: Param, text: str) -> Any:

@@ -110,7 +110,14 @@ def test_movers_never_reshuffle_obstacles_or_tasks():
     three = worldgen.generate("cluttered", seed=5, size=[10, 10], n_obstacles=12, n_movers=3)
     for w in (one, three):
         assert w.scene.nodes == base.scene.nodes and w.tasks == base.tasks
-        assert w.metadata["tasks"] == base.metadata["tasks"]
+        # The static task is the same; a world with movers adds its certificate among them (docs/people.md),
+        # and a time limit that a run keeping to it never exceeds.
+        certified = ("timed_path", "arrival_time", "time_limit")
+        for entry, static in zip(w.metadata["tasks"], base.metadata["tasks"]):
+            assert {k: v for k, v in entry.items() if k not in certified} == \
+                {k: v for k, v in static.items() if k not in certified}
+            assert entry["arrival_time"] > 0 and entry["time_limit"] >= static["time_limit"]
+            assert entry["time_limit"] >= entry["arrival_time"]
     assert one.scene.movers[0] == three.scene.movers[0]  # more movers leave the first one alone
     assert base.content_hash != one.content_hash != three.content_hash  # the hash covers movers
     assert base.scene.canonical().get("movers") is None  # worlds without movers keep their hashes

@@ -221,7 +221,7 @@ def test_a_draw_without_a_timed_path_is_refused_and_counted():
     # A 1.5 m corridor: the robot cannot pass a person in it along its path, and people end up standing in it.
     with pytest.raises(InfeasibleError) as err:
         worldgen.generate("corridor", seed=0, max_attempts=2, length=10.0, n_people=3, people_duration=20.0)
-    assert "timed_path failed 2x" in str(err.value) and "no timed path among the people" in str(err.value)
+    assert "timed_path failed 2x" in str(err.value) and "no timed path among the 3 people for task_0: they leave no way through" in str(err.value)
     w = worldgen.generate("corridor", seed=0, max_attempts=1, allow_infeasible=True, length=10.0, n_people=3,
                           people_duration=20.0)
     meta = w.metadata
@@ -311,3 +311,86 @@ def test_a_path_of_many_corners_is_given_time_to_stop_and_turn_at_each():
     turning = sum(math.ceil(a / (lim.turn_rate * DT) - 1e-9) * DT for a in turn_angles(waypoints, 0.0))
     assert found is not None and found.arrival > length / lim.max_speed + turning + 5.0
     _assert_drivable(found.rows, 0.0, lim.turn_rate, lim.acceleration)
+
+
+# -- movers: agents of the same certificate ---------------------------------------------------------------------
+
+def _looping_at(track: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Where a looping script is at times ``t``: its rows again every period (its last row's time)."""
+    return _interp(track, np.mod(t, track[-1, 0]))
+
+
+def _verify_movers(meta: dict) -> float:
+    """Every task's timed path of a world.json dict with movers, checked at a fine step against each mover's
+    loop (and each person's walk) and the robot's limits; the smallest gap beyond the certified distance."""
+    robot = meta["robot"]
+    inflation, v_max = robot["radius"] + robot["clearance"] + robot["tracking_margin"], robot["max_speed"]
+    agents = [(np.array(m["trajectory"]), m["radius"], bool(m["loop"])) for m in meta["dynamic_obstacles"]]
+    agents += [(np.array(p["trajectory"]), p["radius"], False) for p in meta.get("people", [])]
+    w = v_max + max(float(np.max(np.hypot(*np.diff(t[:, 1:], axis=0).T) / np.diff(t[:, 0]))) for t, _, _ in agents)
+    worst = math.inf
+    for task in meta["tasks"]:
+        rows = np.array(task["timed_path"])
+        assert rows[-1, 0] == task["arrival_time"] <= task["time_limit"]
+        np.testing.assert_allclose(rows[[0, -1], 1:], [task["spawn"][:2], task["goal"][:2]], atol=1e-6)
+        assert (np.hypot(*np.diff(rows[:, 1:], axis=0).T) / np.diff(rows[:, 0])).max() <= v_max
+        _assert_drivable(rows, task["spawn"][-1], robot["max_turn_rate"], robot["max_acceleration"])
+        t = np.arange(0.0, rows[-1, 0] + H, H)
+        me = _interp(rows, t)
+        for track, radius, loop in agents:
+            them = _looping_at(track, t) if loop else _interp(track, t)
+            worst = min(worst, float((np.hypot(*(me - them).T) - (inflation + radius)).min() - w * H / 2))
+    return worst
+
+
+@pytest.mark.parametrize("generator,params,seeds", [
+    ("cluttered", {"size": [8.0, 8.0], "n_obstacles": 10, "n_movers": 3, "n_tasks": 2}, 3),
+    ("corridor", {"n_movers": 2, "width": 3.0}, 2),
+    ("door", {"n_movers": 2, "n_people": 2, "people_duration": 10.0}, 1),
+])
+def test_worlds_with_movers_carry_a_timed_path_clear_of_every_loop(generator, params, seeds):
+    for seed in range(seeds):
+        world = worldgen.generate(generator, seed=seed, **params)
+        meta = world.metadata
+        metadata.validate(meta)
+        assert meta["robot"]["max_turn_rate"] == 1.0 and meta["robot"]["max_acceleration"] == 1.0
+        assert _verify_movers(meta) >= 0.0, (generator, seed)
+
+
+def _crossing_loop() -> tuple[np.ndarray, np.ndarray]:
+    """A 10 m straight path, and a mover crossing it at x = 5 back and forth at 2 m/s, every 3 s."""
+    return np.array([[0.0, 0.0], [10.0, 0.0]]), np.array([[0.0, 5.0, -3.0], [3.0, 5.0, 3.0], [6.0, 5.0, -3.0]])
+
+
+def test_a_looping_mover_is_certified_against_every_pass_not_only_its_first():
+    waypoints, track = _crossing_loop()
+    t = np.arange(0.0, 40.0, H)
+    inflation, radius = 0.25, 0.25
+    looped = timed_path(waypoints, [track], [radius], inflation, Limits(0.5), loops=[True])
+    once = timed_path(waypoints, [track], [radius], inflation, Limits(0.5))
+    assert looped is not None and once is not None
+
+    def gap(found):
+        tt = t[t <= found.arrival]
+        return float((np.hypot(*(_interp(found.rows, tt) - _looping_at(track, tt)).T) - inflation - radius).min())
+
+    # Read as walking once (standing at its last row after 6 s), the mover leaves the path free: that schedule
+    # drives into one of its later passes; the looping one keeps the certified distance from every pass.
+    assert gap(once) < 0.0
+    assert gap(looped) >= MARGIN + TRACKING
+    assert looped.arrival > once.arrival
+
+
+def test_worldgen_check_refuses_a_timed_path_that_a_mover_runs_into():
+    from worldgen.verify.timed import TimedPathError, check_timed
+
+    world = worldgen.generate("cluttered", seed=1, size=[8.0, 8.0], n_obstacles=6, n_movers=1)
+    meta = world.metadata
+    check_timed(meta, world)  # as written: it holds
+    rows = np.array(meta["tasks"][0]["timed_path"])
+    mid = rows[len(rows) // 2]
+    # The mover made to stand where the robot is half-way, at that time, on every pass of its loop.
+    meta["dynamic_obstacles"][0]["trajectory"] = [[0.0, mid[1], mid[2]], [1.0, mid[1], mid[2] + 1e-3],
+                                                  [2.0, mid[1], mid[2]]]
+    with pytest.raises(TimedPathError, match="from mover_0's centre"):
+        check_timed(meta, world)

@@ -265,11 +265,12 @@ class _Reader(RecipeReader):
 def without_idle_people(params: Mapping[str, Any]) -> dict[str, Any]:
     """``params`` without the people's parameters when they ask for no people: a space may draw ``n_people`` 0
     beside a people behaviour, and the generator refuses people's parameters without people."""
-    from worldgen.params import PEOPLE_PARAMS
+    from worldgen.params import MOTION_PARAMS, PEOPLE_PARAMS
 
     if params.get("n_people"):
         return dict(params)
-    return {k: v for k, v in params.items() if k not in PEOPLE_PARAMS or k == "n_people"}
+    drop = PEOPLE_PARAMS + (() if params.get("n_movers") else MOTION_PARAMS)
+    return {k: v for k, v in params.items() if k not in drop or k == "n_people"}
 
 
 def _end(r: Range, end: int):

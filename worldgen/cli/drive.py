@@ -17,9 +17,7 @@ from worldgen.export.contract import SIM_GZ_RELEASE, SIM_GZ_RELEASES
 __all__ = ["drive_command"]
 
 #: How the verdict line names what the robot followed (worldgen.sim.schedule.Plan's kinds, docs/drive.md).
-_FOLLOWED = {"timed_path": "timed path", "movers": "schedule among the movers along the path",
-             "spacetime": "schedule among the movers off the path", "static": "static path",
-             "straight": "straight line"}
+_FOLLOWED = {"timed_path": "timed path", "static": "static path", "straight": "straight line"}
 
 
 @click.command("drive", context_settings=_CONTEXT, epilog="""\b

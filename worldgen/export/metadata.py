@@ -100,7 +100,9 @@ def build(world, files: Mapping[str, tuple[str, str]]) -> dict:
         meta["edits"] = list(world.edits)
     people = [m for m in scene.movers if m.person]
     if people:  # only then, so that every world without people keeps its bytes
-        _add_people(meta, world, people)
+        meta["people"] = [person_entry(m, world.params, meta["files"]) for m in people]
+    if scene.movers:  # only then, so that every static world keeps its bytes
+        _add_timed(meta, world)
     if scene.terrain is not None:  # only then, so that every flat world keeps its bytes
         _add_terrain(meta, world)
     return _plain(meta)
@@ -118,13 +120,12 @@ def _add_terrain(meta: dict, world) -> None:
         entry["terrain"] = None if fig is None else fig.entry()
 
 
-def _add_people(meta: dict, world, people) -> None:
-    """world.json's ``people``, the robot's limits (``robot.max_speed``, ``max_turn_rate``,
-    ``max_acceleration``), the ``tracking_margin`` its timed paths keep, and each task's ``timed_path``
+def _add_timed(meta: dict, world) -> None:
+    """The robot's limits (``robot.max_speed``, ``max_turn_rate``, ``max_acceleration``), the
+    ``tracking_margin`` its timed paths keep, and each task's ``timed_path`` among the people and movers
     (docs/people.md)."""
     from worldgen.people.timed import TRACKING, limits_of
 
-    meta["people"] = [person_entry(m, world.params, meta["files"]) for m in people]
     limits = limits_of(world.params)
     meta["robot"].update(max_speed=world.params["robot_speed"], max_turn_rate=limits.turn_rate,
                          max_acceleration=limits.acceleration, tracking_margin=TRACKING)

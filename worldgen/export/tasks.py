@@ -15,7 +15,8 @@ from worldgen.scene.doors import door_joints, leaves_in_the_way
 __all__ = ["TIME_FACTOR", "TIME_MARGIN", "DOOR_TIME", "time_limit", "robot_speed", "leaves_on_path", "task_entry"]
 
 #: time_limit = TIME_FACTOR x path length / robot_speed + TIME_MARGIN: twice the time an
-#: ideal run needs, plus a fixed allowance for start-up and turning on the spot.
+#: ideal run needs, plus a fixed allowance for start-up and turning on the spot; at least the task's
+#: certified arrival among people and movers + TIME_MARGIN.
 TIME_FACTOR = 2.0
 TIME_MARGIN = 10.0
 #: Added to time_limit for each door leaf the path needs moved (pushing or pulling it open).
@@ -60,5 +61,19 @@ def task_entry(world, task, path, leaves: Optional[list] = None) -> dict:
             "min_clearance": finite_or_none(path.min_clearance),
         }
         out["time_limit"] = time_limit(float(path.length), robot_speed(world.params), len(leaves))
+        certificate = _certificate(world, task)
+        if certificate is not None:
+            # A run that keeps to its certificate is never out of time: waiting for a gap among people and
+            # movers may take longer than twice the path at full speed.
+            out["time_limit"] = max(out["time_limit"], certificate.arrival + TIME_MARGIN)
     return out
+
+
+def _certificate(world, task):
+    """The task's timed path among the world's people and movers (worldgen.people.timed), or None."""
+    certificates = getattr(world.feasibility, "timed_paths", ())
+    for other, certificate in zip(world.tasks, certificates):
+        if other.id == task.id:
+            return certificate
+    return None
 

@@ -51,11 +51,10 @@ def samples(mover: Mover, duration: float = 0.0) -> np.ndarray:
 
 def horizon(world) -> float:
     """How long (s) a world's looping movers are written out for: its longest task time limit or walk."""
-    from worldgen.export.tasks import leaves_on_path, robot_speed, time_limit
+    from worldgen.export.tasks import task_entry
 
-    speed = robot_speed(world.params)
-    limits = [time_limit(float(p.length), speed, len(leaves_on_path(world, p)))
-              for p in world.feasibility.paths if p is not None]
+    limits = [task_entry(world, task, path)["time_limit"] for task, path in zip(world.tasks, world.feasibility.paths)
+              if path is not None]
     ends = [m.period for m in world.scene.movers]
     return max(limits + ends + [0.0])
 

@@ -20,20 +20,22 @@ def steps_within(tau: float, dt: float) -> int:
     return 0 if tau <= 0 else math.ceil(tau / dt + 0.5 - 1e-9)
 
 
-def free_cells(w, cum, s, tracks, reach, times, dt: float, window=None) -> np.ndarray:
+def free_cells(w, cum, s, tracks, reach, times, dt: float, window=None, loops=None) -> np.ndarray:
     """(steps + 1, cells) bool: no person's recorded position within ``window`` steps of the step (its
     tube's, :func:`steps_within`), for steps ``dt`` s apart within its ``reach`` of the cell's point.
 
+    ``loops`` (one per track, default none) says which tracks repeat (a scripted mover's loop).
     People with the same window are taken together: the cells they block at the steps from ``window``
     before the first to ``window`` after the last, then each step blocked where any of its window is.
     """
     window = np.zeros(len(tracks), dtype=np.int64) if window is None else window
+    loops = np.zeros(len(tracks), dtype=bool) if loops is None else np.asarray(loops, dtype=bool).reshape(len(tracks))
     free = np.ones((len(times), len(s)), dtype=bool)
     for m in np.unique(window):
         who = np.flatnonzero(window == m)
         m = int(m)
         ext = np.concatenate([times[0] - dt * np.arange(m, 0, -1), times, times[-1] + dt * np.arange(1, m + 1)])
-        blocked = ~free_at(w, cum, s, [tracks[j] for j in who], reach[who], ext)
+        blocked = ~free_at(w, cum, s, [tracks[j] for j in who], reach[who], ext, loops[who])
         if m:
             c = np.concatenate([np.zeros((1, len(s)), dtype=np.int32), np.cumsum(blocked, axis=0, dtype=np.int32)])
             blocked = (c[2 * m + 1:] - c[:-2 * m - 1]) > 0
@@ -41,8 +43,9 @@ def free_cells(w, cum, s, tracks, reach, times, dt: float, window=None) -> np.nd
     return free
 
 
-def free_at(w, cum, s, tracks, reach, times) -> np.ndarray:
-    """(steps + 1, cells) bool: no person within its ``reach`` of the cell's point at the step's time.
+def free_at(w, cum, s, tracks, reach, times, loops=None) -> np.ndarray:
+    """(steps + 1, cells) bool: no person within its ``reach`` of the cell's point at the step's time
+    (``loops``: which tracks repeat, default none).
 
     Only (step, person) pairs within reach of the polyline are looked at; each blocks the cells
     whose arc length falls inside the circle's chords on the path's segments (exact, then marked
@@ -51,7 +54,8 @@ def free_at(w, cum, s, tracks, reach, times) -> np.ndarray:
     marks = np.zeros((n_t, n_s + 1), dtype=np.int32)
     if not len(tracks):
         return np.ones((n_t, n_s), dtype=bool)
-    pos = positions_at(list(tracks), [False] * len(tracks), times)  # (n_t, people, 2)
+    loops = [False] * len(tracks) if loops is None else [bool(x) for x in loops]
+    pos = positions_at(list(tracks), loops, times)  # (n_t, agents, 2)
     a, b = w[:-1], w[1:]
     d = b - a
     dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)

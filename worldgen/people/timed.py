@@ -111,11 +111,15 @@ def turn_angles(waypoints: np.ndarray, heading: float) -> np.ndarray:
 # long: the sweep and its read-back share every array; apart they would pass a dozen of them around
 def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Sequence[float], inflation: float,
                limits, tubes: Optional[Sequence[Tube]] = None, heading: Optional[float] = None,
-               tracking: float = TRACKING) -> Optional[TimedPath]:
+               tracking: float = TRACKING, loops: Optional[Sequence[bool]] = None) -> Optional[TimedPath]:
     """The earliest timed path along ``waypoints`` (k, 2) within ``limits`` (a :class:`Limits`, or a top
     speed with the default turn rate and acceleration) that keeps the robot's disc (``inflation``) and
-    every person's (its (m, 3) track, not looping, and radius) apart, or None. The robot starts at rest
-    facing ``heading`` (rad; default: along the first leg).
+    every agent's (its (m, 3) track and radius) apart, or None. The robot starts at rest facing
+    ``heading`` (rad; default: along the first leg).
+
+    ``loops`` (one per track, default none): a looping track (a scripted mover's) repeats for ever; the
+    others stand at their last row. The sweep gives the robot until the last person stops or the slowest
+    loop has come round once, then the time the path takes and :data:`AFTER`; no schedule by then is None.
 
     ``tubes`` (one per person, default the recorded line): the robot keeps clear of the whole tube, every
     recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`worldgen.people.blocked.free_cells`)."""
@@ -143,6 +147,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     # A move of u cells from cell c may not cross a corner: c + u <= the first corner after c.
     nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
     ok = np.arange(n_cells + 1)[:, None] + np.arange(levels + 1)[None, :] <= nxt[:, None]
+    loops = [False] * len(tracks) if loops is None else [bool(x) for x in loops]
     end = max((float(t[-1, 0]) for t in tracks), default=0.0)
     # Beyond the drive at full speed: the stands to turn, and slowing to a stop and speeding up again at
     # every corner (V steps each way at most).
@@ -165,7 +170,8 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     cell = np.zeros((levels + 1, n_cells + 1), dtype=bool)
     for k in range(steps + 1):
         if k == len(free):
-            free = np.concatenate([free, free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], DT, window)])
+            free = np.concatenate([free, free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], DT, window,
+                                                         loops)])
         here = free[k]
         prev, cell = cell, np.zeros((levels + 1, n_cells + 1), dtype=bool)
         turn = np.zeros((len(spot), span), dtype=bool)
@@ -267,33 +273,48 @@ def _cells(w: np.ndarray, ds: float) -> tuple[np.ndarray, np.ndarray]:
 
 def certify(report: FeasibilityReport, scene, tasks, robot, limits,
             behaviours: Optional[Sequence[str]] = None) -> FeasibilityReport:
-    """``report`` with the check ``timed_path`` and each task's certificate among the scene's people, within
-    ``limits`` (a :class:`Limits`, or a top speed with the default turn rate and acceleration), each from
-    its spawn's heading.
+    """``report`` with the check ``timed_path`` and each task's certificate among everything of the scene
+    that moves (its people and its scripted movers, one kind of agent: each a disc on a known schedule,
+    a mover's repeating), within ``limits`` (a :class:`Limits`, or a top speed with the default turn rate
+    and acceleration), each from its spawn's heading. ``behaviours`` (one per person, in order) give the
+    reacting people their tubes; a scripted mover is impassive.
 
     A task without a static path has no certificate either; the check fails then, and where the
-    people leave the robot no way through along its path (its value: the latest arrival, s).
+    agents leave the robot no way through along its path.
     """
     lim = limits if isinstance(limits, Limits) else Limits(float(limits))
-    people = [m for m in scene.movers if m.person]
-    tracks = [np.asarray(m.trajectory, dtype=float) for m in people]
-    radii = [m.radius for m in people]
-    tubes = [tube_of(b) for b in behaviours] if behaviours is not None else None
+    agents = list(scene.movers)
+    tracks = [np.asarray(m.trajectory, dtype=float) for m in agents]
+    radii = [m.radius for m in agents]
+    loops = [m.loop and not m.person for m in agents]
+    tubes = None
+    if behaviours is not None:
+        reacting = iter(tube_of(b) for b in behaviours)
+        tubes = [next(reacting) if m.person else Tube(0.0, 0.0) for m in agents]
     found, missing = [], []
     for task, path in zip(tasks, report.paths):
         timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, lim, tubes,
-                                                     heading=float(task.spawn.yaw))
+                                                     heading=float(task.spawn.yaw), loops=loops)
         found.append(timed)
         if timed is None:
-            why = "no static path" if path is None else f"the people leave no way through at <= {lim.max_speed:g} m/s"
+            why = "no static path" if path is None else f"they leave no way through at <= {lim.max_speed:g} m/s"
             missing.append(f"{task.id}: {why}")
+    among = _among(agents)
     if missing:
-        check = Check("timed_path", False, None, "no timed path among the people for " + "; ".join(missing))
+        check = Check("timed_path", False, None, f"no timed path among the {among} for " + "; ".join(missing))
     else:
         latest = max(t.arrival for t in found if t is not None)  # none missing: all found
         check = Check("timed_path", True, latest,
-                      f"{len(found)} timed path(s) among {len(people)} people, latest arrival {latest:.2f} s")
+                      f"{len(found)} timed path(s) among {among}, latest arrival {latest:.2f} s")
     return replace(report, checks=report.checks + (check,), timed_paths=tuple(found))
+
+
+def _among(agents) -> str:
+    """'3 people', '2 movers', '3 people and 2 movers': what a certificate was made among."""
+    people = sum(1 for m in agents if m.person)
+    movers = len(agents) - people
+    parts = [f"{people} people"] * bool(people) + [f"{movers} mover{'s' * (movers != 1)}"] * bool(movers)
+    return " and ".join(parts) or "0 people"
 
 
 def _at(w: np.ndarray, cum: np.ndarray, s: np.ndarray) -> np.ndarray:

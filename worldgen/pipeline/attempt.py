@@ -97,16 +97,17 @@ def attempt(request: Request, number: int, *, proven: Optional[World] = None) ->
     scene = draft.scene
     occupancy.extent(scene, params["map_resolution"])  # the map's size follows from the floor: refuse before planning
     if proven is not None and proven.scene.content_hash() == scene.content_hash():
-        report = proven.feasibility
+        report = _static(proven.feasibility)
     else:
         report = feasibility.check(scene, draft.tasks, robot)  # static: people are movers, which it never reads
-    if plan is not None:
+    if plan is not None or scene.movers:
         if not (report.feasible or request.allow_infeasible or params.get("infeasible")):
-            # The people walk (the costly part) only on a draw that can still be kept: one that failed a static
-            # check is refused here as it would be after the walk (docs/people.md, "Refusal").
+            # The people walk and the certificate is sought (the costly part) only on a draw that can still be
+            # kept: one that failed a static check is refused here as it would be after (docs/people.md, "Refusal").
             return Attempt(number, failed=_failed(report))
-        _progress.info("%s seed %d: attempt %d of max_attempts=%d: walking %d people", spec.name, seed, number + 1,
-                       params["max_attempts"], params["n_people"])
+        if plan is not None:
+            _progress.info("%s seed %d: attempt %d of max_attempts=%d: walking %d people", spec.name, seed,
+                           number + 1, params["max_attempts"], params["n_people"])
         scene, report = _walk_and_certify(request, scene, draft.tasks, plan, report)
     world = World(spec.name, seed, params, scene, draft.tasks, robot, report, number + 1, request.allow_infeasible)
     kept = bool(report.feasible or (params.get("infeasible") and _infeasible_on_purpose(report)))
@@ -153,14 +154,26 @@ def _failed(report) -> tuple[tuple[str, str], ...]:
 
 
 def _walk_and_certify(request: Request, scene, tasks, plan, report):
-    """(scene with its people walked, ``report`` with the timed certificate among them and their tubes)."""
+    """(scene with its people walked, if it has a ``plan`` for them, and ``report`` with the timed certificate
+    among everything that moves: people, their tubes, scripted movers)."""
     from worldgen.people.behaviours import behaviours_of
-    from worldgen.people.crowd import walk_plan
     from worldgen.people.timed import certify, limits_of
 
     params, robot = request.params, request.robot
-    scene = scene.with_movers(scene.movers + walk_plan(scene, tasks, robot, params, plan))
-    return scene, certify(report, scene, tasks, robot, limits_of(params), behaviours_of(params))
+    if plan is not None:
+        from worldgen.people.crowd import walk_plan
+
+        scene = scene.with_movers(scene.movers + walk_plan(scene, tasks, robot, params, plan))
+    behaviours = behaviours_of(params) if plan is not None else None
+    return scene, certify(report, scene, tasks, robot, limits_of(params), behaviours)
+
+
+def _static(report):
+    """``report`` with only its static checks: a proven draw's report (a level request's, made before its people
+    were walked) without any certificate it carries, which the attempt makes anew among everything that moves."""
+    from dataclasses import replace
+
+    return replace(report, checks=tuple(c for c in report.checks if c.name != "timed_path"), timed_paths=())
 
 
 def _with_common_extras(request: Request, draft: Draft, number: int):

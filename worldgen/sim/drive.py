@@ -79,7 +79,7 @@ class Outcome:
     run: dict
     sim_seconds: float
     wall: dict = field(default_factory=dict)
-    #: What the robot followed (worldgen.sim.schedule.Plan's kind: timed_path, movers, static or straight).
+    #: What the robot followed (worldgen.sim.schedule.Plan's kind: timed_path, static or straight).
     plan: str = "static"
     #: The simulator's own contacts of the robot, (t, name), door leaves left out (MuJoCo; None in Gazebo,
     #: whose bridge reports none), the doors whose opener the robot triggered, and its contacts with leaves.
@@ -219,7 +219,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
         raise OutputError(f"output folder '{out}' is not a folder")
     wall = {}
     started = time.perf_counter()
-    plan = plan_for(meta, chosen, speed, straight, lambda: _scene_of(opened))
+    plan = plan_for(meta, chosen, speed, straight)
     wall["plan"] = time.perf_counter() - started
     backend = _backend(sim, opened, gz_release)
     try:

@@ -151,7 +151,7 @@ def _proven(world: World, edits: list[dict], walk: bool = True) -> Optional[Edit
     if not report.feasible or any(p is None for p in report.paths):
         return None
     plan = people_plan(world)
-    if plan is not None and walk:
+    if walk and (plan is not None or scene.movers):
         scene, report = settle(world, plan, scene, tasks, report)
         if not report.feasible:  # the people left no way through: not a world to keep
             return None

@@ -13,11 +13,13 @@ both stale, so a world with people is settled after its edits:
 2. the plan's rows of the people still there (``person_<i>`` is row ``i``) are walked by the crowd model
    (:func:`worldgen.people.crowd.walk_plan`) through the edited scene with the world's own parameters, and
    keep their names, so each keeps its behaviour and tube (world.json reads them off the name);
-3. every task is certified among them (:func:`worldgen.people.timed.certify`), each with its behaviour.
+3. every task is certified among them and the scripted movers still there
+   (:func:`worldgen.people.timed.certify`), each person with its behaviour; a world with movers and no
+   people is certified among its movers alone.
 
 Removing a person changes the others' walk (nobody steps round it any more), and removing an obstacle
 changes the walk and the reference paths: the re-walk is the truth, and what is certified. With nobody
-left the world has no people, hence no certificate, as a world generated without them. The settled world
+and no mover left the world has no certificate, as a world generated without them. The settled world
 depends only on the edited static scene and on who is left, never on the order of the edits, so
 :func:`~worldgen.verify.edits.with_edits` and :func:`~worldgen.verify.edits.replay_edits` make the same one.
 """
@@ -65,14 +67,17 @@ def people_plan(world) -> Optional[PeoplePlan]:
     return plan
 
 
-def settle(world, plan: PeoplePlan, scene: Scene, tasks, report):
-    """(``scene`` with the people still in it walked again, ``report`` with their timed certificate): the people
-    of ``world``'s ``plan`` that ``scene`` keeps, walked through its static part; ``report`` is the static
-    proof of ``scene`` and ``tasks``. With nobody left: the scene without people and ``report`` as it is."""
+def settle(world, plan: Optional[PeoplePlan], scene: Scene, tasks, report):
+    """(``scene`` with the people still in it walked again, ``report`` with the timed certificate among
+    everything in it that moves): the people of ``world``'s ``plan`` (None: a world without people) that
+    ``scene`` keeps, walked through its static part; ``report`` is the static proof of ``scene`` and ``tasks``.
+    With nobody and no mover left: the scene without people and ``report`` as it is."""
     kept = sorted((m for m in scene.movers if m.person), key=lambda m: person_index(m.name))
     static = without_people(scene)
-    if not kept:
-        return static, report
+    if not kept or plan is None:
+        if not static.movers:
+            return static, report
+        return static, certify(report, static, tasks, world.robot, limits_of(world.params))
     rows = np.array([person_index(m.name) for m in kept])
     some = PeoplePlan(plan.starts[rows], plan.places[rows], plan.speeds[rows], plan.radius, plan.duration,
                       plan.depart[rows], None if plan.groups is None else plan.groups[rows])

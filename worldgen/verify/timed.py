@@ -1,4 +1,4 @@
-"""``worldgen check``'s ``timed`` check: a world's certificate among people, re-proved from world.json.
+"""``worldgen check``'s ``timed`` check: a world's certificate among people and movers, re-proved from world.json.
 
 The timed path (``tasks[].timed_path``, docs/people.md) is checked on its own terms, without the code
 that found it (:mod:`worldgen.people.timed`): rows from the spawn at t = 0 to the goal at
@@ -6,9 +6,10 @@ that found it (:mod:`worldgen.people.timed`): rows from the spawn at t = 0 to th
 (``tasks[].path.waypoints``) and each two consecutive rows on one leg of it, so the robot between them
 stays on the path and never cuts a corner; the rows' polyline clear of the static geometry by FCL (the
 regenerated scene, doors at their open limit, as the path was proven); and, sampled every
-:data:`TIMED_STEP` s, every person's ``trajectory`` (straight between rows, standing after the last)
-never closer than ``robot.radius + robot.clearance + radius`` plus ``w TIMED_STEP / 2``, ``w`` the
-robot's top speed plus the fastest any person walks: what two discs moving straight at those speeds
+:data:`TIMED_STEP` s, every person's ``trajectory`` (straight between rows, standing after the last) and
+every mover's (``dynamic_obstacles[]``: the same, repeating from its first row after its last where
+``loop``) never closer than ``robot.radius + robot.clearance + radius`` plus ``w TIMED_STEP / 2``, ``w`` the
+robot's top speed plus the fastest any person or mover walks: what two discs moving straight at those speeds
 could close between two samples.
 
 A person who reacts to the robot (``people[].behaviour``) may be anywhere in its ``tube``: within ``d``
@@ -55,21 +56,27 @@ def check_timed(meta: dict, world) -> None:
     """Re-prove every task's timed path of world.json ``meta`` (``world``: its regenerated World, for the
     static geometry); raise :class:`TimedPathError` with one line at the first fault."""
     people = meta.get("people") or []
-    if not people:
+    movers = meta.get("dynamic_obstacles") or []
+    if not (people or movers):
         return
     robot = meta["robot"]
+    if "max_speed" not in robot:
+        raise TimedPathError("the world has people or movers but robot.max_speed is missing: its timed paths "
+                             "have no speed to be checked against")
     inflation, v_max = robot["radius"] + robot["clearance"], float(robot["max_speed"])
     inflation += float(robot.get("tracking_margin", 0.0))
     tracks = [(str(p["name"]), np.asarray(p["trajectory"], dtype=float).reshape(-1, 3), float(p["radius"]))
-              for p in people]
-    tubes = [_tube(p) for p in people]
+              for p in people + movers]
+    loops = [False] * len(people) + [bool(m.get("loop", False)) for m in movers]
+    tubes = [_tube(p) for p in people] + [None] * len(movers)
     fastest = max((_speeds(track).max(initial=0.0) for _, track, _ in tracks), default=0.0)
     colliders = None
     for task in meta["tasks"]:
         rows = task.get("timed_path")
         if rows is None:
             if meta["feasibility"]["feasible"] and task.get("path") is not None:
-                raise TimedPathError(f"{task['id']} has no timed_path, but the world is recorded feasible among people")
+                raise TimedPathError(f"{task['id']} has no timed_path, but the world is recorded feasible among "
+                                     "its people and movers")
             continue
         if task.get("path") is None:
             raise TimedPathError(f"{task['id']} has a timed_path but no path for it to follow")
@@ -91,11 +98,11 @@ def check_timed(meta: dict, world) -> None:
         reach = (v_max + fastest) * TIMED_STEP / 2
         t = np.arange(0.0, rows[-1, 0] + TIMED_STEP, TIMED_STEP)
         me = _at(rows, t)
-        for (name, track, radius), tube in zip(tracks, tubes):
+        for (name, track, radius), tube, loop in zip(tracks, tubes, loops):
             if tube is not None:
                 _check_tube(task["id"], name, me, t, track, inflation + radius, tube, v_max)
                 continue
-            gap = np.hypot(*(me - _at(track, t)).T) - (inflation + radius)
+            gap = np.hypot(*(me - _at(track, _looped(track, t) if loop else t)).T) - (inflation + radius)
             k = int(np.argmin(gap))
             if gap[k] < reach:
                 raise TimedPathError(f"{task['id']} timed_path at t = {t[k]:.3f} s comes "
@@ -143,6 +150,12 @@ def _speeds(rows: np.ndarray) -> np.ndarray:
     d = np.diff(rows, axis=0)
     with np.errstate(divide="ignore"):  # rows not after the one before: an infinite speed, never a pass
         return np.where(d[:, 0] > 0, np.hypot(d[:, 1], d[:, 2]) / np.where(d[:, 0] > 0, d[:, 0], 1.0), np.inf)
+
+
+def _looped(track: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The times ``t`` within one pass of a looping script: its period is its last row's time."""
+    period = float(track[-1, 0])
+    return np.mod(t, period) if period > 0 else t
 
 
 def _at(rows: np.ndarray, t: np.ndarray) -> np.ndarray:
