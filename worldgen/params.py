@@ -291,9 +291,9 @@ COMMON_PARAMS: tuple[Param, ...] = (
           "stays inside a tube round the person's recorded walk that the timed path is certified clear of",
           choices=("impassive", "regular", "surprised", "scared", "curious")),
     Param("robot_turn_rate", "float", 1.0, "how fast the robot turns on the spot: the timed path among people "
-          "turns its corners no faster (docs/people.md)", 0.05, 20.0, unit="rad/s"),
+          "and movers turns its corners no faster (docs/people.md)", 0.05, 20.0, unit="rad/s"),
     Param("robot_acceleration", "float", 1.0, "how fast the robot changes speed: the timed path among people "
-          "speeds up and slows down no faster (docs/people.md)", 0.05, 20.0, unit="m/s^2"),
+          "and movers speeds up and slows down no faster (docs/people.md)", 0.05, 20.0, unit="m/s^2"),
     Param("infeasible", "bool", False, "deliberately make the goal unreachable (a negative test world)"),
     # Ground truth written with every world (worldgen.groundtruth).
     Param("lidar_height", "float", 0.3, "height above the floor of the ground-truth lidar at the first spawn",

@@ -12,7 +12,8 @@ mover's disc off the floor shadow of every static collider below its height
 (exact segment distances, not samples) and inside the bounds. A mover starts
 at least ``robot.inflation + mover_radius`` from every spawn and goal, and
 ``2 x mover_radius`` from every other mover's start. The tasks' reference paths
-stay those of the static world; judging separation over time is the oracles'.
+stay those of the static world; the pipeline then certifies each task among the movers (and people) with
+the timed path of :mod:`worldgen.people.timed`, refusing a draw whose movers leave no way through.
 
 Where a mover is at a time ``t`` is :mod:`worldgen.scene.motion`'s.
 """
