@@ -105,9 +105,12 @@ def test_multi_robot_footprints_apart_and_each_task_has_its_own_proven_path():
 # -- independence and determinism ---------------------------------------------------------
 
 def test_movers_never_reshuffle_obstacles_or_tasks():
-    base = worldgen.generate("cluttered", seed=5, size=[10, 10], n_obstacles=12)
-    one = worldgen.generate("cluttered", seed=5, size=[10, 10], n_obstacles=12, n_movers=1)
-    three = worldgen.generate("cluttered", seed=5, size=[10, 10], n_obstacles=12, n_movers=3)
+    # Seed 4's draws are kept at the first attempt with 0, 1 and 3 movers (a draw whose movers leave no way
+    # through is refused, and the next attempt draws other obstacles: seed 5 with 3 movers is kept at the 4th).
+    base = worldgen.generate("cluttered", seed=4, size=[10, 10], n_obstacles=12)
+    one = worldgen.generate("cluttered", seed=4, size=[10, 10], n_obstacles=12, n_movers=1)
+    three = worldgen.generate("cluttered", seed=4, size=[10, 10], n_obstacles=12, n_movers=3)
+    assert base.attempts == one.attempts == three.attempts == 1
     for w in (one, three):
         assert w.scene.nodes == base.scene.nodes and w.tasks == base.tasks
         # The static task is the same; a world with movers adds its certificate among them (docs/people.md),
