@@ -419,3 +419,39 @@ def test_a_robot_as_tall_as_the_doorway_allows_drives_under_its_head_without_tou
     assert not task["requires_door_open"]  # the path goes through the open doorway, under its head
     xy = np.asarray(task["path"]["waypoints"], dtype=float)
     assert oracles.collisions(np.column_stack([np.arange(len(xy), dtype=float), xy]), world) == []
+
+
+def _sweep(door: dict, leaf: dict):
+    """The floor a leaf sweeps from its initial angle to its open limit, from world.json alone: its box as
+    ``entities`` has it (at the initial angle), turned about the hinge in 1/400ths of the way, each two
+    positions joined by their convex hull."""
+    import shapely
+
+    (cx, cy, _, _, _, yaw), (lx, ly, _) = leaf["pose"], leaf["shape"]["size"]
+    local = np.array([[-lx, -ly], [lx, -ly], [lx, ly], [-lx, ly]]) / 2
+    c, s_ = math.cos(yaw), math.sin(yaw)
+    corners = local @ np.array([[c, s_], [-s_, c]]) + [cx, cy]
+    hinge = np.asarray(door["hinge"][:2], dtype=float)
+    lo, hi = door["limits"]
+    opened = hi if abs(hi) >= abs(lo) else lo
+    turns = (np.linspace(door["angle"], opened, 401) - door["angle"]) * float(door["axis"][2])
+    at = [(corners - hinge) @ np.array([[math.cos(t), math.sin(t)], [-math.sin(t), math.cos(t)]]) + hinge
+          for t in turns]
+    return shapely.union_all([shapely.MultiPoint(np.vstack([p, q])).convex_hull for p, q in zip(at, at[1:])])
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10_000))
+def test_no_spawn_or_goal_lies_where_a_leaf_opening_would_push_the_robot(seed):
+    # Door seed 171 of benchmarks/bench_drive_dynamic.py spawned 0.68 m from the hinge of a 0.9 m pull leaf:
+    # opened, it pressed the robot into the wall (stuck).
+    import shapely
+
+    world = worldgen.generate("door", seed=seed, state="random", swing="random", n_doors=2, n_tasks=2)
+    meta = world.metadata
+    inflation = meta["robot"]["radius"] + meta["robot"]["clearance"]
+    for door in meta["doors"]:
+        sweep = _sweep(door, next(e for e in meta["entities"] if e["name"] == door["name"]))
+        for task in meta["tasks"]:
+            for where in ("spawn", "goal"):
+                assert shapely.Point(task[where][:2]).distance(sweep) >= inflation - 1e-3, (seed, door["name"], where)

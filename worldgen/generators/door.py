@@ -40,7 +40,7 @@ from worldgen.generators.room import WALL_RGBA, floor_node, wall_nodes
 from worldgen.generators.tasks import free_points
 from worldgen.params import Param
 from worldgen.scene import Box, Joint, Material, Node, Physics, Pose, Scene, Task, matrix_to_pose
-from worldgen.scene.doors import open_scene
+from worldgen.scene.doors import swept_scenes
 from worldgen.scene.footprint import FootprintIndex, robot_footprints
 
 __all__ = ["SPEC", "build", "check", "wall_positions", "LEAF_GAP", "JAMB_WIDTH", "MAX_OPENING"]
@@ -206,8 +206,10 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
         joints.append(joint)
     scene = Scene(tuple(nodes), tuple(joints), bounds, Physics(params["step_size"], params["real_time_factor"]))
     robot = robot_from_params(params)
-    # Spawns and goals must be free with the doors as they start and as they open.
-    index = FootprintIndex(robot_footprints(scene, robot) + robot_footprints(open_scene(scene), robot))
+    # Spawns and goals must be free with the doors as they start, as they open and everywhere in between: a
+    # robot waiting on a leaf's sweep would be pushed by the leaf opening onto it (benchmark door seed 171).
+    sweep = swept_scenes(scene, robot.inflation) or [scene]
+    index = FootprintIndex([fp for at in sweep for fp in robot_footprints(at, robot)])
     first = ((rooms[0][0], -sy / 2), (rooms[0][1], sy / 2))
     last = ((rooms[-1][0], -sy / 2), (rooms[-1][1], sy / 2))
     tasks, reason = _tasks(params, task_rng, index, first, last, robot)

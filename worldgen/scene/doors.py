@@ -32,7 +32,7 @@ from worldgen.scene.graph import Joint, Node, Scene
 from worldgen.scene.pose import matrix_to_pose
 from worldgen.scene.shapes import Box
 
-__all__ = ["door_joints", "open_angle", "state_of", "scene_at", "open_scene", "fixed_scene", "door_records",
+__all__ = ["swept_scenes", "door_joints", "open_angle", "state_of", "scene_at", "open_scene", "fixed_scene", "door_records",
            "leaves_in_the_way", "requires_door_open", "STATE_TOL"]
 
 #: Angles (rad) closer than this to 0 or to the open limit count as closed or open.
@@ -105,6 +105,19 @@ def open_scene(scene: Scene) -> Scene:
     """``scene`` with every door leaf at its open limit (the scene itself when none has to move)."""
     angles = {j.name: open_angle(j) for j in door_joints(scene) if j.initial != open_angle(j)}
     return scene_at(scene, angles)
+
+
+def swept_scenes(scene: Scene, spacing: float) -> list[Scene]:
+    """``scene`` with every door leaf at angles from its initial angle to its open limit (both ends
+    included), no two of them more than ``spacing`` m apart at the leaf's far edge: whatever keeps that much
+    from each of them keeps clear of the whole sweep. [] when no leaf has to move."""
+    joints = [j for j in door_joints(scene) if j.initial != open_angle(j)]
+    if not joints:
+        return []
+    children = {node.name: node for node in scene.nodes}
+    steps = max(math.ceil(abs(open_angle(j) - j.initial) * _leaf_width(children[j.child]) / spacing) for j in joints)
+    return [scene_at(scene, {j.name: j.initial + (open_angle(j) - j.initial) * k / steps for j in joints})
+            for k in range(steps + 1)]
 
 
 def _passage(scene: Scene, joint: Joint) -> Optional[dict]:
