@@ -136,7 +136,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     spot_steps = turns[turns > 0]
     # A corner passed without a turn joins legs of slightly different cells: which speed (in cells a step)
     # may follow which there, for the change in m/s to stay within one cell a step of the finest legs.
-    leg_ds = np.diff(s[corner])
+    leg_ds = np.diff(s[corner]) / np.diff(corner)  # each leg's cell length (m)
     lv = np.arange(levels + 1)
     passes = {int(corner[j]): np.abs(lv[None, :] * leg_ds[j] - lv[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
               for j in range(1, len(corner) - 1) if turns[j] == 0}
