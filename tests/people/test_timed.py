@@ -331,3 +331,17 @@ def test_a_corner_without_a_turn_is_passed_at_speed():
     brute = _brute_force(split, [person], [0.25], 0.25, small)
     assert got is not None and brute is not None and abs(got.arrival - brute) < 1e-9
     assert got.arrival > timed_path(split, [], [], 0.25, small).arrival + DT  # the person held it up
+
+
+def test_a_collinear_corner_passed_at_one_speed_keeps_its_row_for_worldgen_check():
+    """Rows a constant-speed leg between their neighbours already says are dropped, but not a corner's: the
+    rows either side of a collinear corner lie on different legs, and worldgen check (each two rows on one
+    leg) would read the pair as a cut corner."""
+    from worldgen.people.timed import _rows
+    from worldgen.verify.timed import _timed_on_path
+
+    w = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]])
+    cum = np.array([0.0, 1.0, 2.0])
+    rows = _rows(w, cum, np.array([0.0, 2.0, 4.0]), np.array([0.0, 1.0, 2.0]), cum)
+    assert rows[:, 1].tolist() == [0.0, 1.0, 2.0]
+    _timed_on_path({"id": "task_0", "path": {"waypoints": w.tolist()}}, rows)  # raises on a cut corner

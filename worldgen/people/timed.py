@@ -190,7 +190,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
         return np.unpackbits(moving[step], count=(levels + 1) * (n_cells + 1)).reshape(levels + 1, -1).T.astype(bool)
 
     cells = _read_back(states, len(moving), turning, spot, spot_steps, ok, passes, n_cells, levels)
-    return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)]), k_goal * DT)
+    return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)], s[corner]), k_goal * DT)
 
 
 def _advance(prev: np.ndarray, was: np.ndarray, here: np.ndarray, passes: dict, ok_t: np.ndarray, live: np.ndarray,
@@ -307,12 +307,14 @@ def tube_steps(tau: float) -> int:
     return steps_within(tau, DT)
 
 
-def _rows(w: np.ndarray, cum: np.ndarray, times: np.ndarray, profile: np.ndarray) -> np.ndarray:
+def _rows(w: np.ndarray, cum: np.ndarray, times: np.ndarray, profile: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """(k, 3) t, x, y rows of the profile's samples (every corner is one: corners are passed at a
-    step's end), less those a straight constant-speed leg between their neighbours already says."""
+    step's end), less those a straight constant-speed leg between their neighbours already says. A row at
+    a corner (arc lengths ``corners``) is always kept: a collinear one passed at one speed would otherwise
+    go, leaving two rows on different legs, which ``worldgen check`` reads as a cut corner."""
     pts = _at(w, cum, profile)
     rows = np.column_stack([times, pts])
     vel = np.diff(pts, axis=0) / np.diff(times)[:, None]
-    same = np.all(np.abs(vel[1:] - vel[:-1]) < 1e-9, axis=1)
+    same = np.all(np.abs(vel[1:] - vel[:-1]) < 1e-9, axis=1) & ~np.isin(profile[1:-1], corners)
     keep = np.r_[True, ~same, True]
     return rows[keep]
