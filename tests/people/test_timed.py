@@ -345,3 +345,20 @@ def test_a_collinear_corner_passed_at_one_speed_keeps_its_row_for_worldgen_check
     rows = _rows(w, cum, np.array([0.0, 2.0, 4.0]), np.array([0.0, 1.0, 2.0]), cum)
     assert rows[:, 1].tolist() == [0.0, 1.0, 2.0]
     _timed_on_path({"id": "task_0", "path": {"waypoints": w.tolist()}}, rows)  # raises on a cut corner
+
+
+def test_a_sweep_that_can_no_longer_change_gives_up_once_everyone_stands(monkeypatch):
+    """Once every person stands (after the last row and the tube's window) the free cells no longer change:
+    a step whose states equal the step's before keeps them for ever. The sweep stops there instead of
+    running on to its horizon (beyond it by the path's time at full speed and 5 s); the answer is the same."""
+    import worldgen.people.timed as timed
+
+    calls = []
+    advance = timed._advance
+    monkeypatch.setattr(timed, "_advance", lambda *a: calls.append(1) or advance(*a))
+    waypoints = np.array([[0.0, 0.0], [8.0, 0.0]])
+    person = np.array([[0.0, 4.0, 3.0], [3.0, 4.0, 0.0]])  # walks onto the path and stands there from 3 s
+    assert timed_path(waypoints, [person], [0.25], 0.25, Limits(0.5, 1.0, 1.0)) is None
+    # The robot's states stop changing once it has come as far as the person lets it (some 3.4 m, about
+    # 7.4 s: 148 steps); the horizon is 3 s + 16 s + 5 s and more (over 480 steps).
+    assert len(calls) < 200, len(calls)

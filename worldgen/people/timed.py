@@ -155,6 +155,9 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     window = np.array([tube_steps(tube.tau) for tube in tubes], dtype=np.int64).reshape(len(tracks))
     span = int(spot_steps.max(initial=1))
     live = np.arange(span)[None, :] < spot_steps[:, None]
+    # From this time on every person stands and every step's free cells are the last step's: a step whose
+    # states are the step's before then has them for ever, and the goal is out of reach.
+    settled = end + (int(window.max(initial=0)) + 1) * DT
     free = np.zeros((0, n_cells + 1), dtype=bool)
     # Per step: the (speed, cell) states, bit-packed (a long path holds some 10^4 cells at 11 speeds for
     # 10^3 steps), and the (spot, steps turned) states; ``cell`` is the last step's, unpacked.
@@ -176,6 +179,8 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
                 cell[0, 0] = here[0]
         else:
             cell, turn = _advance(prev, turning[-1], here, passes, ok_t, live, spot, spot_steps)
+            if times[k] > settled and np.array_equal(cell, prev) and np.array_equal(turn, turning[-1]):
+                return None
         moving.append(np.packbits(cell))
         turning.append(turn)
         if cell[:2, n_cells].any():
