@@ -314,12 +314,14 @@ def tube_steps(tau: float) -> int:
 
 def _rows(w: np.ndarray, cum: np.ndarray, times: np.ndarray, profile: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """(k, 3) t, x, y rows of the profile's samples (every corner is one: corners are passed at a
-    step's end), less those a straight constant-speed leg between their neighbours already says. A row at
-    a corner (arc lengths ``corners``) is always kept: a collinear one passed at one speed would otherwise
-    go, leaving two rows on different legs, which ``worldgen check`` reads as a cut corner."""
+    step's end), less those a straight constant-speed leg between their neighbours already says. A row
+    passing through a corner (arc lengths ``corners``) is always kept: a collinear one passed at one speed
+    would otherwise go, leaving two rows on different legs, which ``worldgen check`` reads as a cut corner."""
     pts = _at(w, cum, profile)
     rows = np.column_stack([times, pts])
     vel = np.diff(pts, axis=0) / np.diff(times)[:, None]
-    same = np.all(np.abs(vel[1:] - vel[:-1]) < 1e-9, axis=1) & ~np.isin(profile[1:-1], corners)
+    mid = profile[1:-1]
+    through = np.isin(mid, corners) & (profile[:-2] != mid) & (profile[2:] != mid)
+    same = np.all(np.abs(vel[1:] - vel[:-1]) < 1e-9, axis=1) & ~through
     keep = np.r_[True, ~same, True]
     return rows[keep]
