@@ -345,6 +345,9 @@ def test_a_collinear_corner_passed_at_one_speed_keeps_its_row_for_worldgen_check
     rows = _rows(w, cum, np.array([0.0, 2.0, 4.0]), np.array([0.0, 1.0, 2.0]), cum)
     assert rows[:, 1].tolist() == [0.0, 1.0, 2.0]
     _timed_on_path({"id": "task_0", "path": {"waypoints": w.tolist()}}, rows)  # raises on a cut corner
+    # Standing at a corner (turning there) keeps only the rows where the stand begins and ends.
+    stand = _rows(w, cum, np.arange(6.0), np.array([0.0, 0.0, 0.0, 0.0, 1.0, 2.0]), cum)
+    assert stand[:, 0].tolist() == [0.0, 3.0, 5.0]
 
 
 def test_a_sweep_that_can_no_longer_change_gives_up_once_everyone_stands(monkeypatch):
