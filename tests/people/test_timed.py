@@ -346,7 +346,7 @@ def test_a_collinear_corner_passed_at_one_speed_keeps_its_row_for_worldgen_check
     assert rows[:, 1].tolist() == [0.0, 1.0, 2.0]
     _timed_on_path({"id": "task_0", "path": {"waypoints": w.tolist()}}, rows)  # raises on a cut corner
     # Standing at a corner (turning there) keeps only the rows where the stand begins and ends.
-    stand = _rows(w, cum, np.arange(6.0), np.array([0.0, 0.0, 0.0, 0.0, 1.0, 2.0]), cum)
+    stand = _rows(w, cum, np.arange(6.0), np.array([0.0, 0.0, 0.0, 0.0, 0.5, 1.0]), cum)
     assert stand[:, 0].tolist() == [0.0, 3.0, 5.0]
 
 
