@@ -38,6 +38,7 @@ import numpy as np
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.people.behaviours import Tube, tube_of
 from worldgen.people.blocked import free_cells, steps_within
+from worldgen.people.corners import cap_moves, chord_clear, passed_moving
 
 __all__ = ["DT", "MARGIN", "TRACKING", "SPARE", "TURN_RATE", "ACCELERATION", "MAX_LEVELS", "Limits", "limits_of",
            "TimedPath", "timed_path", "person_speed", "certify", "tube_steps", "turn_angles"]
@@ -111,14 +112,18 @@ def turn_angles(waypoints: np.ndarray, heading: float) -> np.ndarray:
 # long: the sweep and its read-back share every array; apart they would pass a dozen of them around
 def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Sequence[float], inflation: float,
                limits, tubes: Optional[Sequence[Tube]] = None, heading: Optional[float] = None,
-               tracking: float = TRACKING) -> Optional[TimedPath]:
+               tracking: float = TRACKING, clear=None) -> Optional[TimedPath]:
     """The earliest timed path along ``waypoints`` (k, 2) within ``limits`` (a :class:`Limits`, or a top
     speed with the default turn rate and acceleration) that keeps the robot's disc (``inflation``) and
     every person's (its (m, 3) track, not looping, and radius) apart, or None. The robot starts at rest
     facing ``heading`` (rad; default: along the first leg).
 
     ``tubes`` (one per person, default the recorded line): the robot keeps clear of the whole tube, every
-    recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`worldgen.people.blocked.free_cells`)."""
+    recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`worldgen.people.blocked.free_cells`).
+
+    ``clear`` (a function of two points, True where the robot's disc along the segment between them keeps
+    its clearance from the static geometry): with it, small corners whose arc's chord is clear are passed
+    on the move (:mod:`worldgen.people.corners`); without it every corner is turned on the spot."""
     lim = limits if isinstance(limits, Limits) else Limits(float(limits))
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     if len(w) == 1:
@@ -132,17 +137,12 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     angles = turn_angles(w, math.atan2(*(w[1] - w[0])[::-1]) if heading is None else heading)
     turns = np.ceil(angles / (lim.turn_rate * DT) - 1e-9).astype(np.int64)
     turns[np.hypot(*np.diff(w, axis=0).T) == 0] = 0  # a leg of no length has no heading to turn to
+    leg_ds = np.diff(s[corner]) / np.diff(corner)  # each leg's cell length (m)
+    passed = passed_moving(w, lim.max_speed, lim.turn_rate, leg_ds, clear, DT)  # corners passed on the move
+    turns[list(passed)] = 0
     spot = corner[:-1][turns > 0]  # the cells the robot stands on to turn, and for how many steps
     spot_steps = turns[turns > 0]
-    # A corner passed without a turn joins legs of slightly different cells: which speed (in cells a step)
-    # may follow which there, for the change in m/s to stay within one cell a step of the finest legs.
-    leg_ds = np.diff(s[corner]) / np.diff(corner)  # each leg's cell length (m)
-    lv = np.arange(levels + 1)
-    passes = {int(corner[j]): np.abs(lv[None, :] * leg_ds[j] - lv[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
-              for j in range(1, len(corner) - 1) if turns[j] == 0}
-    # A move of u cells from cell c may not cross a corner: c + u <= the first corner after c.
-    nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
-    ok = np.arange(n_cells + 1)[:, None] + np.arange(levels + 1)[None, :] <= nxt[:, None]
+    passes, ok, extra = _moves(s, corner, leg_ds, cum, turns, levels, ds, passed)
     end = max((float(t[-1, 0]) for t in tracks), default=0.0)
     # Beyond the drive at full speed: the stands to turn, and slowing to a stop and speeding up again at
     # every corner (V steps each way at most).
@@ -168,7 +168,8 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     cell = np.zeros((levels + 1, n_cells + 1), dtype=bool)
     for k in range(steps + 1):
         if k == len(free):
-            free = np.concatenate([free, free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], DT, window)])
+            free = np.concatenate([free, free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], DT, window,
+                                                          extra if passed else None)])
         here = free[k]
         prev, cell = cell, np.zeros((levels + 1, n_cells + 1), dtype=bool)
         turn = np.zeros((len(spot), span), dtype=bool)
@@ -196,6 +197,26 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
 
     cells = _read_back(states, len(moving), turning, spot, spot_steps, ok, passes, n_cells, levels)
     return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)], s[corner]), k_goal * DT)
+
+
+def _moves(s: np.ndarray, corner: np.ndarray, leg_ds: np.ndarray, cum: np.ndarray, turns: np.ndarray, levels: int,
+           ds: float, passed: dict) -> tuple[dict, np.ndarray, np.ndarray]:
+    """(the speeds that may follow one another through each corner passed without a stop, ``ok`` (cell,
+    cells a step): the moves allowed, the more reach on each leg (m) beside a corner passed moving)."""
+    n_cells = len(s) - 1
+    # A corner passed without a turn joins legs of slightly different cells: which speed (in cells a step)
+    # may follow which there, for the change in m/s to stay within one cell a step of the finest legs.
+    lv = np.arange(levels + 1)
+    passes = {int(corner[j]): np.abs(lv[None, :] * leg_ds[j] - lv[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
+              for j in range(1, len(corner) - 1) if turns[j] == 0}
+    # A move of u cells from cell c may not cross a corner: c + u <= the first corner after c.
+    nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
+    ok = np.arange(n_cells + 1)[:, None] + np.arange(levels + 1)[None, :] <= nxt[:, None]
+    extra = np.zeros(len(corner) - 1)
+    for j, (cut, dev) in passed.items():
+        extra[j - 1:j + 1] = np.maximum(extra[j - 1:j + 1], dev)  # the largest arc's, as worldgen check keeps it
+        cap_moves(ok, s, corner, leg_ds, float(cum[j]), cut, DT)
+    return passes, ok, extra
 
 
 def _advance(prev: np.ndarray, was: np.ndarray, here: np.ndarray, passes: dict, ok_t: np.ndarray, live: np.ndarray,
@@ -284,10 +305,11 @@ def certify(report: FeasibilityReport, scene, tasks, robot, limits,
     tracks = [np.asarray(m.trajectory, dtype=float) for m in people]
     radii = [m.radius for m in people]
     tubes = [tube_of(b) for b in behaviours] if behaviours is not None else None
+    clear = chord_clear(scene, robot)
     found, missing = [], []
     for task, path in zip(tasks, report.paths):
         timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, lim, tubes,
-                                                     heading=float(task.spawn.yaw))
+                                                     heading=float(task.spawn.yaw), clear=clear)
         found.append(timed)
         if timed is None:
             why = "no static path" if path is None else f"the people leave no way through at <= {lim.max_speed:g} m/s"
