@@ -3,8 +3,9 @@
 The robot is a point with a heading; each small step ``h`` it asks for the speed and turn rate that
 keep it on the schedule, and gets them clipped to ``|w| <= turn_rate``, ``0 <= v <= max_speed`` and
 ``|v - v_before| <= acceleration h``: what a differential-drive base can do. Its steering is simple on
-purpose: it faces where the schedule goes next (turning on the spot while that lies off its heading),
-and its speed is the schedule's, plus a pull toward the scheduled point.
+purpose: it faces where the schedule goes next (turning on the spot while that lies off its heading and
+the schedule stands; turning on the move where the schedule passes a small corner without stopping), and
+its speed is the schedule's, plus a pull toward the scheduled point.
 """
 
 from __future__ import annotations
@@ -12,6 +13,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+from worldgen.people.corners import CUT_ANGLE
 
 __all__ = ["drive"]
 
@@ -49,7 +52,10 @@ def drive(rows, yaw0: float, max_speed: float, turn_rate: float, acceleration: f
         ahead = _at(rows, t + h)
         v_ref = math.hypot(*(ahead - here)) / h
         lag = float(np.dot(here - np.array([x, y]), [math.cos(yaw), math.sin(yaw)]))
-        target = 0.0 if abs(err) > 1e-3 else v_ref + gain * lag
+        # Off its heading it stands to turn, unless the schedule itself moves on through a small corner: then
+        # it turns on the move (docs/people.md, corners passed moving).
+        on_the_move = v_ref > 1e-9 and abs(err) <= CUT_ANGLE + 1e-3
+        target = 0.0 if abs(err) > 1e-3 and not on_the_move else v_ref + gain * lag
         target = max(0.0, min(max_speed, target))
         v = max(v - acceleration * h, min(v + acceleration * h, target))
         x, y = x + v * h * math.cos(yaw), y + v * h * math.sin(yaw)

@@ -320,3 +320,29 @@ def test_a_timed_path_that_sets_off_before_turning_from_the_spawn_fails_timed(am
     rows[2:] = [[round(t - 0.05, 6), x, y] for t, x, y in rows[2:]]
     _timed(folder, rows)
     _fails(capsys, folder, "timed", "timed_path turns", "after standing", "faster than robot.max_turn_rate 1 rad/s")
+
+
+def test_corners_passed_on_the_move_are_re_proved_and_need_their_chord_clear(among_people):
+    """The cluttered world's timed path passes small corners without stopping: worldgen check re-derives each
+    arc from the recorded path (test_worlds_among_people_pass_timed passes it); with a robot 1 mm wider in
+    clearance the chords are no longer clear, those corners count as turns without a stand, and fail."""
+    import dataclasses
+
+    import numpy as np
+
+    from worldgen.feasibility.collision import Colliders
+    from worldgen.scene.doors import open_scene
+    from worldgen.verify.timed import TimedPathError, _drivable, _moving
+
+    meta = json.loads((among_people[1] / "world.json").read_text())
+    world = worldgen.generate("cluttered", 0, size=[8.0, 8.0], n_obstacles=10, n_people=6, people_duration=20.0)
+    task, robot = meta["tasks"][0], meta["robot"]
+    rows = np.array(task["timed_path"])
+    colliders = Colliders(open_scene(world.scene))
+    moving = _moving(task, rows, robot, colliders, world.robot)
+    assert len(moving) >= 2 and max(dev for _, _, (_, dev) in moving) > 1e-4
+    wider = dataclasses.replace(world.robot, clearance=world.robot.clearance + 1e-3)
+    kept = _moving(task, rows, robot, colliders, wider)
+    assert len(kept) < len(moving)
+    with pytest.raises(TimedPathError, match="timed_path turns"):
+        _drivable(task, rows, robot["max_turn_rate"], robot["max_acceleration"], {k for k, _, _ in kept})

@@ -20,13 +20,14 @@ def steps_within(tau: float, dt: float) -> int:
     return 0 if tau <= 0 else math.ceil(tau / dt + 0.5 - 1e-9)
 
 
-def free_cells(w, cum, s, tracks, reach, times, dt: float, window=None, loops=None) -> np.ndarray:
+def free_cells(w, cum, s, tracks, reach, times, dt: float, window=None, loops=None, extra=None) -> np.ndarray:
     """(steps + 1, cells) bool: no person's recorded position within ``window`` steps of the step (its
     tube's, :func:`steps_within`), for steps ``dt`` s apart within its ``reach`` of the cell's point.
 
     ``loops`` (one per track, default none) says which tracks repeat (a scripted mover's loop).
     People with the same window are taken together: the cells they block at the steps from ``window``
     before the first to ``window`` after the last, then each step blocked where any of its window is.
+    ``extra`` (one per segment of the path, m): more reach on that segment (a corner passed moving).
     """
     window = np.zeros(len(tracks), dtype=np.int64) if window is None else window
     loops = np.zeros(len(tracks), dtype=bool) if loops is None else np.asarray(loops, dtype=bool).reshape(len(tracks))
@@ -35,7 +36,7 @@ def free_cells(w, cum, s, tracks, reach, times, dt: float, window=None, loops=No
         who = np.flatnonzero(window == m)
         m = int(m)
         ext = np.concatenate([times[0] - dt * np.arange(m, 0, -1), times, times[-1] + dt * np.arange(1, m + 1)])
-        blocked = ~free_at(w, cum, s, [tracks[j] for j in who], reach[who], ext, loops[who])
+        blocked = ~free_at(w, cum, s, [tracks[j] for j in who], reach[who], ext, loops[who], extra)
         if m:
             c = np.concatenate([np.zeros((1, len(s)), dtype=np.int32), np.cumsum(blocked, axis=0, dtype=np.int32)])
             blocked = (c[2 * m + 1:] - c[:-2 * m - 1]) > 0
@@ -43,7 +44,7 @@ def free_cells(w, cum, s, tracks, reach, times, dt: float, window=None, loops=No
     return free
 
 
-def free_at(w, cum, s, tracks, reach, times, loops=None) -> np.ndarray:
+def free_at(w, cum, s, tracks, reach, times, loops=None, extra=None) -> np.ndarray:
     """(steps + 1, cells) bool: no person within its ``reach`` of the cell's point at the step's time
     (``loops``: which tracks repeat, default none).
 
@@ -59,9 +60,10 @@ def free_at(w, cum, s, tracks, reach, times, loops=None) -> np.ndarray:
     a, b = w[:-1], w[1:]
     d = b - a
     dd = np.maximum(np.einsum("ij,ij->i", d, d), 1e-300)
+    more = np.zeros(len(d)) if extra is None else np.asarray(extra, dtype=float)
     for j in range(pos.shape[1]):
         p = pos[:, j, :]
-        r2 = reach[j] ** 2
+        r2 = ((reach[j] + more) ** 2)[None, :]
         # Circle-segment chords: |a + u d - p|^2 = r^2, u in [0, 1], for every step and segment.
         ap = a[None, :, :] - p[:, None, :]
         bq = np.einsum("tsk,sk->ts", ap, d)

@@ -38,6 +38,7 @@ import numpy as np
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.people.behaviours import Tube, tube_of
 from worldgen.people.blocked import free_cells, steps_within
+from worldgen.people.corners import cap_moves, chord_clear, passed_moving
 
 __all__ = ["DT", "MARGIN", "TRACKING", "SPARE", "TURN_RATE", "ACCELERATION", "MAX_LEVELS", "Limits", "limits_of",
            "TimedPath", "timed_path", "person_speed", "certify", "tube_steps", "turn_angles"]
@@ -111,7 +112,8 @@ def turn_angles(waypoints: np.ndarray, heading: float) -> np.ndarray:
 # long: the sweep and its read-back share every array; apart they would pass a dozen of them around
 def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Sequence[float], inflation: float,
                limits, tubes: Optional[Sequence[Tube]] = None, heading: Optional[float] = None,
-               tracking: float = TRACKING, loops: Optional[Sequence[bool]] = None) -> Optional[TimedPath]:
+               tracking: float = TRACKING, loops: Optional[Sequence[bool]] = None,
+               clear=None) -> Optional[TimedPath]:
     """The earliest timed path along ``waypoints`` (k, 2) within ``limits`` (a :class:`Limits`, or a top
     speed with the default turn rate and acceleration) that keeps the robot's disc (``inflation``) and
     every agent's (its (m, 3) track and radius) apart, or None. The robot starts at rest facing
@@ -122,7 +124,11 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     loop has come round once, then the time the path takes and :data:`AFTER`; no schedule by then is None.
 
     ``tubes`` (one per person, default the recorded line): the robot keeps clear of the whole tube, every
-    recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`worldgen.people.blocked.free_cells`)."""
+    recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`worldgen.people.blocked.free_cells`).
+
+    ``clear`` (a function of two points, True where the robot's disc along the segment between them keeps
+    its clearance from the static geometry): with it, small corners whose arc's chord is clear are passed
+    on the move (:mod:`worldgen.people.corners`); without it every corner is turned on the spot."""
     lim = limits if isinstance(limits, Limits) else Limits(float(limits))
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     if len(w) == 1:
@@ -136,17 +142,12 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     angles = turn_angles(w, math.atan2(*(w[1] - w[0])[::-1]) if heading is None else heading)
     turns = np.ceil(angles / (lim.turn_rate * DT) - 1e-9).astype(np.int64)
     turns[np.hypot(*np.diff(w, axis=0).T) == 0] = 0  # a leg of no length has no heading to turn to
+    leg_ds = np.diff(s[corner]) / np.diff(corner)  # each leg's cell length (m)
+    passed = passed_moving(w, lim.max_speed, lim.turn_rate, leg_ds, clear, DT)  # corners passed on the move
+    turns[list(passed)] = 0
     spot = corner[:-1][turns > 0]  # the cells the robot stands on to turn, and for how many steps
     spot_steps = turns[turns > 0]
-    # A corner passed without a turn joins legs of slightly different cells: which speed (in cells a step)
-    # may follow which there, for the change in m/s to stay within one cell a step of the finest legs.
-    leg_ds = np.diff(s[corner])
-    lv = np.arange(levels + 1)
-    passes = {int(corner[j]): np.abs(lv[None, :] * leg_ds[j] - lv[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
-              for j in range(1, len(corner) - 1) if turns[j] == 0}
-    # A move of u cells from cell c may not cross a corner: c + u <= the first corner after c.
-    nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
-    ok = np.arange(n_cells + 1)[:, None] + np.arange(levels + 1)[None, :] <= nxt[:, None]
+    passes, ok, extra = _moves(s, corner, leg_ds, cum, turns, levels, ds, passed)
     loops = [False] * len(tracks) if loops is None else [bool(x) for x in loops]
     end = max((float(t[-1, 0]) for t in tracks), default=0.0)
     # Beyond the drive at full speed: the stands to turn, and slowing to a stop and speeding up again at
@@ -160,6 +161,10 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     window = np.array([tube_steps(tube.tau) for tube in tubes], dtype=np.int64).reshape(len(tracks))
     span = int(spot_steps.max(initial=1))
     live = np.arange(span)[None, :] < spot_steps[:, None]
+    # From this time on every person stands and every step's free cells are the last step's: a step whose
+    # states are the step's before then has them for ever, and the goal is out of reach. A looping mover
+    # never stands: with one, the sweep runs to its end.
+    settled = math.inf if any(loops) else end + (int(window.max(initial=0)) + 1) * DT
     free = np.zeros((0, n_cells + 1), dtype=bool)
     # Per step: the (speed, cell) states, bit-packed (a long path holds some 10^4 cells at 11 speeds for
     # 10^3 steps), and the (spot, steps turned) states; ``cell`` is the last step's, unpacked.
@@ -171,7 +176,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     for k in range(steps + 1):
         if k == len(free):
             free = np.concatenate([free, free_cells(w, cum, s, tracks, reach, times[k:k + FREE_CHUNK], DT, window,
-                                                         loops)])
+                                                         loops, extra if passed else None)])
         here = free[k]
         prev, cell = cell, np.zeros((levels + 1, n_cells + 1), dtype=bool)
         turn = np.zeros((len(spot), span), dtype=bool)
@@ -182,6 +187,8 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
                 cell[0, 0] = here[0]
         else:
             cell, turn = _advance(prev, turning[-1], here, passes, ok_t, live, spot, spot_steps)
+            if times[k] > settled and np.array_equal(cell, prev) and np.array_equal(turn, turning[-1]):
+                return None
         moving.append(np.packbits(cell))
         turning.append(turn)
         if cell[:2, n_cells].any():
@@ -196,7 +203,27 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
         return np.unpackbits(moving[step], count=(levels + 1) * (n_cells + 1)).reshape(levels + 1, -1).T.astype(bool)
 
     cells = _read_back(states, len(moving), turning, spot, spot_steps, ok, passes, n_cells, levels)
-    return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)]), k_goal * DT)
+    return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)], s[corner]), k_goal * DT)
+
+
+def _moves(s: np.ndarray, corner: np.ndarray, leg_ds: np.ndarray, cum: np.ndarray, turns: np.ndarray, levels: int,
+           ds: float, passed: dict) -> tuple[dict, np.ndarray, np.ndarray]:
+    """(the speeds that may follow one another through each corner passed without a stop, ``ok`` (cell,
+    cells a step): the moves allowed, the more reach on each leg (m) beside a corner passed moving)."""
+    n_cells = len(s) - 1
+    # A corner passed without a turn joins legs of slightly different cells: which speed (in cells a step)
+    # may follow which there, for the change in m/s to stay within one cell a step of the finest legs.
+    lv = np.arange(levels + 1)
+    passes = {int(corner[j]): np.abs(lv[None, :] * leg_ds[j] - lv[:, None] * leg_ds[j - 1]) <= ds * (1 + 1e-9)
+              for j in range(1, len(corner) - 1) if turns[j] == 0}
+    # A move of u cells from cell c may not cross a corner: c + u <= the first corner after c.
+    nxt = np.append(corner, n_cells)[np.searchsorted(corner, np.arange(n_cells + 1), side="right")]
+    ok = np.arange(n_cells + 1)[:, None] + np.arange(levels + 1)[None, :] <= nxt[:, None]
+    extra = np.zeros(len(corner) - 1)
+    for j, (cut, dev) in passed.items():
+        extra[j - 1:j + 1] = np.maximum(extra[j - 1:j + 1], dev)  # the largest arc's, as worldgen check keeps it
+        cap_moves(ok, s, corner, leg_ds, float(cum[j]), cut, DT)
+    return passes, ok, extra
 
 
 def _advance(prev: np.ndarray, was: np.ndarray, here: np.ndarray, passes: dict, ok_t: np.ndarray, live: np.ndarray,
@@ -291,10 +318,12 @@ def certify(report: FeasibilityReport, scene, tasks, robot, limits,
     if behaviours is not None:
         reacting = iter(tube_of(b) for b in behaviours)
         tubes = [next(reacting) if m.person else Tube(0.0, 0.0) for m in agents]
+    clear = chord_clear(scene, robot)
     found, missing = [], []
     for task, path in zip(tasks, report.paths):
         timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, lim, tubes,
-                                                     heading=float(task.spawn.yaw), loops=loops)
+                                                     heading=float(task.spawn.yaw), loops=loops,
+                                                     clear=clear)
         found.append(timed)
         if timed is None:
             why = "no static path" if path is None else f"they leave no way through at <= {lim.max_speed:g} m/s"
@@ -328,12 +357,16 @@ def tube_steps(tau: float) -> int:
     return steps_within(tau, DT)
 
 
-def _rows(w: np.ndarray, cum: np.ndarray, times: np.ndarray, profile: np.ndarray) -> np.ndarray:
+def _rows(w: np.ndarray, cum: np.ndarray, times: np.ndarray, profile: np.ndarray, corners: np.ndarray) -> np.ndarray:
     """(k, 3) t, x, y rows of the profile's samples (every corner is one: corners are passed at a
-    step's end), less those a straight constant-speed leg between their neighbours already says."""
+    step's end), less those a straight constant-speed leg between their neighbours already says. A row
+    passing through a corner (arc lengths ``corners``) is always kept: a collinear one passed at one speed
+    would otherwise go, leaving two rows on different legs, which ``worldgen check`` reads as a cut corner."""
     pts = _at(w, cum, profile)
     rows = np.column_stack([times, pts])
     vel = np.diff(pts, axis=0) / np.diff(times)[:, None]
-    same = np.all(np.abs(vel[1:] - vel[:-1]) < 1e-9, axis=1)
+    mid = profile[1:-1]
+    through = np.isin(mid, corners) & (profile[:-2] != mid) & (profile[2:] != mid)
+    same = np.all(np.abs(vel[1:] - vel[:-1]) < 1e-9, axis=1) & ~through
     keep = np.r_[True, ~same, True]
     return rows[keep]

@@ -26,7 +26,12 @@ robot drives: from one row interval to the next the speed changes by at most ``m
 the shorter interval (at rest before t = 0 and after the goal); wherever the direction of travel turns
 by an angle (at the spawn from the spawn's yaw) the robot stands at least that angle over
 ``max_turn_rate`` in between (:data:`TURN_SLACK` rad forgiven for the rounding of the rows); and every
-distance above is kept with ``tracking_margin`` more.
+distance above is kept with ``tracking_margin`` more. A turn of at most ``CUT_ANGLE`` at a waypoint the rows
+pass through needs no stand where it is a corner passed moving (docs/people.md): the arc tangent to both
+legs is re-derived here from the recorded path and limits (or one of its ``SHRINK`` shares), its chord must
+keep the clearance by FCL, the rows within its reach of the waypoint must be no faster than its radius times
+``max_turn_rate``, and while the schedule is within that reach every person is kept the largest arc's
+deviation farther.
 """
 
 from __future__ import annotations
@@ -94,23 +99,27 @@ def check_timed(meta: dict, world) -> None:
         if nearest.distance < world.robot.clearance - 1e-6:
             raise TimedPathError(f"{task['id']} timed_path comes {nearest.distance:.6f} m from {nearest.name}, "
                                  f"under the clearance {world.robot.clearance} m")
+        limited = "max_turn_rate" in robot or "max_acceleration" in robot
+        moving = _moving(task, rows, robot, colliders, world.robot) if limited else []
         # Between two samples a robot and a person, each straight at constant speed, close at most w h / 2.
         reach = (v_max + fastest) * TIMED_STEP / 2
         t = np.arange(0.0, rows[-1, 0] + TIMED_STEP, TIMED_STEP)
         me = _at(rows, t)
+        cut = _cut_near(me, t, rows, moving)  # how far the robot may be off the schedule at each sample
         for (name, track, radius), tube, loop in zip(tracks, tubes, loops):
             if tube is not None:
-                _check_tube(task["id"], name, me, t, track, inflation + radius, tube, v_max)
+                _check_tube(task["id"], name, me, t, track, inflation + radius + cut, tube, v_max)
                 continue
-            gap = np.hypot(*(me - _at(track, _looped(track, t) if loop else t)).T) - (inflation + radius)
+            gap = np.hypot(*(me - _at(track, _looped(track, t) if loop else t)).T) - (inflation + radius + cut)
             k = int(np.argmin(gap))
             if gap[k] < reach:
                 raise TimedPathError(f"{task['id']} timed_path at t = {t[k]:.3f} s comes "
-                                     f"{gap[k] + radius + inflation:.4f} m from {name}'s centre, under "
+                                     f"{gap[k] + radius + inflation + cut[k]:.4f} m from {name}'s centre, under "
                                      "robot.radius + robot.clearance (+ robot.tracking_margin) + its radius = "
-                                     f"{inflation + radius:.4f} m (+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
-        if "max_turn_rate" in robot or "max_acceleration" in robot:
-            _drivable(task, rows, float(robot["max_turn_rate"]), float(robot["max_acceleration"]))
+                                     f"{inflation + radius + cut[k]:.4f} m (+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
+        if limited:
+            _drivable(task, rows, float(robot["max_turn_rate"]), float(robot["max_acceleration"]),
+                      {corner for corner, _, _ in moving})
 
 
 def _tube(person: dict):
@@ -130,20 +139,22 @@ def _tube(person: dict):
     return float(tube["d"]), float(tube["tau"])
 
 
-def _check_tube(task_id: str, name: str, me: np.ndarray, t: np.ndarray, track: np.ndarray, contact: float,
+def _check_tube(task_id: str, name: str, me: np.ndarray, t: np.ndarray, track: np.ndarray, contact,
                 tube: tuple, v_max: float) -> None:
-    """Every sample of the robot at ``me`` (times ``t``) far enough from the person's whole tube."""
+    """Every sample of the robot at ``me`` (times ``t``) far enough from the person's whole tube (``contact``:
+    the distance to keep, one for all samples or one each)."""
     from worldgen.people.behaviours import tube_distance
 
     d, tau = tube
     reach = v_max * TIMED_STEP / 2
+    contact = np.broadcast_to(np.asarray(contact, dtype=float), t.shape)
     gap = tube_distance(me, t, track, tau + TIMED_STEP / 2) - (contact + d)
     k = int(np.argmin(gap))
     if gap[k] < reach:
-        raise TimedPathError(f"{task_id} timed_path at t = {t[k]:.3f} s comes {gap[k] + contact:.4f} m from "
+        raise TimedPathError(f"{task_id} timed_path at t = {t[k]:.3f} s comes {gap[k] + contact[k]:.4f} m from "
                              f"{name}'s recorded positions within {tau:g} s of then, under robot.radius + "
-                             f"robot.clearance (+ robot.tracking_margin) + its radius + its tube's d = {contact + d:.4f} m "
-                             f"(+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
+                             f"robot.clearance (+ robot.tracking_margin) + its radius + its tube's d = "
+                             f"{contact[k] + d:.4f} m (+ {reach:.4f} m between {TIMED_STEP:g} s samples)")
 
 
 def _speeds(rows: np.ndarray) -> np.ndarray:
@@ -206,8 +217,9 @@ def _timed_on_path(task: dict, rows: np.ndarray) -> None:
                              f"{rows[k + 1, 0]:g} s (the rows lie on different legs: it cuts a corner)")
 
 
-def _drivable(task: dict, rows: np.ndarray, turn_rate: float, acceleration: float) -> None:
-    """Speed changes within ``acceleration``; a stand of at least angle / ``turn_rate`` wherever the way turns."""
+def _drivable(task: dict, rows: np.ndarray, turn_rate: float, acceleration: float, moving=frozenset()) -> None:
+    """Speed changes within ``acceleration``; a stand of at least angle / ``turn_rate`` wherever the way turns,
+    but at the rows of ``moving`` (indices: corners passed on the move, already checked by :func:`_moving`)."""
     tid = task["id"]
     dt = np.diff(rows[:, 0])
     step = np.diff(rows[:, 1:], axis=0)
@@ -230,7 +242,73 @@ def _drivable(task: dict, rows: np.ndarray, turn_rate: float, acceleration: floa
             continue
         yaw = float(np.arctan2(step[k, 1], step[k, 0]))
         angle = abs((yaw - heading + np.pi) % (2 * np.pi) - np.pi)
-        if angle - TURN_SLACK > stood * turn_rate:
+        if angle - TURN_SLACK > stood * turn_rate and not (stood == 0.0 and k in moving):
             raise TimedPathError(f"{tid} timed_path turns {angle:.4f} rad at t = {rows[k, 0]:g} s after standing "
                                  f"{stood:g} s, faster than robot.max_turn_rate {turn_rate:g} rad/s")
         heading, stood = yaw, 0.0
+
+
+def _moving(task: dict, rows: np.ndarray, robot: dict, colliders, body) -> list:
+    """The corners the rows pass on the move, each (row index, waypoint, (reach, deviation)) of its largest
+    arc (docs/people.md, "Corners passed moving"), re-derived from the recorded path: a turn of at most
+    CUT_ANGLE at a waypoint the rows pass through without standing, some arc of SHRINK's whose chord keeps
+    the clearance (FCL, ``body`` the robot) and whose rows within its reach of the waypoint are no faster than
+    its radius times ``robot.max_turn_rate``. A turn there that fits no arc is left to :func:`_drivable`."""
+    from worldgen.feasibility.verify import verify_path
+    from worldgen.people.corners import CUT, CUT_ANGLE, SHRINK
+
+    wp = np.asarray(task["path"]["waypoints"], dtype=float).reshape(-1, 2)
+    if len(wp) < 3:
+        return []
+    omega, top = float(robot["max_turn_rate"]), float(robot["max_speed"])
+    d = np.diff(wp, axis=0)
+    legs = np.hypot(d[:, 0], d[:, 1])
+    yaw = np.arctan2(d[:, 1], d[:, 0])
+    turn = np.zeros(len(wp))
+    turn[1:-1] = np.abs((yaw[1:] - yaw[:-1] + np.pi) % (2 * np.pi) - np.pi)
+    ok = (turn > 0) & (turn <= CUT_ANGLE)
+    ok[1:-1] &= (legs[:-1] > 0) & (legs[1:] > 0)
+    half = turn / 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        want = np.where(ok, np.minimum(top / omega, CUT / (1 / np.cos(half) - 1)) * np.tan(half), 0.0)
+    speed = _speeds(rows)
+    out = []
+    for j in np.flatnonzero(want > 0):
+        ell = min(want[j], legs[j - 1] * want[j] / (want[j - 1] + want[j]), legs[j] * want[j] / (want[j] + want[j + 1]))
+        at = np.flatnonzero(np.hypot(*(rows[1:-1, 1:] - wp[j]).T) <= ON_PATH) + 1
+        if not len(at) or np.hypot(*(rows[at[0] - 1, 1:] - wp[j])) <= ON_PATH:
+            continue  # not passed through (it stands there, or never comes)
+        rho = ell / np.tan(half[j])
+        for share in SHRINK:
+            reach, cap = ell * share, rho * share * omega
+            a, b = wp[j] - d[j - 1] / legs[j - 1] * reach, wp[j] + d[j] / legs[j] * reach
+            near = _seg_dist(wp[j], rows[:-1, 1:], rows[1:, 1:]) <= reach
+            if np.all(speed[near] <= cap * (1 + 1e-6) + 2e-6 / np.diff(rows[:, 0])[near]) and \
+                    verify_path(colliders, body, np.array([a, b])).distance >= body.clearance - 1e-6:
+                out.append((int(at[0]), wp[j], (float(ell), float(rho * (1 / np.cos(half[j]) - 1)))))
+                break
+    return out
+
+
+def _seg_dist(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(n,) the distance from point ``p`` to each segment ``a[i]``-``b[i]``."""
+    ab = b - a
+    u = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
+    return np.hypot(*(a + u[:, None] * ab - p).T)
+
+
+def _cut_near(me: np.ndarray, t: np.ndarray, rows: np.ndarray, moving: list) -> np.ndarray:
+    """(len(me),) how far the robot may be off the schedule at each sample (times ``t``): the largest arc's
+    deviation while the schedule, passing a corner on the move, is within its reach of it, else 0."""
+    out = np.zeros(len(me))
+    for k, corner, (reach, dev) in moving:
+        inside = np.hypot(*(me - corner).T) <= reach + 1e-9
+        # Only the pass itself: the samples within reach next to the corner's row, not a later return.
+        mid = int(np.argmin(np.abs(t - rows[k, 0])))
+        lo, hi = mid, mid
+        while lo > 0 and inside[lo - 1]:
+            lo -= 1
+        while hi + 1 < len(t) and inside[hi + 1]:
+            hi += 1
+        out[lo:hi + 1] = np.maximum(out[lo:hi + 1], dev)
+    return out
