@@ -342,7 +342,8 @@ def _verify_movers(meta: dict) -> float:
         assert rows[-1, 0] == task["arrival_time"] <= task["time_limit"]
         np.testing.assert_allclose(rows[[0, -1], 1:], [task["spawn"][:2], task["goal"][:2]], atol=1e-6)
         assert (np.hypot(*np.diff(rows[:, 1:], axis=0).T) / np.diff(rows[:, 0])).max() <= v_max
-        _assert_drivable(rows, task["spawn"][-1], robot["max_turn_rate"], robot["max_acceleration"])
+        _assert_drivable(rows, task["spawn"][-1], robot["max_turn_rate"], robot["max_acceleration"],
+                         task["path"]["waypoints"])
         t = np.arange(0.0, rows[-1, 0] + H, H)
         me = _interp(rows, t)
         for track, radius, loop in agents:

@@ -162,11 +162,11 @@ def test_reacting_people_react_to_the_driven_robot_inside_their_tubes():
 
 
 @pytest.mark.parametrize("seed, params", [
-    (157, {"n_movers": 2, "n_people": 4}),
-    (159, {"n_movers": 2, "n_people": 4}),
+    (154, {"n_movers": 2, "n_people": 4}),
+    (180, {"n_movers": 2, "n_people": 4}),
 ])
 def test_a_pull_leaf_opening_onto_the_robot_is_given_way(seed, params, tmp_path, monkeypatch):
-    """Door seeds 157 and 159 with movers and people, whose certificates walk into a pull leaf's sweep while
+    """Door seeds 154 and 180 with movers and people, whose certificates walk into a pull leaf's sweep while
     the leaf opens (no spawn lies in a sweep: the generator keeps them out); standing in the sweep, the robot
     kept the leaf shut and ended stuck. It backs out of the sweep, or waits outside it, until the leaf is
     open."""

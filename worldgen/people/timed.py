@@ -154,11 +154,7 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     # every corner (V steps each way at most).
     steps = math.ceil((end + length / lim.max_speed + float(spot_steps.sum()) * DT + AFTER) / DT) + levels * len(corner)
     times = np.arange(steps + 1) * DT
-    reach = (np.asarray(radii, dtype=float) + inflation + MARGIN + tracking
-             + (lim.max_speed + person_speed(tracks)) * DT / 2)
-    tubes = list(tubes) if tubes is not None else [Tube(0.0, 0.0)] * len(tracks)
-    reach = reach + np.array([tube.d for tube in tubes], dtype=float).reshape(len(tracks))
-    window = np.array([tube_steps(tube.tau) for tube in tubes], dtype=np.int64).reshape(len(tracks))
+    reach, window = _reaches(tracks, radii, tubes, inflation + MARGIN + tracking, lim.max_speed)
     span = int(spot_steps.max(initial=1))
     live = np.arange(span)[None, :] < spot_steps[:, None]
     # From this time on every person stands and every step's free cells are the last step's: a step whose
@@ -204,6 +200,17 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
 
     cells = _read_back(states, len(moving), turning, spot, spot_steps, ok, passes, n_cells, levels)
     return TimedPath(_rows(w, cum, times[: k_goal + 1], s[np.array(cells)], s[corner]), k_goal * DT)
+
+
+def _reaches(tracks, radii, tubes, keep: float, top: float) -> tuple[np.ndarray, np.ndarray]:
+    """(how near each agent's recorded centre a cell is blocked (m), the steps either side of a step its tube
+    spans): its radius, ``keep`` (the robot's inflation, MARGIN and the tracking margin), its tube's ``d``,
+    and what the robot at ``top`` m/s and the fastest agent close between two steps."""
+    tubes = list(tubes) if tubes is not None else [Tube(0.0, 0.0)] * len(tracks)
+    reach = (np.asarray(radii, dtype=float) + keep + (top + person_speed(tracks)) * DT / 2
+             + np.array([tube.d for tube in tubes], dtype=float).reshape(len(tracks)))
+    window = np.array([tube_steps(tube.tau) for tube in tubes], dtype=np.int64).reshape(len(tracks))
+    return reach, window
 
 
 def _moves(s: np.ndarray, corner: np.ndarray, leg_ds: np.ndarray, cum: np.ndarray, turns: np.ndarray, levels: int,

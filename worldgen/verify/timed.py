@@ -57,6 +57,7 @@ class TimedPathError(WorldgenError):
     exit_status = EXIT_FAILED
 
 
+# long: one pass over the tasks, each checked on every count in turn against the same agents and geometry
 def check_timed(meta: dict, world) -> None:
     """Re-prove every task's timed path of world.json ``meta`` (``world``: its regenerated World, for the
     static geometry); raise :class:`TimedPathError` with one line at the first fault."""
