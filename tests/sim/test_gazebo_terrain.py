@@ -1,5 +1,7 @@
 """Terrain in a real Gazebo (Fortress and Harmonic, headless): the ground under points sampled on every kind of
-element (ramp, kerb, pothole, rough patch) and on the floor between them is world.json's height within 1 cm.
+element (ramp, kerb, pothole, rough patch) and on the floor between them is world.json's height within 1 cm;
+``worldgen drive --sim gazebo`` goes up a ramp, along its landing and down to the goal (Fortress; Harmonic too
+with ``WORLDGEN_GAZEBO_ALL=1``, as the other drives).
 
 Gazebo has no ray-cast service to ask, so the test asks its physics: a small ball on a vertical rail (a
 prismatic joint to the world) above each point, let go 3 cm above world.json's height, falls onto the world's
@@ -12,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from lxml import etree
+from support.gazebo import release_cases
 
 import worldgen
 from worldgen.export.contract import SIM_GZ_RELEASES
@@ -75,3 +78,27 @@ def test_gazebo_ground_is_world_json_height_at_sampled_points(probed, release, i
     rest = np.array([poses[f"probe_{k}"][2] + poses[f"probe_{k}::ball"][2] for k in range(len(points))])
     error = rest - BALL - heights
     assert np.abs(error).max() < TOLERANCE, (points[np.argmax(np.abs(error))], error.round(4).tolist())
+
+
+@pytest.mark.parametrize(("release", "case"), release_cases(["ramp"], set()))
+def test_gazebo_drives_up_the_ramp_along_its_landing_and_down_to_the_goal(release, case, installs, tmp_path):
+    """``worldgen drive --sim gazebo`` in the MuJoCo drive test's world: export.robot's diff-drive robot,
+    its casters sprung on terrain, over a 9.4 degree ramp met 8 degrees off square. Its (x, y) crosses the
+    landing, which it can only have done on top of the ramp (the ramp is a solid), and it reaches the goal."""
+    pytest.importorskip("rosbags")
+    from support.terrain import ramp_world
+
+    from worldgen.ros import read_run
+    from worldgen.sim.drive import drive
+
+    installs(release)
+    world = ramp_world()
+    folder = world.write(tmp_path / "worlds", preview=False)
+    outcome = drive(folder, tmp_path / "runs", sim="gazebo", gz_release=release)
+    assert outcome.ended == "goal" and outcome.passed, outcome.verdict
+    (ramp,) = world.scene.terrain.elements
+    xy = read_run(outcome.bag, folder).trajectory[:, 1:3]
+    heights = world.scene.terrain.heights(xy)
+    on_landing = np.flatnonzero(np.isclose(heights, ramp.rise))
+    assert len(on_landing) >= 10  # 0.5 s at 20 Hz or more on top
+    assert heights[: on_landing[0]].min() == 0.0 and heights[on_landing[-1]:].min() == 0.0  # up from and down to the floor
