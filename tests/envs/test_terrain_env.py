@@ -52,3 +52,22 @@ def test_a_flat_world_gets_the_flat_base_unchanged():
     assert terrain.find("worldbody/geom").get("conaffinity") == "3" and math.isclose(
         float(terrain.find("worldbody/body").get("pos").split()[2]), centre_height(0.4, robot.ground_clearance))
     assert np.isclose(centre_height(0.4, 0.03), 0.215)
+
+
+def test_the_geodesic_reward_goes_round_ground_the_robot_cannot_drive():
+    # A 6 cm kerb stands between spawn and goal: the proven path goes round it, and so does the field the
+    # default reward shapes with (within the field's documented 2.75 % plus a spacing per corner).
+    from support.terrain import KERB_PARAMS, KERB_SEED
+
+    import worldgen
+    from worldgen.envs.geodesic import GeodesicField
+
+    world = worldgen.generate("terrain", seed=KERB_SEED, **KERB_PARAMS)
+    path = world.feasibility.paths[0]
+    (x, y), goal = path.waypoints[0], path.waypoints[-1]
+    field = GeodesicField.for_scene(world.scene, world.robot, goal)
+    straight = math.dist((x, y), goal)
+    assert path.length > straight + 0.1
+    assert path.length - 0.002 <= field.distance(x, y) <= 1.0275 * path.length + 2 * 0.05
+    assert GeodesicField.for_scene(world.scene.with_terrain(None), world.robot, goal).distance(x, y) == \
+        pytest.approx(straight, abs=1e-6)
