@@ -129,6 +129,11 @@ def score(world) -> dict:
     f = difficulty.features_from(truth.difficulty(world), finite_or_none(report.narrowest_passage), world.robot.radius,
                                  [(p.waypoints, float(p.length)) for p in paths if p is not None],
                                  [bool(leaves_on_path(world, p)) for p in paths])
+    terrain = world.scene.terrain
+    if f is not None and terrain is not None:  # as world.json's score reads it: the first task's path
+        first = next((fig for p, fig in zip(paths, getattr(report, "terrain", ())) if p is not None), None)
+        f.update(difficulty.terrain_features(terrain, world.scene.bounds, None if first is None else first.profile,
+                                             None if first is None else (first.largest_incline, first.largest_step)))
     return difficulty.rating(f)
 
 

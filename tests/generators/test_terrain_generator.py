@@ -134,7 +134,7 @@ def test_a_terrain_parameter_without_the_option_is_one_line_and_exit_2(tmp_path)
 
 
 def test_a_generator_without_the_terrain_option_refuses_it_in_one_line(tmp_path):
-    got = run("generate", "corridor", "--set", "terrain=true", "--out", tmp_path)
+    got = run("generate", "door", "--set", "terrain=true", "--out", tmp_path)
     assert got.returncode == 2 and len(got.stderr.strip().splitlines()) == 1
     assert got.stderr.startswith("error: unknown parameter 'terrain'")
 

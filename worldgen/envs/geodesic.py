@@ -116,15 +116,18 @@ class GeodesicField:
 
     @classmethod
     def for_scene(cls, scene, robot, goal, spacing: float = 0.05) -> "GeodesicField":
-        """The field of ``scene`` (doors open, as the feasibility proof plans) for ``robot``, to ``goal`` (x, y)."""
+        """The field of ``scene`` (doors open, as the feasibility proof plans; the ground ``robot`` cannot drive
+        in the way) for ``robot``, to ``goal`` (x, y)."""
         from worldgen.feasibility.check import SAFETY
         from worldgen.feasibility.cspace import ConfigSpace
         from worldgen.feasibility.geometry import Obstacles2D
         from worldgen.scene.doors import open_scene
+        from worldgen.scene.drivable import terrain_footprints
         from worldgen.scene.footprint import robot_footprints
 
         opened = open_scene(scene)
-        obstacles = Obstacles2D.from_footprints(robot_footprints(opened, robot))
+        # Ground the robot cannot drive is in the way as the feasibility proof has it ([] on flat ground).
+        obstacles = Obstacles2D.from_footprints(robot_footprints(opened, robot) + terrain_footprints(opened, robot))
         cs = ConfigSpace.build(obstacles, robot.inflation + SAFETY, opened.bounds)
         return cls(cs, goal, opened.bounds, spacing)
 

@@ -72,15 +72,24 @@ class Lidar:
         """Length of :meth:`observe`'s output: sectors when binning, else beams."""
         return self.sectors or self.beams
 
-    def cast(self, model, data, x: float, y: float, yaw: float, height: float, exclude_body: int) -> np.ndarray:
-        """(beams,) noise-free ranges (m) from (x, y, height) with heading ``yaw``; a new array."""
+    def cast(self, model, data, x: float, y: float, yaw: float, height: float, exclude_body: int,
+             frame: Optional[tuple] = None) -> np.ndarray:
+        """(beams,) noise-free ranges (m) from (x, y, height) with heading ``yaw``; a new array. ``frame``
+        (origin (3,), rotation (3, 3)) casts from a tilted lidar instead: the beams in the frame's x-y plane,
+        from its x axis (the robot on terrain, worldgen.envs.terrain)."""
         import mujoco
 
-        c, s = math.cos(yaw), math.sin(yaw)
         vec = self._vec
-        vec[:, 0] = self._cos * c - self._sin * s
-        vec[:, 1] = self._sin * c + self._cos * s
-        self._pnt[:] = (x, y, height)
+        if frame is None:
+            c, s = math.cos(yaw), math.sin(yaw)
+            vec[:, 0] = self._cos * c - self._sin * s
+            vec[:, 1] = self._sin * c + self._cos * s
+            vec[:, 2] = 0.0  # after a tilted cast
+            self._pnt[:] = (x, y, height)
+        else:
+            origin, rotation = frame
+            vec[:] = np.outer(self._cos, rotation[:, 0]) + np.outer(self._sin, rotation[:, 1])
+            self._pnt[:] = origin
         if _MULTIRAY_NORMALS:
             mujoco.mj_multiRay(model, data, self._pnt, vec.reshape(-1), self._groups, 1, exclude_body,
                                self._geom, self._dist, None, self.beams, self.range_max)

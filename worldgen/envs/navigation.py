@@ -57,6 +57,10 @@ path length, world.json ``tasks[].path.length``), ``time_limit`` (the one in for
 ``success``, ``spl``, ``path_length``, ``collisions``, ``door_contacts``, ``doors_opened``, ``min_clearance``,
 ``duration``, ``time_to_goal``, ``reached_goal``, ...
 
+Terrain: in a world with terrain (world.json ``terrain``) the robot is :mod:`worldgen.envs.terrain`'s base,
+whose height and tilt follow its feet's contacts with the ground, and the lidar rides and tilts with it;
+in a flat world it is the planar base of :mod:`worldgen.envs.robot`, as before.
+
 Seeding: ``reset(seed=s)`` reseeds two independent streams derived from s (one
 draws each episode's world seed, one the lidar noise), so the same seeds and
 actions give the same observations in any process. ``reset(options=...)``:
@@ -82,8 +86,9 @@ from worldgen.envs.lidar import Lidar
 from worldgen.envs.period import run_period
 from worldgen.envs.reacting import walkers_of
 from worldgen.envs.reward import StepOutcome, reward
-from worldgen.envs.robot import RobotModel, add_robot, compile_world
+from worldgen.envs.robot import RobotModel, compile_world
 from worldgen.envs.source import EpisodeWorld, PackSource, make_source
+from worldgen.envs.terrain import add_base, lidar_frame, settle
 from worldgen.errors import CallOrderError, ParameterError
 from worldgen.judge.figures import Contact
 from worldgen.seeding import check_seed, draw_seed, env_rngs
@@ -137,6 +142,8 @@ class NavigationEnv(gym.Env):
         self._noise_rng: Optional[np.random.Generator] = None
         self._next_index = 0
         self._sim: Optional[RobotModel] = None
+        # On terrain, the body's centre over flat ground (where the lidar rides from); None on flat ground.
+        self._centre: Optional[float] = None
         self.world: Optional[EpisodeWorld] = None
         self.episode: Optional[Episode] = None
         self._painter = None
@@ -182,10 +189,10 @@ class NavigationEnv(gym.Env):
         cfg = self.config
         spawn = world.task["spawn"]
         movers = walkers_of(world)  # people who react to the robot among them (docs/people.md)
-        add_robot(world.mjcf, world.robot.radius, world.robot.height, cfg.linear_velocity, cfg.angular_velocity)
+        floor = add_base(world.mjcf, world.robot, cfg.linear_velocity, cfg.angular_velocity, world.terrain, world.floor)
         add_openers(world.mjcf, world.doors, cfg.doors)
-        sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), sorted(world.floor),
-                            [m["name"] for m in world.movers])
+        sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), floor, [m["name"] for m in world.movers])
+        self._centre = settle(sim, world.robot) if world.terrain else None
         world.mjcf = None  # the tree is compiled: let it go
         self._substeps = cfg.substeps(float(sim.model.opt.timestep))
         self._sim = sim
@@ -319,7 +326,9 @@ class NavigationEnv(gym.Env):
     def _observe(self) -> np.ndarray:
         sim = self._running()[0]
         x, y, yaw = sim.pose()
-        self._ranges = self.lidar.cast(sim.model, sim.data, x, y, yaw, self._lidar_height, sim.body)
+        # On terrain the lidar rides and tilts with the body (worldgen.envs.terrain); on flat ground it is level.
+        frame = None if self._centre is None else lidar_frame(sim, self._lidar_height, self._centre)
+        self._ranges = self.lidar.cast(sim.model, sim.data, x, y, yaw, self._lidar_height, sim.body, frame)
         scan = self.lidar.observe(self._ranges, self._noise_rng)
         distance, angle = self._goal_polar(x, y, yaw)
         obs = np.empty(self.lidar.size + 4, dtype=np.float32)

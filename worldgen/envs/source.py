@@ -40,7 +40,8 @@ class EpisodeWorld:
     ``door_leaves`` the names of the door leaves (world.json ``doors[].name``, each
     a hinged body the robot may push open: touching one is a door contact, not a collision);
     ``bounds`` ((x0, y0), (x1, y1)) where the robot may be; :meth:`scene` the world's scene (for the geodesic field);
-    ``doors`` world.json's ``doors[]`` (hinge joint, limits, doorway: what an automatic door opens by).
+    ``doors`` world.json's ``doors[]`` (hinge joint, limits, doorway: what an automatic door opens by);
+    ``terrain`` whether the world has terrain (the robot is then :mod:`worldgen.envs.terrain`'s base).
     """
 
     world_id: str
@@ -58,6 +59,7 @@ class EpisodeWorld:
     _scene: Optional[Callable[[], Any]] = field(default=None, repr=False)
     bounds: Optional[tuple] = None
     doors: tuple = ()
+    terrain: bool = False
 
     @property
     def reference_path_length(self) -> float:
@@ -127,7 +129,7 @@ def episode_world(world) -> EpisodeWorld:
         lidar_height=float(world.params.get("lidar_height", 0.3)), params=dict(world.params),
         _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}),
         door_leaves=leaves, _scene=lambda: world.scene, bounds=tuple(map(tuple, world.scene.bounds)),
-        doors=tuple(door_records(world.scene)) if leaves else ())
+        doors=tuple(door_records(world.scene)) if leaves else (), terrain=world.scene.terrain is not None)
 
 
 class GeneratorSource:
@@ -301,7 +303,8 @@ def _episode_world(reader, task: dict, mjcf: bytes, ground: Callable[[], Any], s
         lidar_height=float(params.get("lidar_height", 0.3)), params=params,
         _ground=ground, _metadata=lambda: meta, _scene=scene,
         bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
-        door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()))
+        door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()),
+        terrain=bool(meta.get("terrain")))
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):

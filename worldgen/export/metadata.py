@@ -118,6 +118,7 @@ def _add_terrain(meta: dict, world) -> None:
     figures += [None] * max(0, len(meta["tasks"]) - len(figures))
     for entry, fig in zip(meta["tasks"], figures):
         entry["terrain"] = None if fig is None else fig.entry()
+    meta["metrics"].update(difficulty.assess(meta))  # scored again with the terrain's inputs (docs/metrics.md)
 
 
 def _add_timed(meta: dict, world) -> None:

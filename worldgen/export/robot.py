@@ -44,8 +44,8 @@ from worldgen.export.contract import CMD_VEL, DEFAULT_GZ_RELEASE, GROUND_TRUTH, 
 from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
 
-__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "WHEEL_ACCELERATION", "Dimensions", "dimensions", "robot_sdf",
-           "robot_urdf"]
+__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "WHEEL_ACCELERATION", "CASTER_SPRING", "CASTER_DAMPING",
+           "CASTER_TRAVEL", "CASTER_PRELOAD", "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
 
 #: The model's name: the ROS 2 bundle's robot (worldgen.export.ros2.DEFAULT_ROBOT_NAME).
 DEFAULT_NAME = "robot"
@@ -69,6 +69,11 @@ _CHASSIS_KG, _WHEEL_KG, _CASTER_KG = 10.0, 0.5, 0.2
 #: issue 39 saw after a stop. Below the tyres' grip the body follows its wheels.
 WHEEL_ACCELERATION = 2.5
 _COLOUR = "0.95 0.45 0.1 1"
+#: On terrain only, the casters' suspension: stiffness (N/m), damping (N s/m), travel either way and
+#: preload (m, how far below the wheels' ground the spring would rest). Stiff enough that the body pitches
+#: a few degrees under the DiffDrive's acceleration, soft enough that a caster lifted 2 cm by a ramp's
+#: foot leaves most of the weight on the wheels.
+CASTER_SPRING, CASTER_DAMPING, CASTER_TRAVEL, CASTER_PRELOAD = 5000.0, 100.0, 0.03, 0.003
 
 
 class Dimensions:
@@ -273,10 +278,33 @@ def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_r
     sub(model, "frame", name="base_footprint", attached_to="base_link").append(
         _el("pose", fmt_seq((0, 0, -d.wheel_radius, 0, 0, 0)), relative_to="base_link"))
     _sdf_links(model, d)
+    if _meta(world).get("terrain"):  # only there: a flat world's robot keeps its bytes
+        _suspend_casters(model)
     if sensors:
         _sdf_sensors(model, d, _meta(world)["sensors"]["lidar"], float(lidar_noise), float(lidar_rate))
     _sdf_plugins(model, d, name, gz_release, float(odom_rate))
     return to_bytes(root).decode()
+
+
+def _suspend_casters(model) -> None:
+    """Put each caster on a vertical spring (docs/terrain.md): rigid, the two casters and two wheels stand on
+    four points, and where the ground bends up (a ramp's foot) the casters lift the wheels off it, which
+    then have no grip (measured in Fortress and Harmonic: the robot stalls at every ramp's foot). On springs
+    the casters follow the ground and the wheels keep the weight. The URDF keeps them fixed: nothing reads
+    a caster's joint."""
+    for joint in model.findall("joint"):
+        if joint.get("name", "").endswith("caster_joint"):
+            joint.set("type", "prismatic")
+            axis = sub(joint, "axis")
+            sub(axis, "xyz", "0 0 1")
+            limit = sub(axis, "limit")
+            sub(limit, "lower", fmt(-CASTER_TRAVEL))
+            sub(limit, "upper", fmt(CASTER_TRAVEL))
+            dynamics = sub(axis, "dynamics")
+            sub(dynamics, "spring_stiffness", fmt(CASTER_SPRING))
+            # Rest a little below the wheels' ground: pressed up to it, the casters keep a light contact.
+            sub(dynamics, "spring_reference", fmt(-CASTER_PRELOAD))
+            sub(dynamics, "damping", fmt(CASTER_DAMPING))
 
 
 def _el(tag: str, text: str, **attrs):

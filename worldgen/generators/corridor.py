@@ -35,11 +35,13 @@ from worldgen.errors import InfeasibleError, ParameterError
 from worldgen.floats import round_float
 from worldgen.generators.base import Draft, GeneratorSpec, robot_from_params
 from worldgen.generators.corridor_layout import Layout, layout
+from worldgen.generators.corridor_terrain import OPTION_PARAMS, check_ramps, place_ramps
 from worldgen.generators.knob import Knob
 from worldgen.generators.room import FLOOR_RGBA, FLOOR_THICKNESS, WALL_RGBA
 from worldgen.params import Param
 from worldgen.scene import Box, Material, Node, Physics, Pose, Scene, Task
 from worldgen.scene.footprint import SAFETY
+from worldgen.scene.terrain import Terrain
 
 __all__ = ["SPEC", "build", "check", "proven_width"]
 
@@ -71,7 +73,7 @@ PARAMS = (
     Param("obstacle_height", "range", [0.5, 1.0], "range of obstacle heights", 0.01, 50.0, unit="m"),
     Param("side_openings", "int", 0, "gaps in the side walls, on random sides and legs", 0, 100),
     Param("opening_width", "float", 1.0, "width of each side opening", 0.05, 50.0, unit="m"),
-)
+) + OPTION_PARAMS
 
 
 def proven_width(params: Mapping[str, Any]) -> float:
@@ -137,6 +139,8 @@ def check(params: Mapping[str, Any]) -> None:
     if params["side_openings"] and params["opening_width"] > max(b - a for a, b in
                                                                  (lay.straight_part(i) for i in range(k))):
         raise ParameterError(f"parameter 'opening_width' must fit in a leg's straight part, got {params['opening_width']!r}")
+    if params.get("terrain"):
+        check_ramps(params, max(hi - lo for lo, hi in _usable(lay, params)), g)
     # Last, so that allow_infeasible (which skips this error) still had every other check.
     if params["n_obstacles"]:
         shortest = params["obstacle_length"][0] + 2 * g
@@ -221,6 +225,12 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
                           _pose(centre, h / 2, lay.heads[leg]),
                           mass=round_float(max(along * depth * h * OBSTACLE_DENSITY, 1e-3)), material=mat))
     scene = Scene(tuple(nodes), (), bounds, Physics(params["step_size"], params["real_time_factor"]))
+    if params.get("terrain") and params["n_ramps"]:  # a third stream, spawned only then: the rest keep theirs
+        ramps = place_ramps(params, rng.spawn(1)[0], lay, w,
+                            lambda r, length: _place(r, usable, taken, length, g), lambda leg: _yaw(lay.heads[leg]))
+        if isinstance(ramps, str):
+            return Draft(None, rejected="terrain_placement", detail=ramps)
+        scene = scene.with_terrain(Terrain(tuple(ramps)))
     start = lay.points[0] + e * lay.u(0)
     end = lay.points[-1] - e * lay.u(k - 1)
     task = Task("task_0", Pose(round_float(start[0]), round_float(start[1]), 0.0, 0.0, 0.0, _yaw(lay.heads[0])),
@@ -316,6 +326,7 @@ SPEC = GeneratorSpec(
     check=check,
     examples=(
         "worldgen generate corridor --set width=0.8 --out worlds",
+        "worldgen generate corridor --set terrain=true --set n_ramps=2 --set length=12 --out worlds",
         "worldgen generate corridor --set shape=zigzag --set segments=4,3,4 --set turns=left,right --out worlds",
         "worldgen generate corridor --set shape=L --set n_obstacles=4 --set side_openings=2 --out worlds",
     ),

@@ -63,8 +63,8 @@ def build(params: Mapping[str, Any], rng: np.random.Generator) -> Draft:
     return Draft(scene, tuple(tasks))
 
 
-#: A level request turns the obstacle count as cluttered's knob does, from cluttered's calibration: the
-#: difficulty score reads the obstacles and the paths, not yet the terrain (docs/terrain.md).
+#: A level request turns the obstacle count as cluttered's knob does, from cluttered's calibration; the
+#: score it aims at reads the terrain too (worldgen.groundtruth.difficulty's terrain terms, docs/metrics.md).
 KNOB = Knob("n_obstacles", cluttered.KNOB.start, step=cluttered.KNOB.step, high=cluttered.KNOB.high,
             per_area=True, excludes=("density",))
 

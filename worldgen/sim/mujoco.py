@@ -10,6 +10,9 @@ door leaves, movers and people, everything that moves driven as the environment 
   the robot comes to from the side its leaf swings into (a pull door) swings open by its hinge motor once
   the robot is within :data:`DOOR_TRIGGER` of the doorway; a push door is pushed open by the robot.
 
+In a world with terrain the robot is :mod:`worldgen.envs.terrain`'s base, whose height and tilt follow its
+feet's contacts with the ground (:attr:`MujocoBackend.heights` records how high it rides).
+
 Every contact of the robot's body (the floor left out) is kept in :attr:`MujocoBackend.contacts`, door
 leaves apart in :attr:`MujocoBackend.door_contacts`. Deterministic: the same world and commands give the
 same poses, bit for bit, in any process.
@@ -27,7 +30,8 @@ from lxml import etree
 from worldgen.envs.config import SETTINGS
 from worldgen.envs.doors import Openers, add_openers
 from worldgen.envs.reacting import Walkers
-from worldgen.envs.robot import add_robot, compile_world
+from worldgen.envs.robot import compile_world
+from worldgen.envs.terrain import add_base, settle
 from worldgen.export.xml import safe_parser
 from worldgen.groundtruth.folder import robot_of
 from worldgen.judge.figures import DOOR_DEBOUNCE
@@ -67,11 +71,14 @@ class MujocoBackend:
     def __init__(self, mjcf: Union[bytes, Path], meta: dict, scene: Any = None):
         root = etree.fromstring(mjcf if isinstance(mjcf, bytes) else Path(mjcf).read_bytes(), safe_parser())
         self.robot = robot_of(meta)
-        add_robot(root, self.robot.radius, self.robot.height, V_RANGE, W_MAX)
+        #: Whether the world has terrain: then the robot is the terrain base (worldgen.envs.terrain).
+        self.terrain = bool(meta.get("terrain"))
+        self._floor = add_base(root, self.robot, V_RANGE, W_MAX, self.terrain,
+                               {e["name"] for e in meta["entities"] if e["role"] == "floor"})
+        self._centre = 0.0
         self._doors = list(meta.get("doors") or [])
         add_openers(root, self._doors, DOOR_MODE)
         self._root = root
-        self._floor = sorted(e["name"] for e in meta["entities"] if e["role"] == "floor")
         self._leaves = frozenset(str(d["name"]) for d in self._doors)
         movers = movers_of(meta)
         self._names = [str(m["name"]) for m in movers]
@@ -86,6 +93,9 @@ class MujocoBackend:
         self.contacts: list[tuple[float, str]] = []
         self.door_contacts: list[tuple[float, str]] = []
         self.dt = 0.0
+        #: On terrain: (t, rise) after every command, the robot's centre's height over where it stands on
+        #: flat ground (the ramp it is on, give or take its tilt).
+        self.heights: list[tuple[float, float]] = []
 
     @property
     def doors_opened(self) -> list[str]:
@@ -98,6 +108,9 @@ class MujocoBackend:
         x, y, _, yaw = spawn
         sim: Any = compile_world(self._root, (x, y, yaw), self._floor, self._names)
         self._sim = sim
+        if self.terrain:
+            self._centre = settle(sim, self.robot)
+            self.heights = [(float(sim.data.time), self._rise())]
         self.dt = float(sim.model.opt.timestep)
         self.walkers.reset()
         if len(self.walkers):
@@ -177,9 +190,14 @@ class MujocoBackend:
             mujoco.mj_step(model, data)
             if data.ncon or self._touching:
                 self._note(float(data.time))
+        if self.terrain:
+            self.heights.append((float(data.time), self._rise()))
         x, y, yaw = sim.pose()
         # The hinge's angle winds past +-pi; a heading is an angle in (-pi, pi].
         return float(data.time), x, y, math.atan2(math.sin(yaw), math.cos(yaw))
+
+    def _rise(self) -> float:
+        return float(self._sim.data.xpos[self._sim.body][2]) - self._centre
 
     def _note(self, t: float) -> None:
         """Keep the contacts of the robot's body that began at ``t`` (the floor left out)."""
