@@ -35,7 +35,7 @@ import numpy as np
 
 from worldgen.envs.policies import PathFollower, TimedFollower
 from worldgen.errors import OutputError, ParameterError
-from worldgen.groundtruth.folder import WorldFolder, open_world
+from worldgen.groundtruth.folder import WorldFolder, open_world, robot_of
 from worldgen.sim.schedule import Plan, plan_for
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "CATCH_UP",
@@ -166,7 +166,7 @@ def _on_schedule(plan: Plan, t: float, x: float, y: float) -> bool:
     return math.hypot(x - float(np.interp(t, r[:, 0], r[:, 1])), y - float(np.interp(t, r[:, 0], r[:, 2]))) < LAG
 
 
-def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None):
+def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None, plan: Optional[Plan] = None):
     meta = world.metadata
     if sim == "mujoco":
         from worldgen.sim.mujoco import MujocoBackend
@@ -187,7 +187,16 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None):
     # The robot is written for the release that runs it: its plugins' names are that release's.
     install = locate(release=gz_release)
     robot = robot_sdf(meta, gz_release=install.release.name, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
-    return GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install)
+    # The pull doors on the plan's way get a joint controller in a copy of the world (worldgen.sim.gazebo_doors);
+    # a build without the system refuses here, before anything starts.
+    from worldgen.sim.gazebo_doors import GazeboDoors, plan_points, pulled_doors, world_with_openers
+
+    pulled = pulled_doors(meta.get("doors") or [], plan_points(plan)) if plan is not None else []
+    if not pulled:
+        return GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install)
+    text, topics = world_with_openers(sdf, pulled, install)
+    return GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install, world_text=text,
+                         doors=GazeboDoors(pulled, robot_of(meta).radius), door_topics=tuple(topics))
 
 
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,
@@ -221,7 +230,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     started = time.perf_counter()
     plan = plan_for(meta, chosen, speed, straight, lambda: _scene_of(opened))
     wall["plan"] = time.perf_counter() - started
-    backend = _backend(sim, opened, gz_release)
+    backend = _backend(sim, opened, gz_release, plan)
     try:
         trajectory, commands, ended = run_loop(backend, chosen, straight, speed, plan)
     finally:
