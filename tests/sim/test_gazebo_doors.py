@@ -129,6 +129,30 @@ def test_the_leaf_ramps_open_and_the_robot_gives_way_while_it_swings(pull):
     assert doors.give_way(1.2, *(centre - normal * 1.0), 0.0, 0.5, 0.05) == 0.5  # the far side: nothing swings there
 
 
+def test_the_backend_tests_the_rule_only_from_poses_gazebo_gave(pull):
+    # A robot spawned inside the trigger disc of a pull door: the rule must see the spawn first. A made-up pose
+    # before Gazebo's first (the origin, on this doorway's line: the push side's edge) once marked the door as
+    # entered from the push side, and the ajar pull door of the benchmark's door seed 16 stayed held shut.
+    import io
+
+    from worldgen.sim.bridge import GazeboBackend
+
+    door = open_world(pull, "w").metadata["doors"][0]
+    spawn = np.asarray(door["passage"]["center"]) + np.asarray(door["passage"]["normal"]) * (DOOR_TRIGGER - 0.5)
+    backend = GazeboBackend(pull / "world.sdf", "", dt=0.002, doors=GazeboDoors([door], 0.2), world_text=b"",
+                            door_topics=("t",))
+
+    class Bridge:
+        stdin = io.StringIO()
+        stdout = io.StringIO("".join(f"p {t} {spawn[0]} {spawn[1]} 0\n" for t in (0.05, 0.1)))
+
+    backend._bridge = Bridge()  # type: ignore[assignment]
+    backend.step(0.0, 0.0, 25)  # start's step, for the first pose: nothing is known before it
+    assert backend.doors_opened == [] and "d " not in Bridge.stdin.getvalue()
+    backend.step(0.0, 0.5, 25)  # from the spawn
+    assert backend.doors_opened == ["door_0"] and Bridge.stdin.getvalue().splitlines()[1].startswith("d 0 ")
+
+
 def _drives_through(folder: Path, out: Path, release=None):
     from worldgen.sim.drive import drive
 

@@ -121,7 +121,7 @@ class GazeboBackend:
         self.world_sdf = Path(world_sdf)
         self.doors, self._world_text, self._door_topics = doors, world_text, tuple(door_topics)
         self._world: IO[bytes] | None = None  # the copy of the world with the door openers, when there is one
-        self._pose = (0.0, 0.0, 0.0, 0.0)
+        self._pose: Optional[tuple[float, float, float, float]] = None  # the last pose Gazebo gave
         self.install = install  # the install to run (its release's tools and libraries); None: locate()'s
         self.first_steps = first_steps  # steps until the first pose: the model's OdometryPublisher's period
         self.dt = dt  # the world's physics step (world_step)
@@ -134,6 +134,7 @@ class GazeboBackend:
         """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
         install = self.install or locate()
         exe = build_bridge(install.env, install.release)
+        self._pose = None
         world = self.world_sdf
         if self._world_text is not None:
             self._world = tempfile.NamedTemporaryFile("wb", suffix=".sdf", prefix="worldgen-world-")
@@ -169,11 +170,15 @@ class GazeboBackend:
 
     def give_way(self, x: float, y: float, yaw: float, v: float, ahead: float) -> float:
         """The forward speed the robot may take for the next ``ahead`` s (GazeboDoors.give_way)."""
-        return v if self.doors is None else self.doors.give_way(self._pose[0], x, y, yaw, v, ahead)
+        if self.doors is None or self._pose is None:
+            return v
+        return self.doors.give_way(self._pose[0], x, y, yaw, v, ahead)
 
     def step(self, v: float, w: float, n: int) -> tuple[float, float, float, float]:
         assert self._bridge is not None and self._bridge.stdin is not None
-        if self.doors is not None:  # as in MuJoCo, the doors open from where the robot is when the command starts
+        # As in MuJoCo, the doors open from where the robot is when the command starts (none before the first pose:
+        # a made-up one could set the rule's state, the robot "entered from the push side").
+        if self.doors is not None and self._pose is not None:
             t, x, y, _ = self._pose
             for k, angle in self.doors.targets(t, x, y, int(n) * self.dt):
                 self._bridge.stdin.write(f"d {k} {angle!r}\n")
