@@ -122,6 +122,8 @@ class GazeboBackend:
         self.doors, self._world_text, self._door_topics = doors, world_text, tuple(door_topics)
         self._world: IO[bytes] | None = None  # the copy of the world with the door openers, when there is one
         self._pose: Optional[tuple[float, float, float, float]] = None  # the last pose Gazebo gave
+        #: rad/s^2 the robot's turn rate can change by (its DiffDrive's limit; None: not limited), for the controller
+        self.turn_accel: Optional[float] = None
         self.install = install  # the install to run (its release's tools and libraries); None: locate()'s
         self.first_steps = first_steps  # steps until the first pose: the model's OdometryPublisher's period
         self.dt = dt  # the world's physics step (world_step)
