@@ -28,7 +28,7 @@ from worldgen.sim.gazebo_doors import (
     world_with_openers,
 )
 from worldgen.sim.gazebo_install import DEFAULT_SETUPS, GazeboInstall, GazeboMissingError
-from worldgen.sim.mujoco import DOOR_SPEED, DOOR_TRIGGER
+from worldgen.sim.mujoco import BACK_OFF, DOOR_SPEED, DOOR_TRIGGER
 from worldgen.sim.schedule import Plan
 
 #: shared/gazebo's Fortress 6.7 build: every system, among them the joint position controller the 6.18 build lacks.
@@ -127,6 +127,19 @@ def test_the_leaf_ramps_open_and_the_robot_gives_way_while_it_swings(pull):
     swung = 1.0 + full / DOOR_SPEED + SETTLE + 0.01
     assert doors.give_way(swung, *inside, heading, 0.5, 0.05) == 0.5
     assert doors.give_way(1.2, *(centre - normal * 1.0), 0.0, 0.5, 0.05) == 0.5  # the far side: nothing swings there
+
+    # Inside the sweep, off the open leaf's place, facing the hinge: it backs out where there is room behind
+    # (asked of world.json in a drive), and stands where there is none or where backing meets the open leaf.
+    u = (centre - hinge) + 0.6 * normal
+    off = hinge + 0.9 * u / np.hypot(*u)
+    facing = math.atan2(*(hinge - off)[::-1])
+    room = {"behind": True}
+    doors.room_behind = lambda t, x, y, yaw: room["behind"]
+    assert doors.give_way(1.2, *off, facing, 0.5, 0.05) == -BACK_OFF
+    on_leaf = hinge + normal * door["width"] / 2  # the open pull leaf stands out from the wall into this side
+    assert doors.give_way(1.2, *on_leaf, math.atan2(*(hinge - on_leaf)[::-1]), 0.5, 0.05) == 0.0
+    room["behind"] = False
+    assert doors.give_way(1.2, *off, facing, 0.5, 0.05) == 0.0
 
 
 def test_the_backend_tests_the_rule_only_from_poses_gazebo_gave(pull):

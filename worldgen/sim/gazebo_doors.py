@@ -16,10 +16,12 @@ the ramp's target once a command (the target at the command's end). world.sdf it
 bytes are the exporter's (and the golden bytes'), and a world without pull doors runs as written.
 
 While a leaf swings open towards the robot, the robot gives way as in MuJoCo: it stands rather than enter the
-leaf's sweep. Gazebo has no ray query for the drive, so a robot already inside the sweep stands too (MuJoCo
-backs it out where nothing is behind it). The leaf's angle is not read back: the leaf counts as swinging
-until :data:`SETTLE` s after the ramp reached the open limit (the servo trails the ramp by about
-``2 DOOR_SPEED / OPENER_OMEGA`` rad).
+leaf's sweep, and backs out of it at :data:`~worldgen.sim.mujoco.BACK_OFF` when it stands inside, unless
+backing brings it nearer the hinge or into the open leaf's place, or something is behind it. Gazebo gives
+the drive no ray query: "behind it" is asked of world.json instead (``room_behind``: the judge's collision
+check of the footprint moved back, walls, obstacles, movers and people where world.json has them). The
+leaf's angle is not read back: the leaf counts as swinging until :data:`SETTLE` s after the ramp reached the
+open limit (the servo trails the ramp by about ``2 DOOR_SPEED / OPENER_OMEGA`` rad).
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Optional, Sequence
+from typing import Callable, Optional, Sequence
 
 import numpy as np
 from lxml import etree
@@ -37,7 +39,7 @@ from worldgen.export.contract import DOOR_COMMAND_TOPIC, WORLD_SYSTEMS
 from worldgen.export.xml import safe_parser
 from worldgen.floats import fmt
 from worldgen.sim.gazebo_install import GazeboInstall, GazeboMissingError
-from worldgen.sim.mujoco import DOOR_SPEED, DOOR_TRIGGER, GIVE_WAY
+from worldgen.sim.mujoco import BACK_OFF, DOOR_SPEED, DOOR_TRIGGER, GIVE_WAY, _open_leaf_end, _to_segment
 
 __all__ = ["SETTLE", "Trigger", "pulled_doors", "plan_points", "opener_library", "GazeboDoors", "world_with_openers",
            "leaf_inertia"]
@@ -188,20 +190,24 @@ def world_with_openers(sdf: Path, doors: Sequence[dict], install: GazeboInstall)
 class _Door:
     door: dict
     open: float           # the open limit, rad from the joint's zero (the leaf's initial angle)
+    limit: float          # the open limit, rad from closed (world.json's limits)
     since: Optional[float] = None  # when the robot triggered it (simulation time)
 
 
 class GazeboDoors:
     """The openers of one Gazebo drive: :meth:`targets` says what to send each command, :meth:`give_way` how fast
-    the robot may go. ``doors`` are world.json's, each with a controller in the world run (:func:`world_with_openers`)."""
+    the robot may go. ``doors`` are world.json's, each with a controller in the world run (:func:`world_with_openers`);
+    ``room_behind(t, x, y, yaw)`` says whether the robot may back away (None: it never backs)."""
 
-    def __init__(self, doors: Sequence[dict], radius: float):
+    def __init__(self, doors: Sequence[dict], radius: float,
+                 room_behind: Optional[Callable[[float, float, float, float], bool]] = None):
         self.radius = float(radius)
+        self.room_behind = room_behind
         self._doors = []
         for d in doors:
             lo, hi = d["limits"]
             opened = lo if abs(lo) > abs(hi) else hi  # the open limit (worldgen.scene.doors.open_angle)
-            self._doors.append(_Door(d, float(opened) - float(d.get("angle", 0.0))))
+            self._doors.append(_Door(d, float(opened) - float(d.get("angle", 0.0)), float(opened)))
         self._trigger = Trigger([d.door for d in self._doors])
 
     @property
@@ -223,8 +229,10 @@ class GazeboDoors:
         return out
 
     def give_way(self, t: float, x: float, y: float, yaw: float, v: float, ahead: float) -> float:
-        """``v``, or 0 while a triggered leaf still swings and the robot, on the side it swings into, stands in
-        its sweep (its width plus the robot's radius plus GIVE_WAY about the hinge) or would enter it."""
+        """``v``, unless a triggered leaf still swings and the robot is on the side it swings into: within its
+        sweep (its width plus the robot's radius plus GIVE_WAY about the hinge) it backs away at -BACK_OFF where
+        that takes it further from the hinge, clear of the open leaf, with room behind, else stands; about to
+        enter the sweep, it stands."""
         p = np.array([x, y])
         heading = np.array([math.cos(yaw), math.sin(yaw)])
         for d in self._doors:
@@ -235,6 +243,12 @@ class GazeboDoors:
                 continue
             hinge = np.asarray(d.door["hinge"][:2], dtype=float)
             reach = float(d.door["width"]) + self.radius + GIVE_WAY
-            if np.hypot(*(p - hinge)) < reach or np.hypot(*(p + max(v, 0.0) * ahead * heading - hinge)) < reach:
+            now = float(np.hypot(*(p - hinge)))
+            if now < reach:
+                back = p - 0.01 * heading
+                away = np.hypot(*(back - hinge)) > now and \
+                    _to_segment(back, hinge, _open_leaf_end(d.door, d.limit)) > self.radius + GIVE_WAY
+                return -BACK_OFF if away and self.room_behind is not None and self.room_behind(t, x, y, yaw) else 0.0
+            if np.hypot(*(p + max(v, 0.0) * ahead * heading - hinge)) < reach:
                 return 0.0
         return v
