@@ -98,7 +98,7 @@ def steps_per_command(dt: float) -> int:
 
 def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = None
                ) -> Callable[[float, float, float, float], tuple[float, float]]:
-    """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t from the run's start): the environment's
+    """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t the simulator's time, world.json's rows' clock): the environment's
     :class:`~worldgen.envs.policies.TimedFollower` on a schedule (within :data:`CATCH_UP` x its top speed and
     :data:`TIMED_TURN_RATE`), its :class:`~worldgen.envs.policies.PathFollower` on a path (at ``speed``).
 
@@ -156,7 +156,6 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
     act = controller(plan, speed, getattr(backend, "turn_accel", None))
     give_way = getattr(backend, "give_way", None)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
-    t0 = t
     per = steps_per_command(backend.dt)
     limit = t + float(task["time_limit"])
     rows, commands = [(t, x, y, yaw)], []
@@ -165,12 +164,14 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
         if math.hypot(x - goal[0], y - goal[1]) < float(task["goal_tolerance"]) / 2:
             ended = "goal"
             break
-        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE or _on_schedule(plan, t - t0, x, y):
+        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE or _on_schedule(plan, t, x, y):
             still_since, still_at = t, (x, y)
         elif t - still_since > STUCK_SECONDS:
             ended = "stuck"
             break
-        v, w = act(t - t0, x, y, yaw)
+        # The schedule's clock is the simulator's: its movers and actors, and the judge, play world.json's rows
+        # from time 0, and Gazebo's first pose comes a command after it (MuJoCo's at 0).
+        v, w = act(t, x, y, yaw)
         if give_way is not None:  # a door opening onto the robot (worldgen.sim.mujoco)
             v = give_way(x, y, yaw, v, per * backend.dt)
         commands.append((t, v, w))
