@@ -124,6 +124,8 @@ class GazeboBackend:
         self._pose: Optional[tuple[float, float, float, float]] = None  # the last pose Gazebo gave
         #: rad/s^2 the robot's turn rate can change by (its DiffDrive's limit; None: not limited), for the controller
         self.turn_accel: Optional[float] = None
+        #: m/s^2 its speed can change by (likewise)
+        self.accel: Optional[float] = None
         self.install = install  # the install to run (its release's tools and libraries); None: locate()'s
         self.first_steps = first_steps  # steps until the first pose: the model's OdometryPublisher's period
         self.dt = dt  # the world's physics step (world_step)

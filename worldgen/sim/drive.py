@@ -96,7 +96,7 @@ def steps_per_command(dt: float) -> int:
     return max(1, round(CONTROL_PERIOD / dt))
 
 
-def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = None
+def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = None, accel: Optional[float] = None
                ) -> Callable[[float, float, float, float], tuple[float, float]]:
     """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t the simulator's time, world.json's rows' clock): the environment's
     :class:`~worldgen.envs.policies.TimedFollower` on a schedule (within :data:`CATCH_UP` x its top speed and
@@ -104,17 +104,23 @@ def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = N
 
     ``turn_accel`` (rad/s^2; None: the turn rate is taken at once, as MuJoCo's servos take it) is how fast the
     robot's turn rate can change: on a schedule every turn is then asked no faster than lets the robot stop
-    turning on the heading it aims at (:func:`braked`)."""
+    turning on the heading it aims at (:func:`braked`); ``accel`` (m/s^2) likewise its speed, asked no faster
+    than lets it stop where the schedule next stands still (a wait, the goal)."""
     if plan.rows is not None:
         timed = TimedFollower(plan.rows, v_max=min(CATCH_UP * plan.speed, V_LIMIT), w_max=TIMED_TURN_RATE,
                               period=CONTROL_PERIOD)
         rows = plan.rows
+        step = np.hypot(*np.diff(rows[:, 1:], axis=0).T)
+        stops = np.append(np.flatnonzero(step < 1e-6), len(rows) - 1)  # rows the schedule stands still from
 
         def act(t: float, x: float, y: float, yaw: float) -> tuple[float, float]:
             dx, dy = timed.at(t + CONTROL_PERIOD) - (x, y)
             if math.hypot(dx, dy) > ON_THE_SPOT:
                 v, w = (float(a) for a in timed.action(x, y, yaw, t))
                 err = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi  # what the follower aims at
+                if accel is not None:
+                    stop = rows[stops[np.searchsorted(rows[stops, 0], t)] if t <= rows[-1, 0] else -1, 1:]
+                    v = braked(v, float(np.hypot(*(stop - (x, y)))), accel)
                 return v, braked(w, err, turn_accel)
             # Where the schedule waits (or the goal): stand, facing where it goes next, so that setting off costs
             # no turn (heading for a point millimetres away would only jitter).
@@ -131,12 +137,15 @@ def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = N
 
 
 def braked(w: float, err: float, turn_accel: Optional[float]) -> float:
-    """The turn rate ``w`` toward a heading ``err`` rad away, no faster than a robot whose turn rate changes at
-    most :data:`BRAKING` x ``turn_accel`` rad/s^2 can stop from on that heading (``w`` itself with no limit).
+    """A rate ``w`` (a turn rate, or a speed) toward something ``err`` away (rad, or m), no faster than a robot
+    whose rate changes at most :data:`BRAKING` x ``turn_accel`` (rad/s^2, or m/s^2) can stop from there
+    (``w`` itself with no limit).
 
-    Gazebo's DiffDrive ramps the turn rate it is told at its wheels' acceleration (worldgen.export.robot), so
-    a follower that asks 8 rad/s until it faces its target swings on past it: from 8 rad/s the robot needs
-    2.2 rad to stop at 14.7 rad/s^2 (a 0.2 m robot), and reversing the turn took it 0.3 s and more."""
+    Gazebo's DiffDrive ramps the twist it is told at its wheels' acceleration (worldgen.export.robot), so a
+    follower that asks 8 rad/s until it faces its target swings on past it: from 8 rad/s the robot needs
+    2.0 rad to stop at 15.6 rad/s^2 (a 0.2 m robot), and reversing the turn took it 0.3 s and more; catching
+    up at 0.75 m/s with a schedule that stops, it ran 7 cm past (barn seed 2 among movers, into an obstacle
+    the schedule passes 5 cm from)."""
     if turn_accel is None:
         return w
     return math.copysign(min(abs(w), math.sqrt(2.0 * BRAKING * turn_accel * abs(err))), w)
@@ -153,7 +162,7 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
     if plan is None:
         plan = Plan("straight" if straight else "static",
                     np.asarray([spawn[:2], goal] if straight else task["path"]["waypoints"], dtype=float), speed)
-    act = controller(plan, speed, getattr(backend, "turn_accel", None))
+    act = controller(plan, speed, getattr(backend, "turn_accel", None), getattr(backend, "accel", None))
     give_way = getattr(backend, "give_way", None)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
     per = steps_per_command(backend.dt)
@@ -224,7 +233,7 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None, pla
         doors = GazeboDoors(pulled, robot_of(meta).radius, _room_behind(world))
         backend = GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install, world_text=text,
                                 doors=doors, door_topics=tuple(topics))
-    backend.turn_accel = turn_accel
+    backend.turn_accel, backend.accel = turn_accel, WHEEL_ACCELERATION
     return backend
 
 
