@@ -37,7 +37,7 @@ from typing import Optional
 from worldgen.errors import ParameterError
 
 __all__ = ["GzRelease", "GZ_RELEASES", "DEFAULT_GZ_RELEASE", "SIM_GZ_RELEASE", "SIM_GZ_RELEASES",
-           "release", "release_of_version",
+           "release", "release_of_version", "DOOR_OPENER", "DOOR_COMMAND_TOPIC", "WORLD_SYSTEMS",
            "Topic", "TOPICS", "CLOCK", "GROUND_TRUTH", "CONTACTS", "CMD_VEL", "ODOM", "TF", "TF_STATIC", "SCAN", "IMU",
            "JOINT_STATES", "GOAL_POSE", "NAV_FEEDBACK", "NAV_STATUS", "CMD_VEL_STAMPED_TYPE", "GZ_TO_ROS", "ROS_TO_GZ",
            "BRIDGED", "RECORDED", "topic"]
@@ -66,6 +66,11 @@ class GzRelease:
         """``(filename, name)`` of a system's ``<plugin>`` element in this release."""
         return self.plugin_file.format(file_stem), self.plugin_class.format(class_name)
 
+    def door_opener(self) -> tuple[str, str]:
+        """``(filename, name)`` of the system ``worldgen drive`` swings a pull door's leaf open with
+        (:data:`DOOR_OPENER`), and its shared library's file name is ``lib<filename>.so``."""
+        return self.plugin(*DOOR_OPENER)
+
     def msg(self, short: str) -> str:
         """The full Gazebo message type of ``short`` (``Odometry`` -> ``gz.msgs.Odometry``)."""
         return f"{self.msgs}.{short}"
@@ -91,6 +96,18 @@ GZ_RELEASES: dict[str, GzRelease] = {r.name: r for r in (
               ("gz", "sim"), True, "GZ_SIM_SYSTEM_PLUGIN_PATH", "GZ_PARTITION", 9,
               ("gz-transport14", "gz-msgs11"), "gz", _GZ_DISCOVERY, ".gz"),
 )}
+#: The joint system that opens a pull door in ``worldgen drive --sim gazebo`` (file stem, class): a position
+#: controller on the hinge, its target sent over :data:`DOOR_COMMAND_TOPIC`. Every release's row names it
+#: (:meth:`GzRelease.door_opener`); a build may still lack it (the Fortress 6.18 build of shared/gazebo does:
+#: worldgen.sim.gazebo_doors looks for the library on the install's plugin path).
+DOOR_OPENER = ("joint-position-controller", "JointPositionController")
+#: The controller's target angle (a Double, rad from the joint's zero) for ``{joint}`` of model ``{model}``: the
+#: controller's own default topic in ign-gazebo 6 and gz-sim 8, written into its ``<topic>`` all the same.
+DOOR_COMMAND_TOPIC = "/model/{model}/joint/{joint}/0/cmd_pos"
+#: The world systems a server loads from its ``server.config`` when the world names none (file stem, class), the
+#: same in every release here. ign-gazebo 6.7 also drops them when only a model names a plugin (measured: no
+#: physics, no scene service), so a world given a door opener names them itself.
+WORLD_SYSTEMS = (("physics", "Physics"), ("user-commands", "UserCommands"), ("scene-broadcaster", "SceneBroadcaster"))
 #: Harmonic pairs with ROS 2 Jazzy, the current LTS pair: what a bundle and a robot are written for by default.
 DEFAULT_GZ_RELEASE = "harmonic"
 #: What ``worldgen.sim`` runs unless told otherwise: Fortress (ign-gazebo 6), the suite's default install;

@@ -21,7 +21,7 @@ import subprocess
 import tempfile
 from importlib import resources
 from pathlib import Path
-from typing import IO
+from typing import IO, Optional
 
 from lxml import etree
 
@@ -31,6 +31,7 @@ from worldgen.export.robot import DEFAULT_NAME
 from worldgen.export.xml import safe_parser
 from worldgen.files import move_into_place
 from worldgen.sim.gazebo import GazeboError, GazeboInstall, GazeboMissingError, GazeboServer, locate, user_cache
+from worldgen.sim.gazebo_doors import GazeboDoors
 
 __all__ = ["SOURCE_NAME", "cache_dir", "build_bridge", "prelude", "GazeboBackend", "world_step"]
 
@@ -38,7 +39,7 @@ SOURCE_NAME = "drive_bridge.cc"
 _BUILD_HINT = ("apt-get install g++ pkg-config libignition-transport-dev libignition-msgs-dev (Fortress), or an "
                "install that ships its .pc files (Harmonic: shared/gazebo's build)")
 #: The headers the bridge uses, under the release's folder (``ignition/``, ``gz/``).
-_HEADERS = ("msgs/boolean.pb.h", "msgs/entity_factory.pb.h", "msgs/odometry.pb.h", "msgs/twist.pb.h",
+_HEADERS = ("msgs/boolean.pb.h", "msgs/double.pb.h", "msgs/entity_factory.pb.h", "msgs/odometry.pb.h", "msgs/twist.pb.h",
             "msgs/world_control.pb.h", "transport/Node.hh")
 
 
@@ -109,12 +110,22 @@ class GazeboBackend:
     """The robot in a headless Gazebo: :meth:`start` spawns it, :meth:`step` drives it N physics steps.
 
     ``robot_sdf`` is the model (worldgen.export.robot, with its ground truth published at the end of every command);
-    poses come back from the simulator, (t, x, y, yaw) in the world frame.
+    poses come back from the simulator, (t, x, y, yaw) in the world frame. ``doors`` (with ``world_text``, the
+    world run instead of ``world_sdf``'s bytes, holding their controllers and ``door_topics``, their target
+    topics: worldgen.sim.gazebo_doors.world_with_openers) are the pull doors the robot opens on its way.
     """
 
     def __init__(self, world_sdf: Path, robot_sdf: str, *, dt: float, first_steps: int = 1,
-                 install: GazeboInstall | None = None):
+                 install: GazeboInstall | None = None, doors: Optional[GazeboDoors] = None,
+                 world_text: Optional[bytes] = None, door_topics: tuple[str, ...] = ()):
         self.world_sdf = Path(world_sdf)
+        self.doors, self._world_text, self._door_topics = doors, world_text, tuple(door_topics)
+        self._world: IO[bytes] | None = None  # the copy of the world with the door openers, when there is one
+        self._pose: Optional[tuple[float, float, float, float]] = None  # the last pose Gazebo gave
+        #: rad/s^2 the robot's turn rate can change by (its DiffDrive's limit; None: not limited), for the controller
+        self.turn_accel: Optional[float] = None
+        #: m/s^2 its speed can change by (likewise)
+        self.accel: Optional[float] = None
         self.install = install  # the install to run (its release's tools and libraries); None: locate()'s
         self.first_steps = first_steps  # steps until the first pose: the model's OdometryPublisher's period
         self.dt = dt  # the world's physics step (world_step)
@@ -127,7 +138,14 @@ class GazeboBackend:
         """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
         install = self.install or locate()
         exe = build_bridge(install.env, install.release)
-        self._server = GazeboServer(self.world_sdf, install=install).start()
+        self._pose = None
+        world = self.world_sdf
+        if self._world_text is not None:
+            self._world = tempfile.NamedTemporaryFile("wb", suffix=".sdf", prefix="worldgen-world-")
+            self._world.write(self._world_text)
+            self._world.flush()
+            world = Path(self._world.name)
+        self._server = GazeboServer(world, install=install).start()
         # The server's environment carries its own partition and discovery ports: the bridge must share them.
         env = self._server.env
         self._model = model = tempfile.NamedTemporaryFile("w", suffix=".sdf", prefix="worldgen-robot-")
@@ -135,7 +153,7 @@ class GazeboBackend:
         model.flush()
         self._bridge = subprocess.Popen(
             [str(exe), self._server.world, CMD_VEL.gazebo_topic, GROUND_TRUTH.gazebo_topic, str(round(self.dt * 1e9)),
-             model.name, self._robot_name, *(repr(float(v)) for v in spawn)],
+             model.name, self._robot_name, *(repr(float(v)) for v in spawn), *self._door_topics],
             env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
         first = self._read()
         if first != "ready":
@@ -149,14 +167,32 @@ class GazeboBackend:
             raise GazeboError(f"the drive bridge stopped: {line or 'no answer'}; Gazebo said: {self.problems()[:3]}")
         return line
 
+    @property
+    def doors_opened(self) -> list[str]:
+        """The doors whose opener the robot triggered, in order."""
+        return self.doors.opened if self.doors is not None else []
+
+    def give_way(self, x: float, y: float, yaw: float, v: float, ahead: float) -> float:
+        """The forward speed the robot may take for the next ``ahead`` s (GazeboDoors.give_way)."""
+        if self.doors is None or self._pose is None:
+            return v
+        return self.doors.give_way(self._pose[0], x, y, yaw, v, ahead)
+
     def step(self, v: float, w: float, n: int) -> tuple[float, float, float, float]:
         assert self._bridge is not None and self._bridge.stdin is not None
+        # As in MuJoCo, the doors open from where the robot is when the command starts (none before the first pose:
+        # a made-up one could set the rule's state, the robot "entered from the push side").
+        if self.doors is not None and self._pose is not None:
+            t, x, y, _ = self._pose
+            for k, angle in self.doors.targets(t, x, y, int(n) * self.dt):
+                self._bridge.stdin.write(f"d {k} {angle!r}\n")
         self._bridge.stdin.write(f"s {int(n)} {v!r} {w!r}\n")
         self._bridge.stdin.flush()
         fields = self._read().split()
         t, x, y, yaw = (float(f) for f in fields[1:5])
         if not all(math.isfinite(f) for f in (t, x, y, yaw)):
             raise GazeboError(f"Gazebo gave a non-finite pose: {fields}")
+        self._pose = (t, x, y, yaw)
         return t, x, y, yaw
 
     def problems(self) -> list[str]:
@@ -178,9 +214,11 @@ class GazeboBackend:
             if self._bridge.stdout is not None:
                 self._bridge.stdout.close()
             self._bridge = None
-        if self._model is not None:
-            self._model.close()
-            self._model = None
+        for kept in (self._model, self._world):
+            if kept is not None:
+                kept.close()
+        self._model = None
+        self._world = None
         if self._server is not None:
             self._server.stop()
             self._server = None

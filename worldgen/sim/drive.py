@@ -35,12 +35,12 @@ import numpy as np
 
 from worldgen.envs.policies import PathFollower, TimedFollower
 from worldgen.errors import OutputError, ParameterError
-from worldgen.groundtruth.folder import WorldFolder, open_world
+from worldgen.groundtruth.folder import WorldFolder, open_world, robot_of
 from worldgen.sim.schedule import Plan, plan_for
 
 __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "CATCH_UP",
-           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "ON_THE_SPOT", "RUN_TOPICS", "Outcome", "controller", "drive",
-           "record_run", "run_loop", "steps_per_command"]
+           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "ON_THE_SPOT", "BRAKING", "braked", "RUN_TOPICS", "Outcome", "controller",
+           "drive", "record_run", "run_loop", "steps_per_command"]
 
 #: The topics a simulated run is recorded with (write_run's names), the simulator's own pose (``/ground_truth``)
 #: among them.
@@ -66,6 +66,9 @@ TIMED_TURN_RATE = 8.0
 LAG = 0.1
 #: m: within this of where the schedule has it a command ahead, the robot stands (and turns to where it goes next).
 ON_THE_SPOT = 0.01
+#: The share of a robot's turn acceleration :func:`braked` plans to stop a turn with (the rest covers a command's
+#: late start: the rate is set once a command).
+BRAKING = 0.8
 
 
 @dataclass
@@ -93,31 +96,59 @@ def steps_per_command(dt: float) -> int:
     return max(1, round(CONTROL_PERIOD / dt))
 
 
-def controller(plan: Plan, speed: float = SPEED) -> Callable[[float, float, float, float], tuple[float, float]]:
-    """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t from the run's start): the environment's
+def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = None, accel: Optional[float] = None
+               ) -> Callable[[float, float, float, float], tuple[float, float]]:
+    """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t the simulator's time, world.json's rows' clock): the environment's
     :class:`~worldgen.envs.policies.TimedFollower` on a schedule (within :data:`CATCH_UP` x its top speed and
-    :data:`TIMED_TURN_RATE`), its :class:`~worldgen.envs.policies.PathFollower` on a path (at ``speed``)."""
+    :data:`TIMED_TURN_RATE`), its :class:`~worldgen.envs.policies.PathFollower` on a path (at ``speed``).
+
+    ``turn_accel`` (rad/s^2; None: the turn rate is taken at once, as MuJoCo's servos take it) is how fast the
+    robot's turn rate can change: on a schedule every turn is then asked no faster than lets the robot stop
+    turning on the heading it aims at (:func:`braked`); ``accel`` (m/s^2) likewise its speed, asked no faster
+    than lets it stop where the schedule next stands still (a wait, the goal)."""
     if plan.rows is not None:
         timed = TimedFollower(plan.rows, v_max=min(CATCH_UP * plan.speed, V_LIMIT), w_max=TIMED_TURN_RATE,
                               period=CONTROL_PERIOD)
         rows = plan.rows
+        step = np.hypot(*np.diff(rows[:, 1:], axis=0).T)
+        stops = np.append(np.flatnonzero(step < 1e-6), len(rows) - 1)  # rows the schedule stands still from
 
         def act(t: float, x: float, y: float, yaw: float) -> tuple[float, float]:
-            if math.hypot(*(timed.at(t + CONTROL_PERIOD) - (x, y))) > ON_THE_SPOT:
+            dx, dy = timed.at(t + CONTROL_PERIOD) - (x, y)
+            if math.hypot(dx, dy) > ON_THE_SPOT:
                 v, w = (float(a) for a in timed.action(x, y, yaw, t))
-                return v, w
+                err = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi  # what the follower aims at
+                if accel is not None:
+                    stop = rows[stops[np.searchsorted(rows[stops, 0], t)] if t <= rows[-1, 0] else -1, 1:]
+                    v = braked(v, float(np.hypot(*(stop - (x, y)))), accel)
+                return v, braked(w, err, turn_accel)
             # Where the schedule waits (or the goal): stand, facing where it goes next, so that setting off costs
             # no turn (heading for a point millimetres away would only jitter).
             ahead = rows[(rows[:, 0] > t) & (np.hypot(rows[:, 1] - x, rows[:, 2] - y) > LAG / 2)]
             if not len(ahead):
                 return 0.0, 0.0
             err = (math.atan2(ahead[0, 2] - y, ahead[0, 1] - x) - yaw + math.pi) % (2.0 * math.pi) - math.pi
-            return 0.0, float(np.clip(err / CONTROL_PERIOD, -TIMED_TURN_RATE, TIMED_TURN_RATE))
+            return 0.0, braked(float(np.clip(err / CONTROL_PERIOD, -TIMED_TURN_RATE, TIMED_TURN_RATE)), err, turn_accel)
 
         return act
     pursuit = PathFollower(plan.waypoints.tolist(), v_max=speed, w_max=TURN_RATE, lookahead=LOOKAHEAD)
     # tuple() of a generator is typed tuple[float, ...]; the follower's action is always (v, w)
     return lambda t, x, y, yaw: tuple(float(a) for a in pursuit.action(x, y, yaw))  # type: ignore[return-value]
+
+
+def braked(w: float, err: float, turn_accel: Optional[float]) -> float:
+    """A rate ``w`` (a turn rate, or a speed) toward something ``err`` away (rad, or m), no faster than a robot
+    whose rate changes at most :data:`BRAKING` x ``turn_accel`` (rad/s^2, or m/s^2) can stop from there
+    (``w`` itself with no limit).
+
+    Gazebo's DiffDrive ramps the twist it is told at its wheels' acceleration (worldgen.export.robot), so a
+    follower that asks 8 rad/s until it faces its target swings on past it: from 8 rad/s the robot needs
+    2.0 rad to stop at 15.6 rad/s^2 (a 0.2 m robot), and reversing the turn took it 0.3 s and more; catching
+    up at 0.75 m/s with a schedule that stops, it ran 7 cm past (barn seed 2 among movers, into an obstacle
+    the schedule passes 5 cm from)."""
+    if turn_accel is None:
+        return w
+    return math.copysign(min(abs(w), math.sqrt(2.0 * BRAKING * turn_accel * abs(err))), w)
 
 
 def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
@@ -131,10 +162,9 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
     if plan is None:
         plan = Plan("straight" if straight else "static",
                     np.asarray([spawn[:2], goal] if straight else task["path"]["waypoints"], dtype=float), speed)
-    act = controller(plan, speed)
+    act = controller(plan, speed, getattr(backend, "turn_accel", None), getattr(backend, "accel", None))
     give_way = getattr(backend, "give_way", None)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
-    t0 = t
     per = steps_per_command(backend.dt)
     limit = t + float(task["time_limit"])
     rows, commands = [(t, x, y, yaw)], []
@@ -143,12 +173,14 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
         if math.hypot(x - goal[0], y - goal[1]) < float(task["goal_tolerance"]) / 2:
             ended = "goal"
             break
-        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE or _on_schedule(plan, t - t0, x, y):
+        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE or _on_schedule(plan, t, x, y):
             still_since, still_at = t, (x, y)
         elif t - still_since > STUCK_SECONDS:
             ended = "stuck"
             break
-        v, w = act(t - t0, x, y, yaw)
+        # The schedule's clock is the simulator's: its movers and actors, and the judge, play world.json's rows
+        # from time 0, and Gazebo's first pose comes a command after it (MuJoCo's at 0).
+        v, w = act(t, x, y, yaw)
         if give_way is not None:  # a door opening onto the robot (worldgen.sim.mujoco)
             v = give_way(x, y, yaw, v, per * backend.dt)
         commands.append((t, v, w))
@@ -166,7 +198,7 @@ def _on_schedule(plan: Plan, t: float, x: float, y: float) -> bool:
     return math.hypot(x - float(np.interp(t, r[:, 0], r[:, 1])), y - float(np.interp(t, r[:, 0], r[:, 2]))) < LAG
 
 
-def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None):
+def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None, plan: Optional[Plan] = None):
     meta = world.metadata
     if sim == "mujoco":
         from worldgen.sim.mujoco import MujocoBackend
@@ -174,7 +206,7 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None):
         people = meta.get("people") or []
         return MujocoBackend(world.file_bytes("mjcf"), meta,
                              _scene_of(world) if any(p.get("behaviour") for p in people) else None)
-    from worldgen.export.robot import robot_sdf
+    from worldgen.export.robot import WHEEL_ACCELERATION, dimensions, robot_sdf
     from worldgen.sim.bridge import GazeboBackend, world_step
     from worldgen.sim.gazebo_install import locate
 
@@ -187,7 +219,40 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None):
     # The robot is written for the release that runs it: its plugins' names are that release's.
     install = locate(release=gz_release)
     robot = robot_sdf(meta, gz_release=install.release.name, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
-    return GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install)
+    # The DiffDrive changes its wheels' speed at most WHEEL_ACCELERATION: its turn rate at that over half the track.
+    turn_accel = WHEEL_ACCELERATION / (dimensions(meta).wheel_separation / 2.0)
+    # The pull doors on the plan's way get a joint controller in a copy of the world (worldgen.sim.gazebo_doors);
+    # a build without the system refuses here, before anything starts.
+    from worldgen.sim.gazebo_doors import GazeboDoors, plan_points, pulled_doors, world_with_openers
+
+    pulled = pulled_doors(meta.get("doors") or [], plan_points(plan)) if plan is not None else []
+    if not pulled:
+        backend = GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install)
+    else:
+        text, topics = world_with_openers(sdf, pulled, install)
+        doors = GazeboDoors(pulled, robot_of(meta).radius, _room_behind(world))
+        backend = GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install, world_text=text,
+                                doors=doors, door_topics=tuple(topics))
+    backend.turn_accel, backend.accel = turn_accel, WHEEL_ACCELERATION
+    return backend
+
+
+def _room_behind(world: WorldFolder) -> Callable[[float, float, float, float], bool]:
+    """``(t, x, y, yaw) -> bool``: whether the robot can back 3 cm plus a command at the back-off speed with
+    nothing in the way, asked of world.json as the judge asks it (walls, obstacles, movers and people; door
+    leaves left out): the drive has no ray query in Gazebo (MuJoCo's backend casts rays)."""
+    from worldgen.groundtruth.ground import load
+    from worldgen.judge.figures import collisions
+    from worldgen.sim.mujoco import BACK_OFF
+
+    ground = load(world)
+
+    def room(t: float, x: float, y: float, yaw: float) -> bool:
+        back = 0.03 + BACK_OFF * CONTROL_PERIOD
+        ends = [(t, x, y, yaw), (t + CONTROL_PERIOD, x - back * math.cos(yaw), y - back * math.sin(yaw), yaw)]
+        return not collisions(np.array(ends), ground)
+
+    return room
 
 
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,
@@ -221,7 +286,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     started = time.perf_counter()
     plan = plan_for(meta, chosen, speed, straight)
     wall["plan"] = time.perf_counter() - started
-    backend = _backend(sim, opened, gz_release)
+    backend = _backend(sim, opened, gz_release, plan)
     try:
         trajectory, commands, ended = run_loop(backend, chosen, straight, speed, plan)
     finally:

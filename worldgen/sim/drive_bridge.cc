@@ -1,6 +1,6 @@
 // drive_bridge: a lockstep link between a Python controller and a paused Gazebo (Fortress or Harmonic) server.
 //
-//   drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW
+//   drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW [DOOR_TOPIC ...]
 //
 // Fortress's ign-transport has no Python bindings (Harmonic's Python bindings are not in every install), and one `ign service` call costs a process start
 // (about 0.1 s), so a controller at 20 Hz cannot drive through the `ign` command. This program stays up
@@ -13,6 +13,8 @@
 //                    for the pose message stamped at the end of those steps
 //   out: "p T X Y YAW"  that pose: simulation time (s) and the model's world pose from POSE_TOPIC (an
 //                    Odometry message, e.g. the OdometryPublisher system's, one per step)
+//   in:  "d K A"     publish Double(A) on the K-th DOOR_TOPIC (a door's joint position controller: its
+//                    target angle, rad); no answer, it reaches the controller before the next "s" steps
 //   in:  "q"         quit
 //   out: "ready" once the Twist publisher is connected to its subscriber; "error: ..." then exit 1.
 //
@@ -32,6 +34,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 
 namespace
@@ -97,9 +100,10 @@ bool Spawn(wgtransport::Node &_node, const std::string &_world, char **_argv)
 
 int main(int argc, char **argv)
 {
-  if (argc != 11)
+  if (argc < 11)
   {
-    std::cerr << "usage: drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW" << std::endl;
+    std::cerr << "usage: drive_bridge WORLD CMD_TOPIC POSE_TOPIC STEP_NS MODEL_SDF NAME X Y Z YAW [DOOR_TOPIC ...]"
+              << std::endl;
     return 2;
   }
   const std::string world = argv[1];
@@ -115,6 +119,16 @@ int main(int argc, char **argv)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   if (!publisher.HasConnections())
     return Fail(std::string("nothing subscribes to ") + argv[2] + " within 10 s");
+  // Each door's controller subscribes when the world loads; a target sent before discovery would be lost.
+  std::vector<wgtransport::Node::Publisher> doors;
+  for (int k = 11; k < argc; ++k)
+  {
+    doors.push_back(node.Advertise<wgmsgs::Double>(argv[k]));
+    for (int i = 0; i < 1000 && doors.back() && !doors.back().HasConnections(); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    if (!doors.back() || !doors.back().HasConnections())
+      return Fail(std::string("nothing subscribes to ") + argv[k] + " within 10 s");
+  }
   std::cout << "ready" << std::endl;
 
   const std::string service = "/world/" + world + "/control";
@@ -127,6 +141,17 @@ int main(int argc, char **argv)
     in >> op;
     if (op == "q")
       return 0;
+    if (op == "d")
+    {
+      size_t k = 0;
+      double angle = 0;
+      if (!(in >> k >> angle) || k >= doors.size())
+        return Fail("bad command: " + line);
+      wgmsgs::Double target;
+      target.set_data(angle);
+      doors[k].Publish(target);
+      continue;
+    }
     long steps = 0;
     double v = 0, w = 0;
     if (op != "s" || !(in >> steps >> v >> w) || steps < 1)
