@@ -93,3 +93,21 @@ def test_the_same_seed_gives_the_same_reactions_and_vector_envs_react_too():
         envs.step(np.tile(np.array([0.3, 0.0], dtype=np.float32), (2, 1)))
     walked = envs.get_attr("episode")
     assert all(len(next(iter(e.walkers.reacted.values()))) > 1 for e in walked)
+
+
+def test_the_timed_follower_passes_movers_on_their_certificate():
+    """Movers are agents of the certificate (docs/people.md): among three looping movers, with people too,
+    the follower at the environment's defaults reaches the goal without contact, within the tracking margin."""
+    from worldgen.envs.policies import TimedFollower
+    from worldgen.people.timed import TRACKING
+
+    for params in ({"n_movers": 3}, {"n_movers": 2, "n_people": 3, "people_duration": 10.0}):
+        env = _env(size=[8.0, 8.0], n_obstacles=4, **params)
+        for seed in range(2):
+            info = drive_timed(env, seed=seed)
+            assert info["success"] and info["collisions"] == [], (params, seed, info["collisions"])
+            u = env.unwrapped
+            assert u.task["timed_path"] is not None
+            follower, rows = TimedFollower.for_env(env), np.asarray(u.episode.rows)
+            lag = max(float(np.hypot(*(follower.at(t) - rows[k, 1:3]))) for k, t in enumerate(rows[:, 0]))
+            assert lag <= TRACKING, (params, seed, lag)
