@@ -65,8 +65,10 @@ test-gazebo: $(TEST_STAMP)
 ## over 1,600 worlds, worlds made to a level, the reactive probe's success per level, a curriculum
 ## reset against a plain one, worlds with people (10, 20, 50) generated and certified, 1,000 episodes
 ## of the timed path among reacting people with the step's and the certificate's cost, and `worldgen
-## drive` of a 10 m path in Gazebo (skipped without it) and MuJoCo; tables on
-## stdout with each target met or missed,
+## drive` of a 10 m path in Gazebo (skipped without it) and MuJoCo, the crowd files against the pipeline, a
+## campaign's adaptive search against random sampling, a 20 x 20 m terrain world and terrain's difficulty
+## terms, a naive robot among regular and impassive people, and `worldgen drive` in 200 random dynamic
+## worlds in MuJoCo (its Gazebo sample by hand: docs/benchmarks.md); tables on stdout with each target met or missed,
 ## JSON in benchmarks/results/
 bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_pipeline.py
@@ -82,6 +84,12 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_reacting.py
 	$(PY) benchmarks/bench_drive.py
 	nice -n 10 $(PY) benchmarks/bench_requests.py
+	$(PY) benchmarks/bench_crowd.py
+	$(PY) benchmarks/bench_campaign.py
+	$(PY) benchmarks/bench_terrain.py
+	nice -n 10 $(PY) benchmarks/bench_terrain_difficulty.py
+	nice -n 10 $(PY) benchmarks/bench_naive_robot.py
+	nice -n 10 $(PY) benchmarks/bench_drive_dynamic.py
 
 ## bench-learning: PPO (stable-baselines3) on one core learns worldgen/Navigation-v0 with the default
 ## reward and with `walkthrough`, against random, heuristic and path-follower baselines on held-out
