@@ -157,13 +157,19 @@ def fit_probe(rows: list[dict], probe: str, l2: float = 1.0) -> dict:
 
     x = np.array([difficulty._vector(r["features"]) for r in rows])
     y = np.array([float(not r[probe]["success"]) for r in rows])
+    return logistic(x, y, l2)
+
+
+def logistic(x: np.ndarray, y: np.ndarray, l2: float, offset=0.0) -> dict:
+    """Newton's method for a logistic model of ``y`` on the standardised columns of ``x`` (L2 penalty ``l2`` on
+    the weights, none on the bias), each row's logit shifted by ``offset``: bias, means, scales, weights."""
     mean, std = x.mean(axis=0), x.std(axis=0)
     std[std == 0] = 1.0
     z = np.column_stack([np.ones(len(x)), (x - mean) / std])
     beta = np.zeros(z.shape[1])
     penalty = np.diag([0.0] + [l2] * (z.shape[1] - 1))
     for _ in range(100):
-        p = 1 / (1 + np.exp(-z @ beta))
+        p = 1 / (1 + np.exp(-(offset + z @ beta)))
         grad = z.T @ (p - y) + penalty @ beta
         hess = (z * (p * (1 - p))[:, None]).T @ z + penalty
         step = np.linalg.solve(hess, grad)

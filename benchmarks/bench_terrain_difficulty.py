@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_difficulty import PROBES, auc  # noqa: E402  (a sibling script: the same AUC and probes)
+from bench_difficulty import PROBES, auc, logistic  # noqa: E402  (a sibling script: the same AUC, probes, fit)
 
 RESULTS = Path(__file__).resolve().parent / "results"
 FIT_SEED0 = 2_000_000
@@ -93,19 +93,7 @@ def fit_probe(rows: list[dict], probe: str, l2: float = 1.0) -> dict:
     x = np.array([r["terrain"] for r in rows], dtype=float)
     y = np.array([float(not r[probe]) for r in rows])
     offset = np.array([r["flat_logit"][probe] for r in rows])
-    mean, std = x.mean(axis=0), x.std(axis=0)
-    std[std == 0] = 1.0
-    z = np.column_stack([np.ones(len(x)), (x - mean) / std])
-    beta = np.zeros(z.shape[1])
-    penalty = np.diag([0.0] + [l2] * (z.shape[1] - 1))
-    for _ in range(100):
-        p = 1 / (1 + np.exp(-(offset + z @ beta)))
-        step = np.linalg.solve((z * (p * (1 - p))[:, None]).T @ z + penalty, z.T @ (p - y) + penalty @ beta)
-        beta -= step
-        if np.abs(step).max() < 1e-10:
-            break
-    return {"bias": round(float(beta[0]), 6), "mean": [round(float(v), 6) for v in mean],
-            "std": [round(float(v), 6) for v in std], "weight": [round(float(v), 6) for v in beta[1:]]}
+    return logistic(x, y, l2, offset)
 
 
 def validate(rows: list[dict]) -> dict:
