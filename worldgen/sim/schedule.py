@@ -22,13 +22,18 @@ from typing import Any, Callable, Optional
 
 import numpy as np
 
-from worldgen.groundtruth.folder import robot_of
+from worldgen.groundtruth.folder import robot_description_of, robot_of
 
-__all__ = ["TRACKING", "Plan", "plan_for", "unrolled"]
+__all__ = ["TRACKING", "CATCH_UP", "Plan", "plan_for", "unrolled"]
 
 #: m added to the robot's inflation in a schedule worked out among movers: room for the follower's lag behind
-#: it (the lag that turning on the spot at a corner costs, TIMED_TURN_RATE in worldgen/sim/drive.py).
+#: it (the lag that turning at a corner within the robot's turn rate costs).
 TRACKING = 0.1
+#: On a schedule the follower may go this many times the schedule's top speed to catch up with it, never beyond
+#: the robot's max_speed: a schedule worked out off the path (worldgen.sim.spacetime) turns at every row on
+#: the spot, which a robot within its turn rate cannot, so it runs at the robot's max_speed / CATCH_UP and
+#: leaves the robot room to catch up after each turn.
+CATCH_UP = 1.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -63,13 +68,14 @@ def unrolled(track: np.ndarray, horizon: float) -> np.ndarray:
 def plan_for(meta: dict, task: dict, speed: float, straight: bool = False,
              scene_of: Optional[Callable[[], Any]] = None) -> Plan:
     """The plan the drive follows in task ``task`` of world.json ``meta`` (see the module's docstring);
-    ``speed`` (m/s) where world.json's robot states no ``max_speed``; ``scene_of`` gives the world's scene
+    ``speed`` (m/s) the static path's (a schedule runs at the robot's ``max_speed``: world.json's, else its
+    documented default, :func:`worldgen.groundtruth.folder.robot_description_of`); ``scene_of`` gives the world's scene
     for a schedule off the path (worldgen.sim.spacetime), which is not tried without it."""
     spawn, goal = task["spawn"], task["goal"]
     if straight:
         return Plan("straight", np.array([spawn[:2], goal[:2]], dtype=float), speed, note="spawn -> goal")
     waypoints = np.asarray(task["path"]["waypoints"], dtype=float)
-    top = float(meta["robot"].get("max_speed", speed))
+    top = robot_description_of(meta).max_speed
     movers = meta.get("dynamic_obstacles") or []
     if movers:
         plan = _among_movers(meta, task, waypoints, top, scene_of)
@@ -87,7 +93,7 @@ def _among_movers(meta: dict, task: dict, waypoints: np.ndarray, top: float, sce
     too), first with :data:`TRACKING` of room, then without; else one off the path (worldgen.sim.spacetime,
     with :data:`TRACKING` of room); None when none exists."""
     from worldgen.people.behaviours import Tube
-    from worldgen.people.timed import timed_path
+    from worldgen.people.timed import Limits, timed_path
 
     horizon = float(task["time_limit"])
     movers = meta.get("dynamic_obstacles") or []
@@ -98,10 +104,12 @@ def _among_movers(meta: dict, task: dict, waypoints: np.ndarray, top: float, sce
     radii = [float(m["radius"]) for m in movers] + [float(p["radius"]) for p in people]
     tubes = [Tube(0.0, 0.0)] * len(movers) + [
         Tube(float(p["tube"]["d"]), float(p["tube"]["tau"])) if p.get("tube") else Tube(0.0, 0.0) for p in people]
-    robot = meta["robot"]
-    inflation = float(robot["radius"]) + float(robot["clearance"])
+    robot = robot_description_of(meta)
+    # The robot's own limits (its top speed is ``top``): the turns and speed changes it can make.
+    limits = Limits(top, robot.turn_rate, robot.acceleration)
+    inflation = robot.footprint.inflation
     for room in (TRACKING, 0.0):
-        found = timed_path(waypoints, tracks, radii, inflation + room, top, tubes)
+        found = timed_path(waypoints, tracks, radii, inflation + room, limits, tubes)
         # Past the horizon the unrolled movers stand still: a schedule that ends there proves nothing.
         if found is not None and found.arrival <= horizon:
             return Plan("movers", waypoints, top, found.rows,
@@ -118,9 +126,9 @@ def _among_movers(meta: dict, task: dict, waypoints: np.ndarray, top: float, sce
     footprints = robot_footprints(open_scene(scene), robot_)
     for room in (TRACKING, 0.0):
         rows = spacetime_path(footprints, scene.bounds, task["spawn"], task["goal"], float(task["goal_tolerance"]),
-                              waypoints, tracks, radii, tubes, inflation, top, horizon, room)
+                              waypoints, tracks, radii, tubes, inflation, top / CATCH_UP, horizon, room)
         if rows is not None:
-            return Plan("spacetime", waypoints, top, rows,
+            return Plan("spacetime", waypoints, top / CATCH_UP, rows,
                         f"a schedule off the path among {len(movers)} mover(s) and {len(people)} person(s), "
                         f"{room * 100:g} cm of room for the follower, arrival {rows[-1, 0]:.2f} s")
     return None
