@@ -109,7 +109,8 @@ def _among_movers(meta: dict, task: dict, waypoints: np.ndarray, top: float, sce
     limits = Limits(top, robot.turn_rate, robot.acceleration)
     inflation = robot.footprint.inflation
     for room in (TRACKING, 0.0):
-        found = timed_path(waypoints, tracks, radii, inflation + room, limits, tubes)
+        # From the spawn's heading: the robot turns onto the first leg within its turn rate before it sets off.
+        found = timed_path(waypoints, tracks, radii, inflation + room, limits, tubes, heading=float(task["spawn"][5]))
         # Past the horizon the unrolled movers stand still: a schedule that ends there proves nothing.
         if found is not None and found.arrival <= horizon:
             return Plan("movers", waypoints, top, found.rows,
