@@ -82,6 +82,7 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	$(PY) benchmarks/bench_curriculum.py
 	$(PY) benchmarks/bench_people.py
 	$(PY) benchmarks/bench_reacting.py
+	$(PY) benchmarks/bench_tracking.py
 	$(PY) benchmarks/bench_drive.py
 	nice -n 10 $(PY) benchmarks/bench_requests.py
 	$(PY) benchmarks/bench_crowd.py

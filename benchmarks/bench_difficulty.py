@@ -7,7 +7,8 @@ Worlds: every configuration of :data:`CONFIGS` (four generators: cluttered rooms
 BARN-like 5 x 5 m, corridors, door worlds, minimal) with seeds 0..N-1 (validation) or
 FIT_SEED0.. FIT_SEED0+N-1 (fitting; disjoint from the validation seeds). In each world both
 probes of ``worldgen.envs.probes`` (``reactive``, ``tracker``) drive the first task in
-worldgen/Navigation-v0 with default settings; a probe fails when the episode is not a success.
+worldgen/Navigation-v0 with default settings but the speeds of worldgen.envs.ladder.SPEEDS; a probe
+fails when the episode is not a success.
 
 Reported per probe: Spearman's rank correlation of ``metrics.difficulty`` with failure (0/1),
 the AUC of the score for telling failures from successes (Mann-Whitney), and success per
@@ -89,7 +90,9 @@ def drive(job: tuple[int, int]) -> dict:
         return dict(rec, skipped=str(exc).splitlines()[0])
     rec.update(world_id=world.world_id, meta=_inputs(world))
     if _ENV is None:
-        _ENV = gymnasium.make("worldgen/Navigation-v0", generator="minimal").unwrapped
+        from worldgen.envs.ladder import SPEEDS  # the speeds its figures were measured at (docs/metrics.md)
+
+        _ENV = gymnasium.make("worldgen/Navigation-v0", generator="minimal", **SPEEDS).unwrapped
     _ENV.source = OneWorldSource(world)
     for probe in PROBES:
         info = run_episode(_ENV, probe, seed=0, options={"world_seed": seed})

@@ -189,14 +189,16 @@ def test_driving_straight_into_an_obstacle_is_a_collision_with_reward_minus_100(
     """A wall 2.0 m straight ahead (the minimal generator): full speed ahead touches it after ~1.8 m."""
     env = make(generator="minimal", params={"target_distance": 2.0}, reward="walkthrough")
     env.reset(seed=0)
-    reward, terminated, truncated, info, rewards = drive(env, lambda e: [1.0, 0.0])
+    v_max = float(env.action_space.high[0])  # the world's robot's max_speed (0.5 m/s, its default)
+    assert v_max == 0.5
+    reward, terminated, truncated, info, rewards = drive(env, lambda e: [v_max, 0.0])
     assert terminated and not truncated and reward == -100.0
     assert [c["entity"] for c in info["collisions"]] == ["target"]
     assert info["success"] is False and info["spl"] == 0.0 and info["reached_goal"] is False
     assert 1.75 < info["path_length"] < 1.85  # 2.0 m to the wall's face less the 0.2 m radius
     assert info["min_clearance"] <= 1e-3
     # Until then the walkthrough's reward: v/2 - |w|/2, less (1 - r)/2 once the wall is nearer than 1 m.
-    assert rewards[0] == pytest.approx(0.5, abs=1e-6) and min(rewards[:-1]) < 0.5
+    assert rewards[0] == pytest.approx(v_max / 2, abs=1e-6) and min(rewards[:-1]) < v_max / 2
     with pytest.raises(RuntimeError, match="reset"):
         env.step([0.0, 0.0])
 

@@ -67,10 +67,10 @@ def test_the_timed_follower_at_the_envs_defaults_reaches_the_goal_in_every_peopl
 
     env = gymnasium.make(ENV_ID, preset=preset)
     _, start = env.reset(seed=0)
-    # The default limit: twice the longer of L / v_max (at the env's 1 m/s) and the certified arrival (at the
-    # world's 0.5 m/s), plus a half turn: never shorter than the schedule.
+    # The default limit: twice the longer of L / v_max and the certified arrival (both at the world's robot's
+    # 0.5 m/s), plus a half turn at its 1 rad/s: never shorter than the schedule.
     arrival = env.unwrapped.task["arrival_time"]
-    assert start["time_limit"] == pytest.approx(2.0 * max(start["reference_path_length"] / 1.0, arrival) + np.pi / 1.0)
+    assert start["time_limit"] == pytest.approx(2.0 * max(start["reference_path_length"] / 0.5, arrival) + np.pi / 1.0)
     info = drive_timed(env, seed=0)
     assert info["success"] and info["collisions"] == [], (info["time_to_goal"], info["collisions"])
     u = env.unwrapped

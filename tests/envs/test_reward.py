@@ -107,8 +107,9 @@ WALKTHROUGH_PIN = "e37391b4f7247b1a0a4131eef21ef1dd0b176efeae44f267511ad6b3a1f9c
 
 
 def test_the_walkthrough_reward_is_unchanged_byte_for_byte():
+    # The speeds pinned as they were when the rewards were recorded (the robot's own are 0.5 m/s and 1 rad/s).
     env = gymnasium.make(ENV_ID, preset="drl_arena", lidar_beams=40, lidar_sectors=20, reward="walkthrough",
-                         time_limit_factor=None)
+                         time_limit_factor=None, linear_velocity=[0.0, 1.0], angular_velocity=1.0)
     rng = np.random.default_rng(7)
     rewards, ends = [], 0
     env.reset(seed=3)

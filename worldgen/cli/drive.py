@@ -35,12 +35,12 @@ Examples:
 @click.option("--out", type=click.Path(path_type=Path), required=True, metavar="DIR",
               help="Where the run's bag folder is written (DIR/<world id>__<task>__<sim>).")
 @click.option("--task", metavar="ID", help="The task to drive [default: the world's first].")
-@click.option("--speed", type=click.FloatRange(0, 2, min_open=True), default=0.5, show_default=True,
-              help="Forward speed, m/s.")
+@click.option("--speed", type=click.FloatRange(0, min_open=True), default=None,
+              help="Forward speed on the static path, m/s, at most the world's robot's max_speed  [default: that].")
 @click.option("--straight", is_flag=True,
               help="Drive spawn -> goal in a straight line instead of the reference path (a test hook: "
                    "it drives into whatever stands between them).")
-def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: float, straight: bool,
+def drive_command(world: Path, sim: str, out: Path, task: Optional[str], speed: Optional[float], straight: bool,
                   gz_release: Optional[str]) -> None:
     """Drive a world's task in a simulator, record the run as a rosbag2 bag and judge it.
 

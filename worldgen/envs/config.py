@@ -22,9 +22,12 @@ __all__ = ["SETTINGS", "EnvConfig", "resolve"]
 SETTINGS: tuple[Param, ...] = (
     Param("control_period", "float", 0.1, "seconds of simulation per env step (a whole number of the world's "
           "physics steps)", 0.001, 10.0, unit="s"),
-    Param("linear_velocity", "range", [0.0, 1.0], "[min, max] forward speed v the action may ask for",
-          -10.0, 10.0, unit="m/s"),
-    Param("angular_velocity", "float", 1.0, "largest turn rate |w| the action may ask for", 0.001, 20.0, unit="rad/s"),
+    Param("linear_velocity", "range", None, "[min, max] forward speed v the action may ask for, and the robot's "
+          "servo range (unset: [0, max_speed] of the world's robot, world.json robot.max_speed or its default)",
+          -10.0, 10.0, optional=True, unit="m/s"),
+    Param("angular_velocity", "float", None, "largest turn rate |w| the action may ask for, and the robot's "
+          "(unset: the world's robot's turn rate, world.json robot.max_turn_rate or its default)", 0.001, 20.0,
+          optional=True, unit="rad/s"),
     Param("lidar_beams", "int", 360, "rays of the planar lidar", 1, 4096),
     Param("lidar_fov", "float", 2.0 * math.pi, "field of view of the lidar, centred ahead unless lidar_angle_min "
           "is set (6.283185 = full circle)", 0.001, 2.0 * math.pi, unit="rad"),
@@ -84,8 +87,8 @@ class EnvConfig:
     """The resolved settings (see :data:`SETTINGS` for each one's meaning and unit)."""
 
     control_period: float
-    linear_velocity: tuple[float, float]
-    angular_velocity: float
+    linear_velocity: Optional[tuple[float, float]]
+    angular_velocity: Optional[float]
     lidar_beams: int
     lidar_fov: float
     lidar_angle_min: Optional[float]
@@ -139,9 +142,11 @@ def resolve(settings: Mapping[str, Any]) -> EnvConfig:
         raise ParameterError(f"parameter 'reward_fn' must be a callable (StepOutcome -> float) or None, "
                              f"got {quoted(reward_fn)}")
     values = validate_params(SETTINGS, settings)
-    v_lo, v_hi = values["linear_velocity"]
-    if v_lo >= v_hi:
-        raise ParameterError(f"parameter 'linear_velocity' must be [min, max] with min < max, got {[v_lo, v_hi]!r}")
+    if values["linear_velocity"] is not None:
+        v_lo, v_hi = values["linear_velocity"]
+        if v_lo >= v_hi:
+            raise ParameterError(f"parameter 'linear_velocity' must be [min, max] with min < max, got {[v_lo, v_hi]!r}")
+        values["linear_velocity"] = (v_lo, v_hi)
     if values["lidar_range_min"] >= values["lidar_range_max"]:
         raise ParameterError(f"parameter 'lidar_range_min' must be below lidar_range_max = "
                              f"{values['lidar_range_max']!r}, got {values['lidar_range_min']!r}")
@@ -149,6 +154,5 @@ def resolve(settings: Mapping[str, Any]) -> EnvConfig:
     if sectors is not None and (sectors > beams or beams % sectors):
         raise ParameterError(f"parameter 'lidar_sectors' must divide lidar_beams = {beams} (a whole number of beams "
                              f"per sector), got {sectors!r}")
-    values["linear_velocity"] = (v_lo, v_hi)
     names = {f.name for f in fields(EnvConfig)}
     return EnvConfig(**{k: v for k, v in values.items() if k in names}, reward_fn=reward_fn)

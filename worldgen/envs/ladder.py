@@ -3,7 +3,7 @@
 :func:`success_by_level` asks a generator for worlds at each level (one request per
 seed, :mod:`worldgen.leveling`) and drives the probe (:mod:`worldgen.envs.probes`)
 through each world's first task in ``worldgen/Navigation-v0`` with default settings (but a reward that
-needs no geodesic field: the probes read no reward);
+needs no geodesic field: the probes read no reward, and the speeds of :data:`SPEEDS`);
 :func:`ladder_figures` reads the table the way issue 19 asks for a ladder: Spearman's
 rank correlation of success with level, and a 95 % Wilson interval per level
 (tests/envs/test_ladder.py, benchmarks/bench_ladder.py, docs/metrics.md).
@@ -13,7 +13,12 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Optional, Sequence
 
-__all__ = ["success_by_level", "ladder_figures"]
+__all__ = ["SPEEDS", "success_by_level", "ladder_figures"]
+
+#: The probe's speeds: the environment's defaults when the ladder's figures were measured (docs/metrics.md),
+#: before its robot became each world's (issue 37: 0.5 m/s by default). The probe's success depends on
+#: them, so the ladder keeps them.
+SPEEDS: dict[str, Any] = {"linear_velocity": [0.0, 1.0], "angular_velocity": 1.0}
 
 
 def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int],
@@ -31,7 +36,7 @@ def success_by_level(generator: str, levels: Sequence[int], seeds: Sequence[int]
 
     # The probes read neither the reward nor the geodesic field; the straight-line reward keeps the reset from
     # building the field (about 20-40 ms of each episode's 0.1-0.3 s), and success is the same whatever the reward.
-    env = gymnasium.make("worldgen/Navigation-v0", generator="minimal", reward="euclidean_progress").unwrapped
+    env = gymnasium.make("worldgen/Navigation-v0", generator="minimal", reward="euclidean_progress", **SPEEDS).unwrapped
     assert isinstance(env, NavigationEnv)
     out: dict[int, list[bool]] = {}
     try:

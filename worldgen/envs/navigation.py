@@ -19,7 +19,10 @@ picks each episode's world from how the learner did (docs/rl.md, Curricula).
 Action: ``Box([v_min, -w_max], [v_max, w_max])``, float32: forward speed v (m/s)
 and turn rate w (rad/s, counter-clockwise), held for one control period
 (``control_period``, default 0.1 s = 50 physics steps at the usual 0.002 s).
-Values outside the box are clipped to it.
+Values outside the box are clipped to it. The box is the ``linear_velocity`` and
+``angular_velocity`` settings where given; unset, the robot's own limits
+(its world's robot description: ``[0, max_speed]`` and ``turn_rate``; over a pack the
+largest among its worlds), and each episode's robot then moves within its world's limits.
 
 Observation: ``Box`` of float32, length ``S + 4``:
 ``[scan[0..S-1], goal_distance, goal_angle, last_v, last_w]`` where ``scan`` is the
@@ -86,11 +89,13 @@ from worldgen.envs.lidar import Lidar
 from worldgen.envs.period import run_period
 from worldgen.envs.reacting import walkers_of
 from worldgen.envs.reward import StepOutcome, reward
-from worldgen.envs.robot import RobotModel, compile_world
+from worldgen.envs.robot import RobotModel, compile_world, servo_limits
 from worldgen.envs.source import EpisodeWorld, PackSource, make_source
 from worldgen.envs.terrain import add_base, lidar_frame, settle
 from worldgen.errors import CallOrderError, ParameterError
+from worldgen.groundtruth.folder import robot_description_of
 from worldgen.judge.figures import Contact
+from worldgen.scene.robot import MAX_SPEED, TURN_RATE, RobotDescription
 from worldgen.seeding import check_seed, draw_seed, env_rngs
 
 if TYPE_CHECKING:  # the checker reads Gymnasium's types; at run time a missing extra is one clear line
@@ -120,7 +125,7 @@ class NavigationEnv(gym.Env):
         self.metadata = dict(self.metadata, render_fps=1.0 / cfg.control_period)
         self.lidar = Lidar(cfg.lidar_beams, cfg.lidar_fov, cfg.lidar_angle_min, cfg.lidar_range_min,
                            cfg.lidar_range_max, cfg.lidar_noise, cfg.lidar_sectors)
-        (v_lo, v_hi), w = cfg.linear_velocity, cfg.angular_velocity
+        (v_lo, v_hi), w = self._action_bound()
         self._act_lo = np.array([v_lo, -w], dtype=np.float32)
         self._act_hi = np.array([v_hi, w], dtype=np.float32)
         self.action_space = gym.spaces.Box(self._act_lo, self._act_hi, dtype=np.float32)
@@ -148,6 +153,22 @@ class NavigationEnv(gym.Env):
         self.episode: Optional[Episode] = None
         self._painter = None
         self.reset_timings: dict = {}
+
+    def _action_bound(self) -> tuple[tuple[float, float], float]:
+        """((v_min, v_max), w_max) of the action box: the settings where given, else the source's robots'
+        largest limits (a source that states none: the description's defaults)."""
+        cfg = self.config
+        bound = getattr(self.source, "motion_bound", None)
+        speed, turn = bound() if bound is not None else (MAX_SPEED, TURN_RATE)
+        v = cfg.linear_velocity if cfg.linear_velocity is not None else (0.0, speed)
+        return v, cfg.angular_velocity if cfg.angular_velocity is not None else turn
+
+    def _robot(self, world: EpisodeWorld) -> tuple[RobotDescription, tuple[float, float], float]:
+        """The episode's robot (its world's description) and its servos' (v_min, v_max), w_max: the settings
+        where given, else the robot's own limits."""
+        robot = world.description if world.description is not None else robot_description_of(world.metadata())
+        v_range, w_max = servo_limits(robot, self.config.linear_velocity, self.config.angular_velocity)
+        return robot, v_range, w_max
 
     # -- episode --------------------------------------------------------------------------------------------
     def _reseed(self, seed: Optional[int]) -> None:
@@ -189,7 +210,8 @@ class NavigationEnv(gym.Env):
         cfg = self.config
         spawn = world.task["spawn"]
         movers = walkers_of(world)  # people who react to the robot among them (docs/people.md)
-        floor = add_base(world.mjcf, world.robot, cfg.linear_velocity, cfg.angular_velocity, world.terrain, world.floor)
+        _, (v_lo, v_max), w_max = self._robot(world)
+        floor = add_base(world.mjcf, world.robot, (v_lo, v_max), w_max, world.terrain, world.floor)
         add_openers(world.mjcf, world.doors, cfg.doors)
         sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), floor, [m["name"] for m in world.movers])
         self._centre = settle(sim, world.robot) if world.terrain else None
@@ -213,7 +235,6 @@ class NavigationEnv(gym.Env):
         if cfg.time_limit_factor is None:
             self._time_limit = float(world.task["time_limit"])
         else:
-            v_max, w_max = float(self._act_hi[0]), float(self._act_hi[1])
             optimal = max(world.reference_path_length / v_max, world.task.get("arrival_time") or 0.0)  # among people
             self._time_limit = cfg.time_limit_factor * optimal + math.pi / w_max
         self._lidar_height = cfg.lidar_height if cfg.lidar_height is not None else world.lidar_height

@@ -1,15 +1,18 @@
 """The robot: a differential-drive body added to a world's MJCF, compiled into MuJoCo.
 
-The body is the world's footprint (world.json ``robot``): a cylinder of
-``radius`` whose top is at ``height``, on a planar base of three joints (slide
-x, slide y, hinge yaw about z), starting at the task's spawn (x, y, yaw; the joints'
-values are the world pose, so ``data.qpos`` reads it directly). Its bottom is lifted
+The body is the world's robot description (:class:`~worldgen.scene.robot.RobotDescription`, read by
+:func:`worldgen.groundtruth.folder.robot_description_of`: the same numbers robot.sdf and robot.urdf
+carry): a cylinder of the footprint's ``radius`` whose top is at its ``height``, of the
+description's mass, on a planar base of three joints (slide x, slide y, hinge yaw about z),
+starting at the task's spawn (x, y, yaw; the joints' values are the world pose, so
+``data.qpos`` reads it directly). Its bottom is lifted
 :data:`FLOOR_GAP` off the floor, so it never rests on it: every contact it makes
 is with something else.
 
 Three velocity servos act through a site at the body's centre, in the body's
 own frame (a site transmission): forward speed ``v`` along the heading, turn
-rate ``w`` about z, and a lateral servo held at 0, so the base moves as a
+rate ``w`` about z (their ranges the robot's ``max_speed`` and ``turn_rate`` unless the caller
+overrides them: :func:`servo_limits`), and a lateral servo held at 0, so the base moves as a
 unicycle (differential drive) and never sideways. The servos are stiff (time
 constant :data:`TIME_CONSTANT`) and integrated implicitly by MuJoCo's
 ``implicitfast``, so the base follows the commanded (v, w) within a few
@@ -30,15 +33,17 @@ changed between MuJoCo 3 releases.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Optional, Sequence
 
 import numpy as np
 from lxml import etree
 
 from worldgen.errors import SceneError
 from worldgen.floats import fmt, fmt_seq
+from worldgen.scene.robot import BODY_MASS, RobotDescription
 
-__all__ = ["ROBOT", "FLOOR_GAP", "TIME_CONSTANT", "ROBOT_MASS", "RobotModel", "add_robot", "compile_world"]
+__all__ = ["ROBOT", "FLOOR_GAP", "TIME_CONSTANT", "ROBOT_MASS", "RobotModel", "add_robot", "servo_limits",
+           "compile_world"]
 
 #: Name of the robot's body and geom in the compiled model (prefix of its joints, site and actuators).
 ROBOT = "nav_robot"
@@ -46,8 +51,9 @@ ROBOT = "nav_robot"
 FLOOR_GAP = 0.005
 #: Time constant (s) of the velocity servos: how fast the base reaches a commanded (v, w).
 TIME_CONSTANT = 0.01
-#: Mass (kg) of the robot's body (a uniform cylinder).
-ROBOT_MASS = 10.0
+#: Mass (kg) of the robot's body (a uniform cylinder): the description's default, worldgen.scene.robot.BODY_MASS
+#: (this name is kept for the code that imported it from here).
+ROBOT_MASS = BODY_MASS
 _RGBA = (0.95, 0.45, 0.1, 1.0)
 
 
@@ -76,10 +82,20 @@ class RobotModel:
         return float(q[self.qpos[0]]), float(q[self.qpos[1]]), float(q[self.qpos[2]])
 
 
-def add_robot(root, radius: float, height: float, v_range: tuple[float, float], w_max: float) -> None:
+def servo_limits(robot: RobotDescription, v_range: Optional[Sequence[float]] = None,
+                 w_max: Optional[float] = None) -> tuple[tuple[float, float], float]:
+    """(``v_range``, ``w_max``) of the servos for ``robot``: its own limits, forward from standstill to
+    ``max_speed`` (m/s) and turns up to ``turn_rate`` (rad/s), each replaced by the caller's where given."""
+    v = (0.0, robot.max_speed) if v_range is None else (float(v_range[0]), float(v_range[1]))
+    return v, robot.turn_rate if w_max is None else float(w_max)
+
+
+def add_robot(root, radius: float, height: float, v_range: tuple[float, float], w_max: float,
+              mass: float = BODY_MASS) -> None:
     """Add the robot's body, site and servos to an MJCF ``<mujoco>`` lxml element (changed in place).
 
-    ``v_range`` (m/s) and ``w_max`` (rad/s) become the servos' control ranges.
+    ``v_range`` (m/s) and ``w_max`` (rad/s) become the servos' control ranges (:func:`servo_limits` gives
+    a description's); ``mass`` (kg) is the body's.
     """
     if root.find(f".//*[@name='{ROBOT}']") is not None:
         raise SceneError(f"the world already has an element named {ROBOT!r}; the environment's robot needs that name")
@@ -89,14 +105,14 @@ def add_robot(root, radius: float, height: float, v_range: tuple[float, float], 
     body = etree.SubElement(root.find("worldbody"), "body", name=ROBOT, pos=fmt_seq((0.0, 0.0, FLOOR_GAP + half)))
     for axis, kind, suffix in (("1 0 0", "slide", "x"), ("0 1 0", "slide", "y"), ("0 0 1", "hinge", "yaw")):
         etree.SubElement(body, "joint", name=f"{ROBOT}_{suffix}", type=kind, axis=axis, limited="false")
-    etree.SubElement(body, "geom", name=ROBOT, type="cylinder", size=fmt_seq((radius, half)), mass=fmt(ROBOT_MASS),
+    etree.SubElement(body, "geom", name=ROBOT, type="cylinder", size=fmt_seq((radius, half)), mass=fmt(mass),
                      rgba=fmt_seq(_RGBA))
     etree.SubElement(body, "site", name=f"{ROBOT}_base", pos="0 0 0")
     actuators = root.find("actuator")
     if actuators is None:
         actuators = etree.SubElement(root, "actuator")
-    kv_linear = ROBOT_MASS / TIME_CONSTANT
-    kv_turn = ROBOT_MASS * radius * radius / 2.0 / TIME_CONSTANT  # the cylinder's inertia about z
+    kv_linear = mass / TIME_CONSTANT
+    kv_turn = mass * radius * radius / 2.0 / TIME_CONSTANT  # the cylinder's inertia about z
     for suffix, gear, kv, limits in (("forward", "1 0 0 0 0 0", kv_linear, v_range),
                                      ("lateral", "0 1 0 0 0 0", kv_linear, None),
                                      ("turn", "0 0 0 0 0 1", kv_turn, (-w_max, w_max))):

@@ -25,6 +25,7 @@ from typing import Any, Callable, Mapping, Optional
 
 from worldgen.errors import ParameterError, quoted
 from worldgen.scene import Robot
+from worldgen.scene.robot import RobotDescription
 
 __all__ = ["EpisodeWorld", "GeneratorSource", "PackSource", "OneWorldSource", "FolderSource", "make_source"]
 
@@ -41,7 +42,9 @@ class EpisodeWorld:
     a hinged body the robot may push open: touching one is a door contact, not a collision);
     ``bounds`` ((x0, y0), (x1, y1)) where the robot may be; :meth:`scene` the world's scene (for the geodesic field);
     ``doors`` world.json's ``doors[]`` (hinge joint, limits, doorway: what an automatic door opens by);
-    ``terrain`` whether the world has terrain (the robot is then :mod:`worldgen.envs.terrain`'s base).
+    ``terrain`` whether the world has terrain (the robot is then :mod:`worldgen.envs.terrain`'s base);
+    ``description`` the robot the environment builds (sizes, motion limits, lidar), ``robot`` its footprint
+    and ``lidar_height`` its lidar's height.
     """
 
     world_id: str
@@ -60,6 +63,7 @@ class EpisodeWorld:
     bounds: Optional[tuple] = None
     doors: tuple = ()
     terrain: bool = False
+    description: Optional[RobotDescription] = None
 
     @property
     def reference_path_length(self) -> float:
@@ -110,6 +114,7 @@ def episode_world(world) -> EpisodeWorld:
     """An :class:`EpisodeWorld` of an in-memory :class:`~worldgen.World` (no file rendered)."""
     from worldgen.export.metadata import mover_entry, person_entry
     from worldgen.export.xml import parse_bytes
+    from worldgen.groundtruth.folder import robot_description_of
     from worldgen.groundtruth.ground import Ground
     from worldgen.scene.doors import door_records
 
@@ -117,7 +122,7 @@ def episode_world(world) -> EpisodeWorld:
     # People after the movers (the MJCF's order); a person's entry carries its behaviour and tube, if any.
     movers = [dict(person_entry(m, world.params), loop=False) if m.person else mover_entry(m, world.params)
               for m in world.scene.movers]
-    robot = world.robot
+    robot, description = world.robot, robot_description_of(world)
     leaves = frozenset(n.name for n in world.scene.nodes if n.role == "door")
     light = {"world_id": world.world_id, "tasks": [task], "dynamic_obstacles": [m for m in movers if m["loop"]],
              "people": [m for m in movers if not m["loop"]],
@@ -126,10 +131,11 @@ def episode_world(world) -> EpisodeWorld:
     return EpisodeWorld(
         world_id=world.world_id, mjcf=parse_bytes(world.to_mjcf().encode()).getroot(), robot=robot,
         task=task, movers=movers, floor=frozenset(n.name for n in world.scene.nodes if n.role == "floor"),
-        lidar_height=float(world.params.get("lidar_height", 0.3)), params=dict(world.params),
+        lidar_height=description.lidar.height, params=dict(world.params),
         _ground=lambda: Ground(light, scene=world.scene), _metadata=lambda: world.metadata_for({}),
         door_leaves=leaves, _scene=lambda: world.scene, bounds=tuple(map(tuple, world.scene.bounds)),
-        doors=tuple(door_records(world.scene)) if leaves else (), terrain=world.scene.terrain is not None)
+        doors=tuple(door_records(world.scene)) if leaves else (), terrain=world.scene.terrain is not None,
+        description=description)
 
 
 class GeneratorSource:
@@ -164,6 +170,13 @@ class GeneratorSource:
 
     def __len__(self) -> int:
         return 0  # unbounded: any seed
+
+    def motion_bound(self) -> tuple[float, float]:
+        """(max_speed m/s, turn_rate rad/s) of every world's robot: its parameters' (a generator's worlds
+        share them)."""
+        from worldgen.groundtruth.folder import motion_limits_of
+
+        return motion_limits_of({"params": self.resolved})[:2]
 
     def distance_bound(self) -> tuple[float, bool]:
         """(bound, exact): the longest straight line inside any world of this source. Exact from the
@@ -200,6 +213,13 @@ class OneWorldSource:
     def __len__(self) -> int:
         return 0
 
+    def motion_bound(self) -> tuple[float, float]:
+        """(max_speed m/s, turn_rate rad/s) of the world's robot."""
+        from worldgen.groundtruth.folder import robot_description_of
+
+        robot = robot_description_of(self.world_)
+        return robot.max_speed, robot.turn_rate
+
     def world(self, seed) -> EpisodeWorld:
         return episode_world(self.world_)
 
@@ -228,6 +248,13 @@ class PackSource:
             b = pw.metadata["bounds"]
             longest = max(longest, math.hypot(b["max"][0] - b["min"][0], b["max"][1] - b["min"][1]))
         return longest, True
+
+    def motion_bound(self) -> tuple[float, float]:
+        """(max_speed m/s, turn_rate rad/s): the largest of the pack's worlds' robots (world.json ``robot``)."""
+        from worldgen.groundtruth.folder import motion_limits_of
+
+        limits = [motion_limits_of(pw.metadata)[:2] for pw in self.pack]
+        return max(v for v, _ in limits), max(w for _, w in limits)
 
     def world(self, index: int) -> EpisodeWorld:
         from worldgen.groundtruth.ground import load as ground_of
@@ -277,6 +304,11 @@ class FolderSource:
     def __len__(self) -> int:
         return 0
 
+    def motion_bound(self) -> tuple[float, float]:
+        """(max_speed m/s, turn_rate rad/s) of the world's robot (world.json ``robot``)."""
+        robot = self.reader.robot_description
+        return robot.max_speed, robot.turn_rate
+
     def world(self, seed) -> EpisodeWorld:
         from worldgen.verify import load_world
 
@@ -295,16 +327,17 @@ def _episode_world(reader, task: dict, mjcf: bytes, ground: Callable[[], Any], s
 
     meta = reader.metadata
     params = dict(meta.get("params", {}))
+    description = reader.robot_description
     return EpisodeWorld(
         world_id=reader.world_id, mjcf=etree.fromstring(mjcf, safe_parser()), robot=reader.robot,
         task=_checked_task(reader.world_id, task),
         movers=list(meta.get("dynamic_obstacles") or []) + [dict(p, loop=False) for p in meta.get("people") or []],
         floor=frozenset(e["name"] for e in meta["entities"] if e["role"] == "floor"),
-        lidar_height=float(params.get("lidar_height", 0.3)), params=params,
+        lidar_height=description.lidar.height, params=params,
         _ground=ground, _metadata=lambda: meta, _scene=scene,
         bounds=(tuple(meta["bounds"]["min"]), tuple(meta["bounds"]["max"])),
         door_leaves=frozenset(str(d["name"]) for d in meta.get("doors") or []), doors=tuple(meta.get("doors") or ()),
-        terrain=bool(meta.get("terrain")))
+        terrain=bool(meta.get("terrain")), description=description)
 
 
 def make_source(generator=None, params=None, preset=None, pack=None, difficulty=None):

@@ -9,8 +9,10 @@
     >>> robot_urdf(world).count("<link ")            # base_footprint, base_link, 2 wheels, 2 casters, lidar, imu
     8
 
-The body is world.json's ``robot`` footprint: a cylinder of ``radius`` whose top is at
-``height``; everything else sits inside it. Two drive wheels on the y axis and two
+Every number comes from the world's one robot description
+(:func:`worldgen.groundtruth.folder.robot_description_of`, the one the environment and ``worldgen drive``
+in MuJoCo build from too): the body is world.json's ``robot`` footprint, a cylinder of ``radius`` whose top
+is at ``height``, of the description's mass; everything else sits inside it. Two drive wheels on the y axis and two
 frictionless caster spheres (front and back) carry it; the chassis' collision starts a caster
 radius above the floor, so only wheels and casters touch it. Frames: the model's frame is
 ``base_footprint`` (on the floor under the centre: the pose a spawn and world.json give),
@@ -19,7 +21,9 @@ radius above the floor, so only wheels and casters touch it. Frames: the model's
 
 Gazebo systems on the model (its own topics, as nav2 expects them, not gz-sim's
 ``/model/<name>/...`` defaults): DiffDrive takes ``cmd_vel`` and publishes ``odom`` and ``tf``
-(``odom`` -> ``base_footprint``, starting at zero at the spawn); OdometryPublisher publishes the
+(``odom`` -> ``base_footprint``, starting at zero at the spawn) and holds the robot to its motion
+limits (speed, turn rate and acceleration: world.json's ``robot.max_speed``, ``max_turn_rate``,
+``max_acceleration``, their documented defaults where a world states none); OdometryPublisher publishes the
 ground truth, the model's pose in the world frame (= the map frame), on ``ground_truth/odom``
 (``map`` -> ``base_footprint``), the topic the ROS 2 bundle bridges as ``/ground_truth``, and the
 same pose on its ``tf_topic``, ``/model/<name>/pose``. Every topic name and the release's plugin
@@ -35,7 +39,7 @@ geometry); Gazebo spawns the SDF. Both are bytes-stable: same world and argument
 from __future__ import annotations
 
 import math
-from typing import Mapping
+from collections.abc import Mapping
 
 from lxml import etree
 
@@ -43,9 +47,11 @@ from worldgen.errors import ParameterError
 from worldgen.export.contract import CMD_VEL, DEFAULT_GZ_RELEASE, GROUND_TRUTH, IMU, JOINT_STATES, ODOM, SCAN, TF, release
 from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
+from worldgen.groundtruth.folder import robot_description_of
+from worldgen.scene.robot import LidarDescription, RobotDescription
 
-__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "WHEEL_ACCELERATION", "CASTER_SPRING", "CASTER_DAMPING",
-           "CASTER_TRAVEL", "CASTER_PRELOAD", "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
+__all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "CASTER_SPRING", "CASTER_DAMPING", "CASTER_TRAVEL",
+           "CASTER_PRELOAD", "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
 
 #: The model's name: the ROS 2 bundle's robot (worldgen.export.ros2.DEFAULT_ROBOT_NAME).
 DEFAULT_NAME = "robot"
@@ -61,13 +67,8 @@ SENSOR_FRAME_ELEMENT = "gz_frame_id"
 #: renders is visuals, and SDFormat 1.9 has no visibility mask for a lidar, so the window keeps the
 #: robot out of its own scan (the collision cylinder is whole).
 LIDAR_WINDOW = 0.01
-_CHASSIS_KG, _WHEEL_KG, _CASTER_KG = 10.0, 0.5, 0.2
-#: m/s^2: the DiffDrive's limit on the wheels' acceleration and braking (nav2's controllers' default
-#: ``acc_lim_x`` / ``decel_lim_x``). Without a limit a twist sets the wheels' speed in one step; the tyres
-#: (mu 1) then give the body about 6.5 m/s^2 (measured in Fortress 6.18 and Harmonic 8.14 alike), so the
-#: wheels spin on a start and the body slides on after a stop by v^2 / 13 m: 0.31 m from 2 m/s, the 0.22 m
-#: issue 39 saw after a stop. Below the tyres' grip the body follows its wheels.
-WHEEL_ACCELERATION = 2.5
+# The wheels' and casters' own masses (kg), beside the chassis' (the description's mass).
+_WHEEL_KG, _CASTER_KG = 0.5, 0.2
 _COLOUR = "0.95 0.45 0.1 1"
 #: On terrain only, the casters' suspension: stiffness (N/m), damping (N s/m), travel either way and
 #: preload (m, how far below the wheels' ground the spring would rest). Stiff enough that the body pitches
@@ -93,18 +94,23 @@ class Dimensions:
         self.chassis_bottom = self.caster_radius
 
 
-def _meta(world) -> Mapping:
-    """world.json's content: a :class:`~worldgen.World`'s metadata, or a world.json already read."""
-    return world if isinstance(world, Mapping) else world.metadata
+def _described(world) -> RobotDescription:
+    """The robot description of ``world``: a World, world.json's content, or a description already made."""
+    return world if isinstance(world, RobotDescription) else robot_description_of(world)
+
+
+def _on_terrain(world) -> bool:
+    """Whether ``world`` (a World or world.json) has terrain; a description alone is of a flat world's robot."""
+    if isinstance(world, RobotDescription):
+        return False
+    return bool((world if isinstance(world, Mapping) else world.metadata).get("terrain"))
 
 
 def dimensions(world) -> Dimensions:
-    """The robot's :class:`Dimensions` for ``world`` (a World or world.json's content): its ``robot``
-    footprint and world.json's lidar height above the first spawn."""
-    meta = _meta(world)
-    lidar, robot = meta["sensors"]["lidar"], meta["robot"]
-    spawn_z = meta["tasks"][0]["spawn"][2]
-    return Dimensions(float(robot["radius"]), float(robot["height"]), float(lidar["pose"][2]) - float(spawn_z))
+    """The robot's :class:`Dimensions` for ``world`` (a World, world.json's content or a
+    :class:`~worldgen.scene.robot.RobotDescription`): its footprint and its lidar's height above the floor."""
+    robot = _described(world)
+    return Dimensions(robot.radius, robot.height, robot.lidar.height)
 
 
 def _inertia_cylinder(m: float, r: float, length: float) -> tuple[float, float, float]:
@@ -167,11 +173,11 @@ def _visual_bands(d: Dimensions) -> list[tuple[float, float]]:
     return [(d.chassis_bottom, low), (high, d.height)]
 
 
-def _sdf_links(model, d: Dimensions) -> None:
+def _sdf_links(model, d: Dimensions, mass: float) -> None:
     length, zc = _chassis(d)
     base = sub(model, "link", name="base_link")
     sub(base, "pose", fmt_seq((0, 0, d.wheel_radius, 0, 0, 0)))
-    _sdf_inertial(base, _CHASSIS_KG, _inertia_cylinder(_CHASSIS_KG, d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
+    _sdf_inertial(base, mass, _inertia_cylinder(mass, d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
     _sdf_shape(base, "collision", "chassis_collision", ("cylinder", d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
     for k, (low, high) in enumerate(_visual_bands(d)):
         _sdf_shape(base, "visual", f"chassis_visual_{k}", ("cylinder", d.radius, high - low),
@@ -194,7 +200,7 @@ def _sdf_links(model, d: Dimensions) -> None:
             sub(axis, "xyz", "0 0 1")
 
 
-def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_rate: float) -> None:
+def _sdf_sensors(model, d: Dimensions, lidar: LidarDescription, lidar_noise: float, lidar_rate: float) -> None:
     scan_link = sub(model, "link", name="base_scan")
     sub(scan_link, "pose", fmt_seq((0, 0, d.lidar_height, 0, 0, 0)))
     _sdf_inertial(scan_link, 0.01, (1e-5, 1e-5, 1e-5))
@@ -206,13 +212,13 @@ def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_ra
     sub(sensor, SENSOR_FRAME_ELEMENT, "base_scan")
     ray = sub(sensor, "lidar")
     horizontal = sub(sub(ray, "scan"), "horizontal")
-    sub(horizontal, "samples", str(int(lidar["samples"])))
+    sub(horizontal, "samples", str(lidar.samples))
     sub(horizontal, "resolution", "1")
-    sub(horizontal, "min_angle", fmt(lidar["angle_min"]))
-    sub(horizontal, "max_angle", fmt(lidar["angle_max"]))
+    sub(horizontal, "min_angle", fmt(lidar.angle_min))
+    sub(horizontal, "max_angle", fmt(lidar.angle_max))
     rng = sub(ray, "range")
-    sub(rng, "min", fmt(lidar["range_min"]))
-    sub(rng, "max", fmt(lidar["range_max"]))
+    sub(rng, "min", fmt(lidar.range_min))
+    sub(rng, "max", fmt(lidar.range_max))
     sub(rng, "resolution", "0.001")
     noise = sub(ray, "noise")
     sub(noise, "type", "gaussian")
@@ -232,7 +238,7 @@ def _sdf_sensors(model, d: Dimensions, lidar: dict, lidar_noise: float, lidar_ra
     sub(imu, SENSOR_FRAME_ELEMENT, "imu_link")
 
 
-def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: float) -> None:
+def _sdf_plugins(model, d: Dimensions, robot: RobotDescription, name: str, gz_release: str, odom_rate: float) -> None:
     row = release(gz_release)
     filename, cls = row.plugin("diff-drive", "DiffDrive")
     drive = sub(model, "plugin", filename=filename, name=cls)
@@ -241,10 +247,16 @@ def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: fl
                        ("odom_publish_frequency", fmt(odom_rate)), ("topic", CMD_VEL.gz_name), ("odom_topic", ODOM.gz_name),
                        ("tf_topic", TF.gz_name), ("frame_id", "odom"), ("child_frame_id", "base_footprint")):
         sub(drive, key, value)
-    # The same tyre acceleration for a turn: a wheel's rim moves at the turn rate times half the separation.
-    turn = WHEEL_ACCELERATION / (d.wheel_separation / 2.0)
-    for limit, rate in (("max_linear_acceleration", WHEEL_ACCELERATION), ("min_linear_acceleration", -WHEEL_ACCELERATION),
-                        ("max_angular_acceleration", turn), ("min_angular_acceleration", -turn)):
+    # The robot's limits, held by the DiffDrive whatever a twist asks. Without an acceleration limit a twist
+    # sets the wheels' speed in one step; the tyres (mu 1) then give the body about 6.5 m/s^2 (measured in
+    # Fortress 6.18 and Harmonic 8.14 alike), so the wheels spin on a start and the body slides on after a
+    # stop (the 0.22 m issue 39 saw); below the tyres' grip the body follows its wheels. A turn gets the same
+    # rim acceleration: a wheel's rim moves at the turn rate times half the separation.
+    a, turn = robot.acceleration, robot.acceleration / (d.wheel_separation / 2.0)
+    for limit, rate in (("max_linear_acceleration", a), ("min_linear_acceleration", -a),
+                        ("max_angular_acceleration", turn), ("min_angular_acceleration", -turn),
+                        ("max_linear_velocity", robot.max_speed), ("min_linear_velocity", -robot.max_speed),
+                        ("max_angular_velocity", robot.turn_rate), ("min_angular_velocity", -robot.turn_rate)):
         sub(drive, limit, fmt(rate))
     filename, cls = row.plugin("odometry-publisher", "OdometryPublisher")
     truth = sub(model, "plugin", filename=filename, name=cls)
@@ -259,7 +271,8 @@ def _sdf_plugins(model, d: Dimensions, name: str, gz_release: str, odom_rate: fl
 
 def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_release: str = DEFAULT_GZ_RELEASE,
               sensors: bool = True, lidar_rate: float = 10.0, odom_rate: float = 50.0) -> str:
-    """``robot.sdf`` (SDFormat 1.9, one ``<model>``) of the robot for ``world`` (a World or world.json's content).
+    """``robot.sdf`` (SDFormat 1.9, one ``<model>``) of the robot for ``world`` (a World, world.json's content or
+    a :class:`~worldgen.scene.robot.RobotDescription`).
 
     ``lidar_noise``: the lidar's Gaussian noise, standard deviation in m (0: exact ranges);
     ``gz_release``: whose plugin names the systems get (``fortress``, ``garden``, ``harmonic``, ``ionic``);
@@ -271,18 +284,19 @@ def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_r
     if not (lidar_rate > 0 and odom_rate > 0):
         raise ParameterError(f"rates must be > 0 Hz, got lidar_rate={lidar_rate!r}, odom_rate={odom_rate!r}")
     release(gz_release)
-    d = dimensions(world)
+    robot = _described(world)
+    d = dimensions(robot)
     root = etree.Element("sdf", version="1.9")
     model = sub(root, "model", name=name)
     sub(model, "pose", "0 0 0 0 0 0")
     sub(model, "frame", name="base_footprint", attached_to="base_link").append(
         _el("pose", fmt_seq((0, 0, -d.wheel_radius, 0, 0, 0)), relative_to="base_link"))
-    _sdf_links(model, d)
-    if _meta(world).get("terrain"):  # only there: a flat world's robot keeps its bytes
+    _sdf_links(model, d, robot.mass)
+    if _on_terrain(world):  # only there: a flat world's robot keeps its bytes
         _suspend_casters(model)
     if sensors:
-        _sdf_sensors(model, d, _meta(world)["sensors"]["lidar"], float(lidar_noise), float(lidar_rate))
-    _sdf_plugins(model, d, name, gz_release, float(odom_rate))
+        _sdf_sensors(model, d, robot.lidar, float(lidar_noise), float(lidar_rate))
+    _sdf_plugins(model, d, robot, name, gz_release, float(odom_rate))
     return to_bytes(root).decode()
 
 
@@ -344,12 +358,14 @@ def _urdf_joint(robot, name: str, kind: str, parent: str, child: str, xyz, rpy=(
 
 def robot_urdf(world, *, name: str = DEFAULT_NAME) -> str:
     """``robot.urdf`` of the robot for ``world``: the SDF's links and joints, for robot_state_publisher."""
-    d = dimensions(world)
+    described = _described(world)
+    mass = described.mass
+    d = dimensions(described)
     length, zc = _chassis(d)
     robot = etree.Element("robot", name=name)
     _urdf_link(robot, "base_footprint")
-    _urdf_link(robot, "base_link", ("cylinder", d.radius, length), _CHASSIS_KG,
-               _inertia_cylinder(_CHASSIS_KG, d.radius, length), (0, 0, zc, 0, 0, 0))
+    _urdf_link(robot, "base_link", ("cylinder", d.radius, length), mass,
+               _inertia_cylinder(mass, d.radius, length), (0, 0, zc, 0, 0, 0))
     _urdf_joint(robot, "base_footprint_joint", "fixed", "base_footprint", "base_link", (0, 0, d.wheel_radius))
     for part, kind, xyz, shape, mass, _ in _parts(d):
         if shape[0] == "cylinder":

@@ -9,8 +9,8 @@ from typing import Any, Mapping, Optional
 import numpy as np
 
 from worldgen.floats import finite_or_none
-from worldgen.params import COMMON_PARAMS
 from worldgen.scene.doors import door_joints, leaves_in_the_way
+from worldgen.scene.robot import MAX_SPEED
 
 __all__ = ["TIME_FACTOR", "TIME_MARGIN", "DOOR_TIME", "time_limit", "robot_speed", "leaves_on_path", "task_entry"]
 
@@ -29,8 +29,9 @@ def time_limit(length: float, robot_speed: float, doors: int = 0) -> float:
 
 
 def robot_speed(params: Mapping[str, Any]) -> float:
-    """The speed (m/s) a world's time limits assume: its ``robot_speed`` parameter, or that parameter's default."""
-    return params.get("robot_speed", next(p.default for p in COMMON_PARAMS if p.name == "robot_speed"))
+    """The speed (m/s) a world's time limits assume: its ``robot_speed`` parameter, or that parameter's default
+    (the robot description's, worldgen.scene.robot.MAX_SPEED)."""
+    return params.get("robot_speed", MAX_SPEED)
 
 
 def leaves_on_path(world, path) -> list[str]:

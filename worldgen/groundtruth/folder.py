@@ -28,10 +28,17 @@ from typing import Any, Callable, Mapping, Optional
 
 from worldgen.errors import ParameterError
 from worldgen.files import METADATA_NAME
+from worldgen.floats import round_float
 from worldgen.scene import Robot
-from worldgen.scene.robot import CLIMB_DEFAULTS
+from worldgen.scene.robot import ACCELERATION, CLIMB_DEFAULTS, MAX_SPEED, TURN_RATE, LidarDescription, RobotDescription
 
-__all__ = ["WorldFolder", "open_world", "is_world_folder", "task_of", "robot_of"]
+__all__ = ["WorldFolder", "open_world", "is_world_folder", "task_of", "robot_of", "robot_description_of",
+           "motion_limits_of"]
+
+#: (world.json robot key, parameter, default) of each motion limit: world.json states the limits only in worlds
+#: with people; elsewhere the world's recorded parameter, else the parameter's default, applies.
+_MOTION = (("max_speed", "robot_speed", MAX_SPEED), ("max_turn_rate", "robot_turn_rate", TURN_RATE),
+           ("max_acceleration", "robot_acceleration", ACCELERATION))
 
 
 def is_world_folder(path) -> bool:
@@ -61,6 +68,52 @@ def robot_of(meta: Mapping[str, Any]) -> Robot:
     return Robot(float(r["radius"]), float(r["height"]), float(r["clearance"]), **limits)
 
 
+def robot_description_of(world) -> RobotDescription:
+    """The :class:`~worldgen.scene.robot.RobotDescription` of ``world``: world.json's content (a mapping), or
+    a generated :class:`~worldgen.World` (read off its robot, parameters and lidar without rendering a file,
+    its numbers rounded as world.json rounds them, so both give the same description).
+
+    Motion limits: world.json's ``robot.max_speed``, ``max_turn_rate``, ``max_acceleration`` where present,
+    else the recorded ``params`` (``robot_speed``, ``robot_turn_rate``, ``robot_acceleration``), else those
+    parameters' defaults. The lidar: world.json's ``sensors.lidar``, its height above the first spawn."""
+    if isinstance(world, Mapping):
+        return _described(world)
+    from worldgen.groundtruth.truth import lidar_spec
+
+    spec = lidar_spec(world)
+    robot = world.robot
+    spawn_z = world.tasks[0].spawn.z if world.tasks else 0.0
+    return _described({"robot": {"radius": robot.radius, "height": robot.height, "clearance": robot.clearance,
+                                 **robot.limits()},
+                       "params": {k: round_float(v) if isinstance(v, float) else v for k, v in world.params.items()},
+                       "tasks": [{"spawn": [0.0, 0.0, round_float(spawn_z)]}],
+                       "sensors": {"lidar": {"pose": [round_float(v) for v in spec.pose.as_list()],
+                                             "samples": spec.samples, "angle_min": round_float(spec.angle_min),
+                                             "angle_max": round_float(spec.angle_max),
+                                             "range_min": round_float(spec.range_min),
+                                             "range_max": round_float(spec.range_max)}}})
+
+
+def motion_limits_of(meta: Mapping[str, Any]) -> tuple[float, float, float]:
+    """(max_speed m/s, turn_rate rad/s, acceleration m/s^2) of world.json's content ``meta``: its ``robot``
+    block's, else its ``params``', else the parameters' defaults (a mapping with only ``params``, a
+    generator's resolved parameters, gets those)."""
+    r, params = meta.get("robot") or {}, meta.get("params") or {}
+    speed, turn, acceleration = (float(r.get(key, params.get(name, default))) for key, name, default in _MOTION)
+    return speed, turn, acceleration
+
+
+def _described(meta: Mapping[str, Any]) -> RobotDescription:
+    limits = motion_limits_of(meta)
+    lidar = meta["sensors"]["lidar"]
+    tasks = meta.get("tasks") or []
+    spawn_z = float(tasks[0]["spawn"][2]) if tasks else 0.0
+    mount = LidarDescription(round_float(float(lidar["pose"][2]) - spawn_z), int(lidar["samples"]),
+                             float(lidar["angle_min"]), float(lidar["angle_max"]), float(lidar["range_min"]),
+                             float(lidar["range_max"]))
+    return RobotDescription(robot_of(meta), *limits, mount)
+
+
 class WorldFolder:
     """One written world, read on demand through ``read`` (a file of the world by its relative name).
 
@@ -70,8 +123,10 @@ class WorldFolder:
     """
 
     def __init__(self, read: Callable[[str], bytes], path: Optional[Path] = None, *, label: str,
-                 metadata: Optional[Callable[[], dict]] = None, scene: Any = None):
+                 metadata: Optional[Callable[[], dict]] = None, scene: Any = None,
+                 description: Optional[Callable[[], RobotDescription]] = None):
         self._read = read
+        self._description = description
         self.path = None if path is None else Path(path)
         self.label = label
         self._built = metadata
@@ -135,6 +190,11 @@ class WorldFolder:
     def robot(self) -> Robot:
         """The footprint (world.json ``robot``)."""
         return robot_of(self.metadata)
+
+    @property
+    def robot_description(self) -> RobotDescription:
+        """The robot every simulator builds (:func:`robot_description_of`): footprint, motion limits, lidar."""
+        return self._description() if self._description is not None else robot_description_of(self.metadata)
 
     def file(self, fmt: str) -> Path:
         """Path on disk of the world's file of format key ``fmt`` (``sdf``, ``mjcf``, ``urdf``, ``usd``, ``usdc``,
@@ -202,5 +262,6 @@ def open_world(world, what: str = "parameter 'world'") -> WorldFolder:
     kind = type(world)  # asked of the class: a World's metadata is rendered on first use, not to be looked at
     if hasattr(kind, "metadata") and hasattr(kind, "read") and hasattr(world, "world_id"):  # a World
         return WorldFolder(world.read, getattr(world, "path", None), label=f"world {world.world_id}",
-                           metadata=lambda: world.metadata, scene=getattr(world, "scene", None))
+                           metadata=lambda: world.metadata, scene=getattr(world, "scene", None),
+                           description=lambda: robot_description_of(world))
     raise ParameterError(f"{what} must be a World, a PackWorld or a world folder, got {type(world).__name__}")

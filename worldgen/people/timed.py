@@ -40,6 +40,10 @@ from worldgen.people.behaviours import Tube, tube_of
 from worldgen.people.blocked import free_cells, steps_within
 from worldgen.people.corners import cap_moves, chord_clear, passed_moving
 
+# The default turn rate (rad/s) and acceleration (m/s^2) of a small differential-drive base have one home,
+# the parameters robot_turn_rate and robot_acceleration, read in worldgen.scene.robot (docs/people.md).
+from worldgen.scene.robot import ACCELERATION, TURN_RATE
+
 __all__ = ["DT", "MARGIN", "TRACKING", "SPARE", "TURN_RATE", "ACCELERATION", "MAX_LEVELS", "Limits", "limits_of",
            "TimedPath", "timed_path", "person_speed", "certify", "tube_steps", "turn_angles"]
 
@@ -53,10 +57,6 @@ MARGIN = 0.01
 TRACKING = 0.03
 #: Share of the top speed and of the acceleration the cells leave spare, for the rounding of the rows.
 SPARE = 1e-3
-#: Default turn rate (rad/s) of a small differential-drive base (params.robot_turn_rate, docs/people.md).
-TURN_RATE = 1.0
-#: Default acceleration (m/s^2) of a small differential-drive base (params.robot_acceleration).
-ACCELERATION = 1.0
 #: Most speed levels a step may have: beyond, the cells keep the acceleration and the top speed is not used.
 MAX_LEVELS = 40
 #: Time (s) the sweep goes on after the last person stops, beyond the time the path takes.

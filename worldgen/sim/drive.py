@@ -36,10 +36,11 @@ import numpy as np
 from worldgen.envs.policies import PathFollower, TimedFollower
 from worldgen.errors import OutputError, ParameterError
 from worldgen.groundtruth.folder import WorldFolder, open_world, robot_of
+from worldgen.scene.robot import MAX_SPEED, RobotDescription
 from worldgen.sim.schedule import Plan, plan_for
 
-__all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "TURN_RATE", "CATCH_UP",
-           "TIMED_TURN_RATE", "V_LIMIT", "LAG", "ON_THE_SPOT", "BRAKING", "braked", "RUN_TOPICS", "Outcome", "controller",
+__all__ = ["SIMS", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "STUCK_TURN", "TURN_RATE", "CATCH_UP",
+           "TIMED_TURN_RATE", "LAG", "ON_THE_SPOT", "BRAKING", "braked", "RUN_TOPICS", "Outcome", "controller",
            "drive", "record_run", "run_loop", "steps_per_command"]
 
 #: The topics a simulated run is recorded with (write_run's names), the simulator's own pose (``/ground_truth``)
@@ -47,20 +48,20 @@ __all__ = ["SIMS", "SPEED", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STU
 RUN_TOPICS = ("clock", "odom", "tf", "cmd_vel", "ground_truth")
 #: Simulators ``worldgen drive --sim`` knows.
 SIMS = ("gazebo", "mujoco")
-SPEED = 0.5            # m/s forward
 LOOKAHEAD = 0.3        # m along the path ahead of the robot's projection on it
 #: s between commands: 20 Hz, nav2 controller_server's default controller_frequency.
 CONTROL_PERIOD = 0.05
-#: rad/s, the largest turn rate the controller asks for.
+#: rad/s, the largest turn rate the path follower asks for (the robot's own turn rate where that is lower).
 TURN_RATE = 2.0
 STUCK_SECONDS = 2.0
 STUCK_MOVE = 0.02      # m
-#: On a schedule, the follower may go this many times the schedule's top speed to catch up with it (the
-#: schedule turns its corners on the spot, so a robot that turns at a finite rate falls behind at each).
+#: rad: a robot that turned this much on the spot in STUCK_SECONDS is turning, not stuck (a half turn at the
+#: robot's default 1 rad/s takes 3.1 s).
+STUCK_TURN = 0.1
+#: On a schedule, the follower may go this many times the schedule's top speed to catch up with it, never beyond
+#: the robot's own max_speed.
 CATCH_UP = 1.5
-#: m/s, the fastest the drive ever asks for (the MuJoCo servos' and the bridge's range).
-V_LIMIT = 1.0
-#: rad/s, the turn rate the timed follower may ask for: a quarter turn in 0.2 s, 0.1 m behind a 0.5 m/s schedule.
+#: rad/s, the turn rate the timed follower may ask for (the robot's own turn rate where that is lower).
 TIMED_TURN_RATE = 8.0
 #: m: a robot this close to where its schedule has it is waiting with the schedule, not stuck.
 LAG = 0.1
@@ -96,22 +97,29 @@ def steps_per_command(dt: float) -> int:
     return max(1, round(CONTROL_PERIOD / dt))
 
 
-def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = None, accel: Optional[float] = None
+def controller(plan: Plan, speed: Optional[float] = None, robot: Optional[RobotDescription] = None,
+               turn_accel: Optional[float] = None, accel: Optional[float] = None
                ) -> Callable[[float, float, float, float], tuple[float, float]]:
     """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t the simulator's time, world.json's rows' clock): the environment's
     :class:`~worldgen.envs.policies.TimedFollower` on a schedule (within :data:`CATCH_UP` x its top speed and
-    :data:`TIMED_TURN_RATE`), its :class:`~worldgen.envs.policies.PathFollower` on a path (at ``speed``).
+    :data:`TIMED_TURN_RATE`), its :class:`~worldgen.envs.policies.PathFollower` on a path (at ``speed``, default
+    the plan's); never beyond ``robot``'s max_speed and turn rate where a robot description is given.
 
     ``turn_accel`` (rad/s^2; None: the turn rate is taken at once, as MuJoCo's servos take it) is how fast the
     robot's turn rate can change: on a schedule every turn is then asked no faster than lets the robot stop
     turning on the heading it aims at (:func:`braked`); ``accel`` (m/s^2) likewise its speed, asked no faster
     than lets it stop where the schedule next stands still (a wait, the goal)."""
+    v_cap, w_cap = (robot.max_speed, robot.turn_rate) if robot is not None else (math.inf, math.inf)
+    turn = min(TIMED_TURN_RATE, w_cap)
     if plan.rows is not None:
-        timed = TimedFollower(plan.rows, v_max=min(CATCH_UP * plan.speed, V_LIMIT), w_max=TIMED_TURN_RATE,
-                              period=CONTROL_PERIOD)
+        timed = TimedFollower(plan.rows, v_max=min(CATCH_UP * plan.speed, v_cap), w_max=turn, period=CONTROL_PERIOD)
         rows = plan.rows
         step = np.hypot(*np.diff(rows[:, 1:], axis=0).T)
-        stops = np.append(np.flatnonzero(step < 1e-6), len(rows) - 1)  # rows the schedule stands still from
+        waits = np.flatnonzero(step < 1e-6)
+        # Where the schedule stands still (each wait, then the goal) and until when: a robot behind its schedule
+        # brakes for a wait until the wait is over, not only until it starts.
+        stops = np.append(waits, len(rows) - 1)
+        until = np.append(rows[waits + 1, 0], rows[-1, 0])
 
         def act(t: float, x: float, y: float, yaw: float) -> tuple[float, float]:
             dx, dy = timed.at(t + CONTROL_PERIOD) - (x, y)
@@ -119,7 +127,7 @@ def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = N
                 v, w = (float(a) for a in timed.action(x, y, yaw, t))
                 err = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi  # what the follower aims at
                 if accel is not None:
-                    stop = rows[stops[np.searchsorted(rows[stops, 0], t)] if t <= rows[-1, 0] else -1, 1:]
+                    stop = rows[stops[np.searchsorted(until, t)] if t <= rows[-1, 0] else -1, 1:]
                     v = braked(v, float(np.hypot(*(stop - (x, y)))), accel)
                 return v, braked(w, err, turn_accel)
             # Where the schedule waits (or the goal): stand, facing where it goes next, so that setting off costs
@@ -128,10 +136,11 @@ def controller(plan: Plan, speed: float = SPEED, turn_accel: Optional[float] = N
             if not len(ahead):
                 return 0.0, 0.0
             err = (math.atan2(ahead[0, 2] - y, ahead[0, 1] - x) - yaw + math.pi) % (2.0 * math.pi) - math.pi
-            return 0.0, braked(float(np.clip(err / CONTROL_PERIOD, -TIMED_TURN_RATE, TIMED_TURN_RATE)), err, turn_accel)
+            return 0.0, braked(float(np.clip(err / CONTROL_PERIOD, -turn, turn)), err, turn_accel)
 
         return act
-    pursuit = PathFollower(plan.waypoints.tolist(), v_max=speed, w_max=TURN_RATE, lookahead=LOOKAHEAD)
+    pursuit = PathFollower(plan.waypoints.tolist(), v_max=min(plan.speed if speed is None else speed, v_cap),
+                           w_max=min(TURN_RATE, w_cap), lookahead=LOOKAHEAD)
     # tuple() of a generator is typed tuple[float, ...]; the follower's action is always (v, w)
     return lambda t, x, y, yaw: tuple(float(a) for a in pursuit.action(x, y, yaw))  # type: ignore[return-value]
 
@@ -151,30 +160,32 @@ def braked(w: float, err: float, turn_accel: Optional[float]) -> float:
     return math.copysign(min(abs(w), math.sqrt(2.0 * BRAKING * turn_accel * abs(err))), w)
 
 
-def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
-             plan: Optional[Plan] = None) -> tuple[np.ndarray, np.ndarray, str]:
+def run_loop(backend, task: dict, straight: bool = False, speed: float = MAX_SPEED,
+             plan: Optional[Plan] = None, robot: Optional[RobotDescription] = None) -> tuple[np.ndarray, np.ndarray, str]:
     """Drive ``task`` in a started-or-not ``backend``: the (n, 4) trajectory, (m, 3) commands and why it ended.
 
-    ``plan`` (default: the static path, or spawn -> goal when ``straight``) says what to follow. On a
+    ``plan`` (default: the static path, or spawn -> goal when ``straight``, at ``speed``) says what to follow;
+    ``robot`` (the world's robot description) bounds what the controller asks. On a
     schedule the robot is stuck only when it stands while the schedule has it more than :data:`LAG` away:
     waiting where the schedule waits is no sign of being stuck."""
     spawn, goal = task["spawn"], np.asarray(task["goal"][:2], dtype=float)
     if plan is None:
         plan = Plan("straight" if straight else "static",
                     np.asarray([spawn[:2], goal] if straight else task["path"]["waypoints"], dtype=float), speed)
-    act = controller(plan, speed, getattr(backend, "turn_accel", None), getattr(backend, "accel", None))
+    act = controller(plan, speed, robot, getattr(backend, "turn_accel", None), getattr(backend, "accel", None))
     give_way = getattr(backend, "give_way", None)
     t, x, y, yaw = backend.start((spawn[0], spawn[1], spawn[2], spawn[5]))
     per = steps_per_command(backend.dt)
     limit = t + float(task["time_limit"])
     rows, commands = [(t, x, y, yaw)], []
-    still_since, still_at, ended = t, (x, y), "time_limit"
+    still_since, still_at, still_yaw, ended = t, (x, y), yaw, "time_limit"
     while t < limit:
         if math.hypot(x - goal[0], y - goal[1]) < float(task["goal_tolerance"]) / 2:
             ended = "goal"
             break
-        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE or _on_schedule(plan, t, x, y):
-            still_since, still_at = t, (x, y)
+        if math.hypot(x - still_at[0], y - still_at[1]) > STUCK_MOVE or abs(_turned(yaw, still_yaw)) > STUCK_TURN \
+                or _on_schedule(plan, t, x, y):
+            still_since, still_at, still_yaw = t, (x, y), yaw
         elif t - still_since > STUCK_SECONDS:
             ended = "stuck"
             break
@@ -188,6 +199,11 @@ def run_loop(backend, task: dict, straight: bool = False, speed: float = SPEED,
         rows.append((t, x, y, yaw))
     commands.append((t, 0.0, 0.0))  # told to stop
     return np.array(rows), np.array(commands), ended
+
+
+def _turned(yaw: float, before: float) -> float:
+    """The turn (rad, in [-pi, pi)) from heading ``before`` to ``yaw``."""
+    return (yaw - before + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def _on_schedule(plan: Plan, t: float, x: float, y: float) -> bool:
@@ -206,7 +222,7 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None, pla
         people = meta.get("people") or []
         return MujocoBackend(world.file_bytes("mjcf"), meta,
                              _scene_of(world) if any(p.get("behaviour") for p in people) else None)
-    from worldgen.export.robot import WHEEL_ACCELERATION, dimensions, robot_sdf
+    from worldgen.export.robot import dimensions, robot_sdf
     from worldgen.sim.bridge import GazeboBackend, world_step
     from worldgen.sim.gazebo_install import locate
 
@@ -219,8 +235,10 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None, pla
     # The robot is written for the release that runs it: its plugins' names are that release's.
     install = locate(release=gz_release)
     robot = robot_sdf(meta, gz_release=install.release.name, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
-    # The DiffDrive changes its wheels' speed at most WHEEL_ACCELERATION: its turn rate at that over half the track.
-    turn_accel = WHEEL_ACCELERATION / (dimensions(meta).wheel_separation / 2.0)
+    # The DiffDrive changes its speed at most the robot's acceleration (worldgen.export.robot), its turn rate at
+    # that over half the track (a wheel's rim).
+    accel = world.robot_description.acceleration
+    turn_accel = accel / (dimensions(meta).wheel_separation / 2.0)
     # The pull doors on the plan's way get a joint controller in a copy of the world (worldgen.sim.gazebo_doors);
     # a build without the system refuses here, before anything starts.
     from worldgen.sim.gazebo_doors import GazeboDoors, plan_points, pulled_doors, world_with_openers
@@ -233,7 +251,7 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None, pla
         doors = GazeboDoors(pulled, robot_of(meta).radius, _room_behind(world))
         backend = GazeboBackend(sdf, robot, dt=dt, first_steps=per, install=install, world_text=text,
                                 doors=doors, door_topics=tuple(topics))
-    backend.turn_accel, backend.accel = turn_accel, WHEEL_ACCELERATION
+    backend.turn_accel, backend.accel = turn_accel, accel
     return backend
 
 
@@ -256,8 +274,12 @@ def _room_behind(world: WorldFolder) -> Callable[[float, float, float, float], b
 
 
 def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straight: bool = False,
-          speed: float = SPEED, gz_release: Optional[str] = None) -> Outcome:
+          speed: Optional[float] = None, gz_release: Optional[str] = None) -> Outcome:
     """Drive ``world`` in ``sim``, write the bag into the new folder ``out``/<bag name>, judge it.
+
+    The robot is the world's robot description (``open_world(world).robot_description``: world.json's
+    ``robot`` and ``sensors.lidar``), in MuJoCo as in Gazebo; ``speed`` (m/s) is the static path's, at most the
+    robot's ``max_speed`` (default: that); a schedule runs at the robot's ``max_speed``.
 
     ``world`` is a world folder, a :class:`~worldgen.World` or a pack's world (read through
     :func:`worldgen.groundtruth.folder.open_world`); Gazebo loads world.sdf from disk, so there it must
@@ -269,10 +291,14 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
         raise ParameterError(f"option '--sim' must be one of {', '.join(SIMS)}, got {sim!r}")
     if gz_release is not None and sim != "gazebo":
         raise ParameterError(f"option '--gz-release' {gz_release} names a Gazebo release: add --sim gazebo")
-    if not (0 < speed <= 2.0):
-        raise ParameterError(f"option '--speed' must be in (0, 2] m/s, got {speed!r}")
     opened = open_world(world, "argument WORLD")
     meta = opened.metadata
+    robot = opened.robot_description
+    if speed is None:
+        speed = robot.max_speed
+    if not (0 < speed <= robot.max_speed):
+        raise ParameterError(f"option '--speed' must be in (0, {robot.max_speed:g}] m/s (the world's robot's "
+                             f"max_speed), got {speed!r}")
     chosen = opened.task(task, "option '--task'")
     # The bag is named as the judge names the run, <world_id>__<task>__<run>; the run part names only what
     # differs between drives of one task (the simulator, the straight hook), never the world again.
@@ -288,7 +314,7 @@ def drive(world, out, *, sim: str = "mujoco", task: Optional[str] = None, straig
     wall["plan"] = time.perf_counter() - started
     backend = _backend(sim, opened, gz_release, plan)
     try:
-        trajectory, commands, ended = run_loop(backend, chosen, straight, speed, plan)
+        trajectory, commands, ended = run_loop(backend, chosen, straight, speed, plan, robot)
     finally:
         backend.close()
     wall["drive"] = time.perf_counter() - started - wall["plan"]

@@ -1,5 +1,8 @@
 """The robot in MuJoCo, as the drive loop steps it: the environment's differential-drive body
-(:mod:`worldgen.envs.robot`) added to a world folder's MJCF, with real contacts against walls, obstacles,
+(:mod:`worldgen.envs.robot`) built from the world's robot description (world.json's ``robot`` and
+``sensors.lidar`` through :func:`worldgen.groundtruth.folder.robot_description_of`: its size and mass, its
+servos' ranges its ``max_speed`` forward and back and its ``turn_rate``, as robot.sdf's DiffDrive limits
+them in Gazebo) added to a world folder's MJCF, with real contacts against walls, obstacles,
 door leaves, movers and people, everything that moves driven as the environment drives it:
 
 - movers (world.json ``dynamic_obstacles``) and impassive people walk their scripts (mocap bodies placed
@@ -33,15 +36,12 @@ from worldgen.envs.reacting import Walkers
 from worldgen.envs.robot import compile_world
 from worldgen.envs.terrain import add_base, settle
 from worldgen.export.xml import safe_parser
-from worldgen.groundtruth.folder import robot_of
+from worldgen.groundtruth.folder import robot_description_of
 from worldgen.judge.figures import DOOR_DEBOUNCE
 
-__all__ = ["MujocoBackend", "V_RANGE", "W_MAX", "DOOR_MODE", "DOOR_TRIGGER", "DOOR_SPEED", "GIVE_WAY", "BACK_OFF",
+__all__ = ["MujocoBackend", "DOOR_MODE", "DOOR_TRIGGER", "DOOR_SPEED", "GIVE_WAY", "BACK_OFF",
            "OPEN_WITHIN", "movers_of"]
 
-#: The servos' limits: forward speed (m/s) and turn rate (rad/s), beyond anything the controller asks.
-V_RANGE = (-1.0, 1.0)
-W_MAX = 10.0
 _DEFAULTS = {p.name: p.default for p in SETTINGS}
 #: m beyond a leaf's sweep (its width, plus the robot's radius) the robot keeps while the leaf swings open.
 GIVE_WAY = 0.05
@@ -70,10 +70,12 @@ class MujocoBackend:
 
     def __init__(self, mjcf: Union[bytes, Path], meta: dict, scene: Any = None):
         root = etree.fromstring(mjcf if isinstance(mjcf, bytes) else Path(mjcf).read_bytes(), safe_parser())
-        self.robot = robot_of(meta)
+        #: The robot driven (world.json's, worldgen.scene.robot.RobotDescription) and its footprint.
+        self.description = robot = robot_description_of(meta)
+        self.robot = robot.footprint
         #: Whether the world has terrain: then the robot is the terrain base (worldgen.envs.terrain).
         self.terrain = bool(meta.get("terrain"))
-        self._floor = add_base(root, self.robot, V_RANGE, W_MAX, self.terrain,
+        self._floor = add_base(root, self.robot, (-robot.max_speed, robot.max_speed), robot.turn_rate, self.terrain,
                                {e["name"] for e in meta["entities"] if e["role"] == "floor"})
         self._centre = 0.0
         self._doors = list(meta.get("doors") or [])
