@@ -322,10 +322,10 @@ def test_a_timed_path_that_sets_off_before_turning_from_the_spawn_fails_timed(am
     _fails(capsys, folder, "timed", "timed_path turns", "after standing", "faster than robot.max_turn_rate 1 rad/s")
 
 
-def test_corners_passed_on_the_move_are_re_proved_and_need_their_chord_clear(among_people):
+def test_corners_passed_on_the_move_are_re_proved_and_need_their_arc_clear(among_people):
     """The cluttered world's timed path passes small corners without stopping: worldgen check re-derives each
     arc from the recorded path (test_worlds_among_people_pass_timed passes it); with a robot 1 mm wider in
-    clearance the chords are no longer clear, those corners count as turns without a stand, and fail."""
+    clearance the arcs are no longer clear, those corners count as turns without a stand, and fail."""
     import dataclasses
 
     import numpy as np

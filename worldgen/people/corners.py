@@ -11,9 +11,11 @@ is then never farther from the schedule than ``rho (sec(theta / 2) - 1)`` (reach
 the schedule is at the corner and the robot at the arc's middle; before and after, both the sideways and
 the along-the-way distance are smaller), at most :data:`CUT`: the certificate keeps that much more from
 every person near the corner (the largest arc's, whichever is driven), and the static clearance is
-re-proved for the chord between the arc's ends (the arc lies in the triangle of that chord and the two
-pieces of leg, whose legs were proved already); where the chord is not clear, a smaller arc (:data:`SHRINK`)
-is tried.
+re-proved for the arc itself: FCL sweeps the robot along :data:`ARC_PIECES` chords inscribed in it, each
+keeping the clearance plus the most the arc bulges beyond its chord (``rho (1 - cos(theta / 2n))``, some
+0.1 mm), so every point of the arc keeps the clearance. Where it does not, a smaller arc (:data:`SHRINK`) is
+tried. (One chord between the arc's ends, nearer the inside of the turn than the arc by up to 0.6 mm, cost
+crowd_reacting its gap: issue 37.)
 
 ``rho`` is the smaller of ``v / omega`` (the arc a robot at top speed turns) and the radius whose arc strays
 :data:`CUT` from the waypoint, made smaller still where the reaches of two neighbouring candidates (every
@@ -28,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["CUT", "CUT_ANGLE", "SHRINK", "Cut", "cuts", "passed_moving", "cap_moves", "chord_clear"]
+__all__ = ["CUT", "CUT_ANGLE", "SHRINK", "ARC_PIECES", "Cut", "cuts", "passed_moving", "cap_moves", "arc_polyline",
+           "arc_clear"]
 
 #: The most (m) the robot may be off its schedule through a corner it passes moving.
 CUT = 0.005
@@ -37,6 +40,8 @@ CUT_ANGLE = 0.3
 #: The shares of a corner's largest arc tried, in turn, until one's chord is clear (a smaller arc strays
 #: less into the corner, and is driven slower).
 SHRINK = (1.0, 0.5, 0.25, 0.125)
+#: The chords an arc is proved clear along.
+ARC_PIECES = 8
 
 
 @dataclass(frozen=True)
@@ -94,7 +99,7 @@ def passed_moving(w: np.ndarray, max_speed: float, turn_rate: float, leg_ds: np.
                   dt: float) -> dict:
     """The corners passed on the move (waypoint index: (the :class:`Cut` driven, the
     largest arc's ``dev``)): the first arc of :data:`SHRINK` whose chord ``clear``
-    finds clear, while it allows at least one cell (``leg_ds``, m) a step of ``dt`` s on both legs."""
+    (:func:`arc_clear`) finds clear, while it allows at least one cell (``leg_ds``, m) a step of ``dt`` s on both legs."""
     if clear is None:
         return {}
     out = {}
@@ -103,7 +108,7 @@ def passed_moving(w: np.ndarray, max_speed: float, turn_rate: float, leg_ds: np.
             cut = largest.scaled(share, w[j])
             if max(leg_ds[j - 1], leg_ds[j]) > cut.speed * dt:
                 break  # slower than a cell a step on a leg: turned on the spot
-            if clear(np.array(cut.a), np.array(cut.b)):
+            if clear(cut, w[j]):
                 out[j] = (cut, largest.dev)
                 break
     return out
@@ -125,19 +130,34 @@ def cap_moves(ok: np.ndarray, s: np.ndarray, corner: np.ndarray, leg_ds: np.ndar
         ok[c, u] &= ~(near & (u * cell > cut.speed * dt))
 
 
-def chord_clear(scene, robot):
-    """A function of two points: whether the robot's disc swept between them keeps ``robot.clearance`` (and
-    1e-5 m more, for world.json's 6-decimal waypoints) from the scene's static geometry, doors open, by FCL
-    as the static path was proven (the colliders built at the first call)."""
+def arc_polyline(a, corner, b, rho: float, pieces: int = ARC_PIECES) -> tuple[np.ndarray, float]:
+    """The arc of radius ``rho`` from ``a`` (on the leg into ``corner``) to ``b`` (on the leg out of it), tangent
+    to both, as ``pieces + 1`` points on it, and how far (m) the arc bulges beyond each of their chords."""
+    a, v, b = (np.asarray(p, dtype=float) for p in (a, corner, b))
+    t1, t2 = (v - a) / np.hypot(*(v - a)), (b - v) / np.hypot(*(b - v))
+    side = 1.0 if t1[0] * t2[1] - t1[1] * t2[0] >= 0.0 else -1.0  # the turn's sense: left +1, right -1
+    theta = math.atan2(abs(t1[0] * t2[1] - t1[1] * t2[0]), float(t1 @ t2))
+    centre = a + rho * side * np.array([-t1[1], t1[0]])
+    phi = side * theta * np.arange(pieces + 1) / pieces
+    r = a - centre
+    points = centre + np.stack([r[0] * np.cos(phi) - r[1] * np.sin(phi), r[0] * np.sin(phi) + r[1] * np.cos(phi)], 1)
+    return points, rho * (1.0 - math.cos(theta / (2 * pieces)))
+
+
+def arc_clear(scene, robot):
+    """A function of a :class:`Cut` and its corner (x, y): whether the robot's disc swept along the cut's arc
+    keeps ``robot.clearance`` (and 1e-5 m more, for world.json's 6-decimal waypoints) from the scene's static
+    geometry, doors open, by FCL as the static path was proven (the colliders built at the first call)."""
     built: list = []
 
-    def clear(a: np.ndarray, b: np.ndarray) -> bool:
+    def clear(cut: Cut, corner) -> bool:
         from worldgen.feasibility.collision import Colliders
         from worldgen.feasibility.verify import verify_path
         from worldgen.scene.doors import open_scene
 
         if not built:
             built.append(Colliders(open_scene(scene)))
-        return bool(verify_path(built[0], robot, np.array([a, b])).distance >= robot.clearance + 1e-5)
+        points, bulge = arc_polyline(cut.a, corner, cut.b, cut.rho)
+        return bool(verify_path(built[0], robot, points).distance >= robot.clearance + 1e-5 + bulge)
 
     return clear

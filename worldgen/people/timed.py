@@ -38,7 +38,7 @@ import numpy as np
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.people.behaviours import Tube, tube_of
 from worldgen.people.blocked import free_cells, steps_within
-from worldgen.people.corners import cap_moves, chord_clear, passed_moving
+from worldgen.people.corners import arc_clear, cap_moves, passed_moving
 
 # The default turn rate (rad/s) and acceleration (m/s^2) of a small differential-drive base have one home,
 # the parameters robot_turn_rate and robot_acceleration, read in worldgen.scene.robot (docs/people.md).
@@ -126,9 +126,9 @@ def timed_path(waypoints: np.ndarray, tracks: Sequence[np.ndarray], radii: Seque
     ``tubes`` (one per person, default the recorded line): the robot keeps clear of the whole tube, every
     recorded position from ``t - tau`` to ``t + tau`` widened by ``d`` (:func:`worldgen.people.blocked.free_cells`).
 
-    ``clear`` (a function of two points, True where the robot's disc along the segment between them keeps
-    its clearance from the static geometry): with it, small corners whose arc's chord is clear are passed
-    on the move (:mod:`worldgen.people.corners`); without it every corner is turned on the spot."""
+    ``clear`` (a function of a corner's arc and the corner, True where the robot's disc along the arc keeps
+    its clearance from the static geometry, :func:`worldgen.people.corners.arc_clear`): with it, small corners
+    whose arc is clear are passed on the move; without it every corner is turned on the spot."""
     lim = limits if isinstance(limits, Limits) else Limits(float(limits))
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
     if len(w) == 1:
@@ -325,7 +325,7 @@ def certify(report: FeasibilityReport, scene, tasks, robot, limits,
     if behaviours is not None:
         reacting = iter(tube_of(b) for b in behaviours)
         tubes = [next(reacting) if m.person else Tube(0.0, 0.0) for m in agents]
-    clear = chord_clear(scene, robot)
+    clear = arc_clear(scene, robot)
     found, missing = [], []
     for task, path in zip(tasks, report.paths):
         timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, lim, tubes,

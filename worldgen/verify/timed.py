@@ -28,10 +28,10 @@ by an angle (at the spawn from the spawn's yaw) the robot stands at least that a
 ``max_turn_rate`` in between (:data:`TURN_SLACK` rad forgiven for the rounding of the rows); and every
 distance above is kept with ``tracking_margin`` more. A turn of at most ``CUT_ANGLE`` at a waypoint the rows
 pass through needs no stand where it is a corner passed moving (docs/people.md): the arc tangent to both
-legs is re-derived here from the recorded path and limits (or one of its ``SHRINK`` shares), its chord must
-keep the clearance by FCL, the rows within its reach of the waypoint must be no faster than its radius times
-``max_turn_rate``, and while the schedule is within that reach every person is kept the largest arc's
-deviation farther.
+legs is re-derived here from the recorded path and limits (or one of its ``SHRINK`` shares), the arc must
+keep the clearance by FCL (along its inscribed chords, with its bulge beyond them), the rows within its
+reach of the waypoint must be no faster than its radius times ``max_turn_rate``, and while the schedule
+is within that reach every person is kept the largest arc's deviation farther.
 """
 
 from __future__ import annotations
@@ -252,11 +252,12 @@ def _drivable(task: dict, rows: np.ndarray, turn_rate: float, acceleration: floa
 def _moving(task: dict, rows: np.ndarray, robot: dict, colliders, body) -> list:
     """The corners the rows pass on the move, each (row index, waypoint, (reach, deviation)) of its largest
     arc (docs/people.md, "Corners passed moving"), re-derived from the recorded path: a turn of at most
-    CUT_ANGLE at a waypoint the rows pass through without standing, some arc of SHRINK's whose chord keeps
-    the clearance (FCL, ``body`` the robot) and whose rows within its reach of the waypoint are no faster than
-    its radius times ``robot.max_turn_rate``. A turn there that fits no arc is left to :func:`_drivable`."""
+    CUT_ANGLE at a waypoint the rows pass through without standing, some arc of SHRINK's that keeps the
+    clearance (FCL along its inscribed chords, each keeping the arc's bulge beyond it more; ``body`` the
+    robot) and whose rows within its reach of the waypoint are no faster than its radius times
+    ``robot.max_turn_rate``. A turn there that fits no arc is left to :func:`_drivable`."""
     from worldgen.feasibility.verify import verify_path
-    from worldgen.people.corners import CUT, CUT_ANGLE, SHRINK
+    from worldgen.people.corners import CUT, CUT_ANGLE, SHRINK, arc_polyline
 
     wp = np.asarray(task["path"]["waypoints"], dtype=float).reshape(-1, 2)
     if len(wp) < 3:
@@ -284,8 +285,9 @@ def _moving(task: dict, rows: np.ndarray, robot: dict, colliders, body) -> list:
             reach, cap = ell * share, rho * share * omega
             a, b = wp[j] - d[j - 1] / legs[j - 1] * reach, wp[j] + d[j] / legs[j] * reach
             near = _seg_dist(wp[j], rows[:-1, 1:], rows[1:, 1:]) <= reach
+            points, bulge = arc_polyline(a, wp[j], b, rho * share)
             if np.all(speed[near] <= cap * (1 + 1e-6) + 2e-6 / np.diff(rows[:, 0])[near]) and \
-                    verify_path(colliders, body, np.array([a, b])).distance >= body.clearance - 1e-6:
+                    verify_path(colliders, body, points).distance >= body.clearance + bulge - 1e-6:
                 out.append((int(at[0]), wp[j], (float(ell), float(rho * (1 / np.cos(half[j]) - 1)))))
                 break
     return out
