@@ -12,10 +12,10 @@ the schedule is at the corner and the robot at the arc's middle; before and afte
 the along-the-way distance are smaller), at most :data:`CUT`: the certificate keeps that much more from
 every person near the corner (the largest arc's, whichever is driven), and the static clearance is
 re-proved for the arc itself: FCL sweeps the robot along :data:`ARC_PIECES` chords inscribed in it, each
-keeping the clearance plus the most the arc bulges beyond its chord (``rho (1 - cos(theta / 2n))``, some
-0.1 mm), so every point of the arc keeps the clearance. Where it does not, a smaller arc (:data:`SHRINK`) is
-tried. (One chord between the arc's ends, nearer the inside of the turn than the arc by up to 0.6 mm, cost
-crowd_reacting its gap: issue 37.)
+keeping the clearance plus the most the arc bulges beyond its chord (``rho (1 - cos(theta / 2n))``, 0.09
+mm for a 0.3 rad turn on a 0.5 m arc), so every point of the arc keeps the clearance. Where it does not, a
+smaller arc (:data:`SHRINK`) is tried. (One chord between the arc's ends, nearer the inside of the turn
+than the arc by up to 0.6 mm, cost crowd_reacting its gap: issue 37.)
 
 ``rho`` is the smaller of ``v / omega`` (the arc a robot at top speed turns) and the radius whose arc strays
 :data:`CUT` from the waypoint, made smaller still where the reaches of two neighbouring candidates (every
