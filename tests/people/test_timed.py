@@ -524,3 +524,6 @@ def test_an_arc_is_proved_along_chords_that_bulge_no_more_than_stated(turn):
     u = np.clip(np.einsum("kij,ij->ki", dense[:, None] - seg_a, ab) / np.einsum("ij,ij->i", ab, ab), 0, 1)
     far = np.hypot(*(seg_a + u[..., None] * ab - dense[:, None]).transpose(2, 0, 1)).min(axis=1)
     assert far.max() <= bulge * (1 + 1e-9)
+    # A turn so small that the arc's ends round onto the corner: the arc is that point (no NaN from its tangents).
+    tiny, _ = arc_polyline(corner, corner, corner + 1e-13, rho)
+    assert np.isfinite(tiny).all() and len(tiny) == 2

@@ -134,6 +134,8 @@ def arc_polyline(a, corner, b, rho: float, pieces: int = ARC_PIECES) -> tuple[np
     """The arc of radius ``rho`` from ``a`` (on the leg into ``corner``) to ``b`` (on the leg out of it), tangent
     to both, as ``pieces + 1`` points on it, and how far (m) the arc bulges beyond each of their chords."""
     a, v, b = (np.asarray(p, dtype=float) for p in (a, corner, b))
+    if min(np.hypot(*(v - a)), np.hypot(*(b - v))) < 1e-12:  # a turn of 1e-8 rad: its arc a point
+        return np.array([a, b]), 0.0
     t1, t2 = (v - a) / np.hypot(*(v - a)), (b - v) / np.hypot(*(b - v))
     side = 1.0 if t1[0] * t2[1] - t1[1] * t2[0] >= 0.0 else -1.0  # the turn's sense: left +1, right -1
     theta = math.atan2(abs(t1[0] * t2[1] - t1[1] * t2[0]), float(t1 @ t2))
