@@ -85,8 +85,9 @@ class Dimensions:
         self.radius, self.height, self.lidar_height = radius, height, lidar_height
         self.wheel_radius = min(0.05, height / 4.0, radius / 4.0)
         self.wheel_width = 0.8 * self.wheel_radius
-        # Each wheel's outer face sits at 0.9 r: the wheels stay inside the footprint cylinder.
-        self.wheel_separation = 2.0 * (0.9 * radius - self.wheel_width / 2.0)
+        # A wheel touches the floor as the sphere of its radius (_sdf_links), which reaches 0.9 r from the centre:
+        # the wheels stay inside the footprint cylinder.
+        self.wheel_separation = 2.0 * (0.9 * radius - self.wheel_radius)
         self.caster_radius = self.wheel_radius / 2.0
         self.caster_x = radius - 1.5 * self.caster_radius
         # The chassis' collision spans [caster radius, height] above the floor: only wheels and casters touch it.
@@ -183,7 +184,11 @@ def _sdf_links(model, d: Dimensions) -> None:
         sub(link, "pose", fmt_seq((xyz[0], xyz[1], xyz[2] + d.wheel_radius, roll, 0, 0)))
         diag = _inertia_cylinder(mass, shape[1], shape[2]) if shape[0] == "cylinder" else (0.4 * mass * shape[1] ** 2,) * 3
         _sdf_inertial(link, mass, diag)
-        _sdf_shape(link, "collision", "collision", shape, "0 0 0 0 0 0", mu)
+        # A wheel touches the floor as the sphere of its radius: DART (Fortress and Harmonic alike) touched a lying
+        # cylinder at one end of its width, the same end for both wheels, and the robot turned on the spot about a
+        # point 2 cm (half a wheel's width) to one side of its centre (docs/drive.md, barn seed 22).
+        touching = ("sphere", shape[1]) if shape[0] == "cylinder" else shape
+        _sdf_shape(link, "collision", "collision", touching, "0 0 0 0 0 0", mu)
         _sdf_shape(link, "visual", "visual", shape, "0 0 0 0 0 0")
         j = sub(model, "joint", name=f"{name}_joint", type=joint)
         sub(j, "parent", "base_link")
