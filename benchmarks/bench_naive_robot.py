@@ -9,9 +9,9 @@ task and places, except that a reacting person's places keep the wider spawn and
 asks for, docs/people.md). In each, :class:`worldgen.envs.policies.PathFollower` drives the task's static
 path (world.json ``tasks[].path``) at the environment's top speed, the world's robot's own (its
 ``robot.max_speed`` 0.5 m/s and turn rate 1 rad/s; before the environment's robot was the world's it was
-1 m/s whatever the world), in the Gymnasium environment with ``terminate_on_collision=False``, so a contact does not end the run: the
-robot drives on until the goal or the time limit. Counted per behaviour: the people touched (distinct per
-run), the contacts (each first touch after a gap), the runs that reached the goal, and for the regular
+1 m/s whatever the world), in the Gymnasium environment with ``terminate_on_collision=False``, so a contact
+does not end the run: the robot drives on until the goal or the time limit. Counted per behaviour: the people
+touched (distinct per run), the contacts (each first touch after a gap), the runs that reached the goal, and for the regular
 people the steps their tube clipped a reaction (``info["people_clips"]``) in all and among the people
 touched.
 

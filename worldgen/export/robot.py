@@ -1,7 +1,9 @@
-"""A differential-drive robot sized to a world's footprint: ``robot.sdf`` for Gazebo, ``robot.urdf`` for ROS.
+"""A differential-drive robot sized to a world's footprint: ``robot.sdf`` for Gazebo, and the parts
+``robot.urdf`` for ROS shares with it (:mod:`worldgen.export.robot_urdf` writes that).
 
     >>> import worldgen
-    >>> from worldgen.export.robot import robot_sdf, robot_urdf
+    >>> from worldgen.export.robot import robot_sdf
+    >>> from worldgen.export.robot_urdf import robot_urdf
     >>> world = worldgen.generate("cluttered", seed=0, size=[6, 6], n_obstacles=4)
     >>> sdf = robot_sdf(world)                       # spawn it with Gazebo's create service
     >>> '<model name="robot">' in sdf, "<topic>cmd_vel</topic>" in sdf
@@ -34,6 +36,7 @@ puts it; the chassis' visual leaves a window around its plane so the lidar never
 
 The URDF is the same tree for robot_state_publisher and RViz (links, joints, inertias,
 geometry); Gazebo spawns the SDF. Both are bytes-stable: same world and arguments, same text.
+(``robot_urdf``, ``Dimensions`` and ``dimensions`` are still importable from here.)
 """
 
 from __future__ import annotations
@@ -45,16 +48,15 @@ from lxml import etree
 
 from worldgen.errors import ParameterError
 from worldgen.export.contract import CMD_VEL, DEFAULT_GZ_RELEASE, GROUND_TRUTH, IMU, JOINT_STATES, ODOM, SCAN, TF, release
+from worldgen.export.robot_body import COLOUR, DEFAULT_NAME, Dimensions, chassis, described, dimensions, inertia_cylinder, parts
+from worldgen.export.robot_urdf import robot_urdf
 from worldgen.export.xml import sub, to_bytes
 from worldgen.floats import fmt, fmt_seq
-from worldgen.groundtruth.folder import robot_description_of
 from worldgen.scene.robot import LidarDescription, RobotDescription
 
 __all__ = ["DEFAULT_NAME", "SENSOR_FRAME_ELEMENT", "LIDAR_WINDOW", "CASTER_SPRING", "CASTER_DAMPING", "CASTER_TRAVEL",
            "CASTER_PRELOAD", "Dimensions", "dimensions", "robot_sdf", "robot_urdf"]
 
-#: The model's name: the ROS 2 bundle's robot (worldgen.export.ros2.DEFAULT_ROBOT_NAME).
-DEFAULT_NAME = "robot"
 #: The element Gazebo's sensors take their message frame from. Without it a scan's frame is the scoped
 #: sensor name (``robot::base_scan::lidar``, measured in Fortress 6.18), a frame no URDF has, and AMCL and
 #: the costmaps drop the scans. ``gz_frame_id`` is read by Fortress 6.18's ign-sensors (beside its older
@@ -67,9 +69,6 @@ SENSOR_FRAME_ELEMENT = "gz_frame_id"
 #: renders is visuals, and SDFormat 1.9 has no visibility mask for a lidar, so the window keeps the
 #: robot out of its own scan (the collision cylinder is whole).
 LIDAR_WINDOW = 0.01
-# The wheels' and casters' own masses (kg), beside the chassis' (the description's mass).
-_WHEEL_KG, _CASTER_KG = 0.5, 0.2
-_COLOUR = "0.95 0.45 0.1 1"
 #: On terrain only, the casters' suspension: stiffness (N/m), damping (N s/m), travel either way and
 #: preload (m, how far below the wheels' ground the spring would rest). Stiff enough that the body pitches
 #: a few degrees under the DiffDrive's acceleration, soft enough that a caster lifted 2 cm by a ramp's
@@ -77,45 +76,11 @@ _COLOUR = "0.95 0.45 0.1 1"
 CASTER_SPRING, CASTER_DAMPING, CASTER_TRAVEL, CASTER_PRELOAD = 5000.0, 100.0, 0.03, 0.003
 
 
-class Dimensions:
-    """Every length of the robot, m, from the footprint (radius, height) and the lidar's height."""
-
-    def __init__(self, radius: float, height: float, lidar_height: float):
-        if not (radius > 0 and height > 0 and math.isfinite(radius) and math.isfinite(height)):
-            raise ParameterError(f"robot radius and height must be finite and > 0, got {radius!r}, {height!r}")
-        self.radius, self.height, self.lidar_height = radius, height, lidar_height
-        self.wheel_radius = min(0.05, height / 4.0, radius / 4.0)
-        self.wheel_width = 0.8 * self.wheel_radius
-        # Each wheel's outer face sits at 0.9 r: the wheels stay inside the footprint cylinder.
-        self.wheel_separation = 2.0 * (0.9 * radius - self.wheel_width / 2.0)
-        self.caster_radius = self.wheel_radius / 2.0
-        self.caster_x = radius - 1.5 * self.caster_radius
-        # The chassis' collision spans [caster radius, height] above the floor: only wheels and casters touch it.
-        self.chassis_bottom = self.caster_radius
-
-
-def _described(world) -> RobotDescription:
-    """The robot description of ``world``: a World, world.json's content, or a description already made."""
-    return world if isinstance(world, RobotDescription) else robot_description_of(world)
-
-
 def _on_terrain(world) -> bool:
     """Whether ``world`` (a World or world.json) has terrain; a description alone is of a flat world's robot."""
     if isinstance(world, RobotDescription):
         return False
     return bool((world if isinstance(world, Mapping) else world.metadata).get("terrain"))
-
-
-def dimensions(world) -> Dimensions:
-    """The robot's :class:`Dimensions` for ``world`` (a World, world.json's content or a
-    :class:`~worldgen.scene.robot.RobotDescription`): its footprint and its lidar's height above the floor."""
-    robot = _described(world)
-    return Dimensions(robot.radius, robot.height, robot.lidar.height)
-
-
-def _inertia_cylinder(m: float, r: float, length: float) -> tuple[float, float, float]:
-    side = m * (3 * r * r + length * length) / 12.0
-    return side, side, m * r * r / 2.0
 
 
 def _sdf_inertial(link, mass: float, diag, pose: str = "0 0 0 0 0 0") -> None:
@@ -141,28 +106,12 @@ def _sdf_shape(parent, kind: str, name: str, shape: tuple, pose: str, mu: float 
         sub(sub(geometry, "sphere"), "radius", fmt(shape[1]))
     if kind == "visual":
         material = sub(el, "material")
-        sub(material, "ambient", _COLOUR)
-        sub(material, "diffuse", _COLOUR)
+        sub(material, "ambient", COLOUR)
+        sub(material, "diffuse", COLOUR)
     elif mu is not None:
         ode = sub(sub(sub(el, "surface"), "friction"), "ode")
         sub(ode, "mu", fmt(mu))
         sub(ode, "mu2", fmt(mu))
-
-
-def _parts(d: Dimensions) -> list[tuple]:
-    """(link, joint type, xyz from base_link, shape, mass, friction) of every body below base_link."""
-    y = d.wheel_separation / 2.0
-    rc, rw = d.caster_radius, d.wheel_radius
-    return [("left_wheel", "revolute", (0.0, y, 0.0), ("cylinder", rw, d.wheel_width), _WHEEL_KG, 1.0),
-            ("right_wheel", "revolute", (0.0, -y, 0.0), ("cylinder", rw, d.wheel_width), _WHEEL_KG, 1.0),
-            ("front_caster", "fixed", (d.caster_x, 0.0, rc - rw), ("sphere", rc), _CASTER_KG, 0.0),
-            ("back_caster", "fixed", (-d.caster_x, 0.0, rc - rw), ("sphere", rc), _CASTER_KG, 0.0)]
-
-
-def _chassis(d: Dimensions) -> tuple[float, float]:
-    """(length, z of its centre above base_link) of the chassis cylinder."""
-    length = d.height - d.chassis_bottom
-    return length, d.chassis_bottom + length / 2.0 - d.wheel_radius
 
 
 def _visual_bands(d: Dimensions) -> list[tuple[float, float]]:
@@ -174,22 +123,26 @@ def _visual_bands(d: Dimensions) -> list[tuple[float, float]]:
 
 
 def _sdf_links(model, d: Dimensions, mass: float) -> None:
-    length, zc = _chassis(d)
+    length, zc = chassis(d)
     base = sub(model, "link", name="base_link")
     sub(base, "pose", fmt_seq((0, 0, d.wheel_radius, 0, 0, 0)))
-    _sdf_inertial(base, mass, _inertia_cylinder(mass, d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
+    _sdf_inertial(base, mass, inertia_cylinder(mass, d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
     _sdf_shape(base, "collision", "chassis_collision", ("cylinder", d.radius, length), fmt_seq((0, 0, zc, 0, 0, 0)))
     for k, (low, high) in enumerate(_visual_bands(d)):
         _sdf_shape(base, "visual", f"chassis_visual_{k}", ("cylinder", d.radius, high - low),
                    fmt_seq((0, 0, (low + high) / 2.0 - d.wheel_radius, 0, 0, 0)))
-    for name, joint, xyz, shape, mass, mu in _parts(d):
+    for name, joint, xyz, shape, mass, mu in parts(d):
         link = sub(model, "link", name=name)
         # A wheel's cylinder axis (its z) turns onto the model's y axis.
         roll = -math.pi / 2 if shape[0] == "cylinder" else 0.0
         sub(link, "pose", fmt_seq((xyz[0], xyz[1], xyz[2] + d.wheel_radius, roll, 0, 0)))
-        diag = _inertia_cylinder(mass, shape[1], shape[2]) if shape[0] == "cylinder" else (0.4 * mass * shape[1] ** 2,) * 3
+        diag = inertia_cylinder(mass, shape[1], shape[2]) if shape[0] == "cylinder" else (0.4 * mass * shape[1] ** 2,) * 3
         _sdf_inertial(link, mass, diag)
-        _sdf_shape(link, "collision", "collision", shape, "0 0 0 0 0 0", mu)
+        # A wheel touches the floor as the sphere of its radius: DART (Fortress and Harmonic alike) touched a lying
+        # cylinder at one end of its width, the same end for both wheels, and the robot turned on the spot about a
+        # point 2 cm (half a wheel's width) to one side of its centre (docs/drive.md, barn seed 22).
+        touching = ("sphere", shape[1]) if shape[0] == "cylinder" else shape
+        _sdf_shape(link, "collision", "collision", touching, "0 0 0 0 0 0", mu)
         _sdf_shape(link, "visual", "visual", shape, "0 0 0 0 0 0")
         j = sub(model, "joint", name=f"{name}_joint", type=joint)
         sub(j, "parent", "base_link")
@@ -229,7 +182,7 @@ def _sdf_sensors(model, d: Dimensions, lidar: LidarDescription, lidar_noise: flo
         sub(j, "parent", "base_link")
         sub(j, "child", name)
     imu_link = sub(model, "link", name="imu_link")
-    sub(imu_link, "pose", fmt_seq((0, 0, d.wheel_radius + _chassis(d)[1], 0, 0, 0)))
+    sub(imu_link, "pose", fmt_seq((0, 0, d.wheel_radius + chassis(d)[1], 0, 0, 0)))
     _sdf_inertial(imu_link, 0.01, (1e-5, 1e-5, 1e-5))
     imu = sub(imu_link, "sensor", name="imu", type="imu")
     sub(imu, "always_on", "true")
@@ -284,7 +237,7 @@ def robot_sdf(world, *, name: str = DEFAULT_NAME, lidar_noise: float = 0.0, gz_r
     if not (lidar_rate > 0 and odom_rate > 0):
         raise ParameterError(f"rates must be > 0 Hz, got lidar_rate={lidar_rate!r}, odom_rate={odom_rate!r}")
     release(gz_release)
-    robot = _described(world)
+    robot = described(world)
     d = dimensions(robot)
     root = etree.Element("sdf", version="1.9")
     model = sub(root, "model", name=name)
@@ -325,56 +278,3 @@ def _el(tag: str, text: str, **attrs):
     el = etree.Element(tag, attrs)
     el.text = text
     return el
-
-
-def _urdf_link(robot, name: str, shape=None, mass: float = 0.0, diag=(0, 0, 0), origin=(0, 0, 0, 0, 0, 0)) -> None:
-    link = sub(robot, "link", name=name)
-    if shape is None:
-        return
-    inertial = sub(link, "inertial")
-    sub(inertial, "origin", xyz=fmt_seq(origin[:3]), rpy=fmt_seq(origin[3:]))
-    sub(inertial, "mass", value=fmt(mass))
-    sub(inertial, "inertia", ixx=fmt(diag[0]), ixy="0", ixz="0", iyy=fmt(diag[1]), iyz="0", izz=fmt(diag[2]))
-    for kind in ("visual", "collision"):
-        el = sub(link, kind)
-        sub(el, "origin", xyz=fmt_seq(origin[:3]), rpy=fmt_seq(origin[3:]))
-        geometry = sub(el, "geometry")
-        if shape[0] == "cylinder":
-            sub(geometry, "cylinder", radius=fmt(shape[1]), length=fmt(shape[2]))
-        else:
-            sub(geometry, "sphere", radius=fmt(shape[1]))
-        if kind == "visual":
-            sub(sub(el, "material", name="robot_orange"), "color", rgba=_COLOUR)
-
-
-def _urdf_joint(robot, name: str, kind: str, parent: str, child: str, xyz, rpy=(0, 0, 0), axis=None) -> None:
-    joint = sub(robot, "joint", name=name, type=kind)
-    sub(joint, "parent", link=parent)
-    sub(joint, "child", link=child)
-    sub(joint, "origin", xyz=fmt_seq(xyz), rpy=fmt_seq(rpy))
-    if axis is not None:
-        sub(joint, "axis", xyz=axis)
-
-
-def robot_urdf(world, *, name: str = DEFAULT_NAME) -> str:
-    """``robot.urdf`` of the robot for ``world``: the SDF's links and joints, for robot_state_publisher."""
-    described = _described(world)
-    mass = described.mass
-    d = dimensions(described)
-    length, zc = _chassis(d)
-    robot = etree.Element("robot", name=name)
-    _urdf_link(robot, "base_footprint")
-    _urdf_link(robot, "base_link", ("cylinder", d.radius, length), mass,
-               _inertia_cylinder(mass, d.radius, length), (0, 0, zc, 0, 0, 0))
-    _urdf_joint(robot, "base_footprint_joint", "fixed", "base_footprint", "base_link", (0, 0, d.wheel_radius))
-    for part, kind, xyz, shape, mass, _ in _parts(d):
-        if shape[0] == "cylinder":
-            _urdf_link(robot, part, shape, mass, _inertia_cylinder(mass, shape[1], shape[2]))
-            _urdf_joint(robot, f"{part}_joint", "continuous", "base_link", part, xyz, (-math.pi / 2, 0, 0), "0 0 1")
-        else:
-            _urdf_link(robot, part, shape, mass, (0.4 * mass * shape[1] ** 2,) * 3)
-            _urdf_joint(robot, f"{part}_joint", "fixed", "base_link", part, xyz)
-    for part, z in (("base_scan", d.lidar_height - d.wheel_radius), ("imu_link", zc)):
-        _urdf_link(robot, part)  # a frame only: no body of its own
-        _urdf_joint(robot, f"{part}_joint", "fixed", "base_link", part, (0, 0, z))
-    return to_bytes(robot).decode()

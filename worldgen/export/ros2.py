@@ -210,7 +210,8 @@ def bundle(world, sdf_version: str = "1.9", gz_release: Optional[str] = DEFAULT_
     worldgen.export.robot makes for the world is shipped as ``robot.sdf`` (spawned unless the run names
     another) and ``robot.urdf`` (robot_state_publisher's), named ``robot_name``.
     """
-    from worldgen.export.robot import robot_sdf, robot_urdf
+    from worldgen.export.robot import robot_sdf
+    from worldgen.export.robot_urdf import robot_urdf
     from worldgen.files import MAP_IMAGE_NAME, MAP_YAML_NAME, SDF_NAME
     from worldgen.groundtruth.truth import doors_start_shut, start_occupancy_map
 

@@ -37,6 +37,7 @@ from worldgen.envs.policies import PathFollower, TimedFollower
 from worldgen.errors import OutputError, ParameterError
 from worldgen.groundtruth.folder import WorldFolder, open_world, robot_of
 from worldgen.scene.robot import MAX_SPEED, RobotDescription
+from worldgen.sim.ramped import BRAKING, braked, ramped_follower
 from worldgen.sim.schedule import Plan, plan_for
 
 __all__ = ["SIMS", "LOOKAHEAD", "CONTROL_PERIOD", "STUCK_SECONDS", "STUCK_MOVE", "STUCK_TURN", "TURN_RATE", "CATCH_UP",
@@ -67,9 +68,6 @@ TIMED_TURN_RATE = 8.0
 LAG = 0.1
 #: m: within this of where the schedule has it a command ahead, the robot stands (and turns to where it goes next).
 ON_THE_SPOT = 0.01
-#: The share of a robot's turn acceleration :func:`braked` plans to stop a turn with (the rest covers a command's
-#: late start: the rate is set once a command).
-BRAKING = 0.8
 
 
 @dataclass
@@ -100,64 +98,41 @@ def steps_per_command(dt: float) -> int:
 def controller(plan: Plan, speed: Optional[float] = None, robot: Optional[RobotDescription] = None,
                turn_accel: Optional[float] = None, accel: Optional[float] = None
                ) -> Callable[[float, float, float, float], tuple[float, float]]:
-    """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t the simulator's time, world.json's rows' clock): the environment's
-    :class:`~worldgen.envs.policies.TimedFollower` on a schedule (within :data:`CATCH_UP` x its top speed and
-    :data:`TIMED_TURN_RATE`), its :class:`~worldgen.envs.policies.PathFollower` on a path (at ``speed``, default
+    """``(t, x, y, yaw) -> (v, w)`` for ``plan`` (t the simulator's time, world.json's rows' clock): on a schedule
+    (within :data:`CATCH_UP` x its top speed and :data:`TIMED_TURN_RATE`) the environment's
+    :class:`~worldgen.envs.policies.TimedFollower`, or :func:`worldgen.sim.ramped.ramped_follower` for a robot whose
+    rates ramp; on a path the environment's :class:`~worldgen.envs.policies.PathFollower` (at ``speed``, default
     the plan's); never beyond ``robot``'s max_speed and turn rate where a robot description is given.
 
-    ``turn_accel`` (rad/s^2; None: the turn rate is taken at once, as MuJoCo's servos take it) is how fast the
-    robot's turn rate can change: on a schedule every turn is then asked no faster than lets the robot stop
-    turning on the heading it aims at (:func:`braked`); ``accel`` (m/s^2) likewise its speed, asked no faster
-    than lets it stop where the schedule next stands still (a wait, the goal)."""
+    ``turn_accel`` (rad/s^2) and ``accel`` (m/s^2) are how fast the robot's turn rate and speed can change (None:
+    at once, as MuJoCo's servos take a twist); given either (Gazebo's DiffDrive), a schedule is followed by the
+    ramped follower."""
     v_cap, w_cap = (robot.max_speed, robot.turn_rate) if robot is not None else (math.inf, math.inf)
-    turn = min(TIMED_TURN_RATE, w_cap)
     if plan.rows is not None:
-        timed = TimedFollower(plan.rows, v_max=min(CATCH_UP * plan.speed, v_cap), w_max=turn, period=CONTROL_PERIOD)
+        v_max, w_max = min(CATCH_UP * plan.speed, v_cap), min(TIMED_TURN_RATE, w_cap)
+        if turn_accel is not None or accel is not None:
+            return ramped_follower(plan.rows, v_max, w_max, CONTROL_PERIOD, turn_accel, accel)
+        timed = TimedFollower(plan.rows, v_max=v_max, w_max=w_max, period=CONTROL_PERIOD)
         rows = plan.rows
-        step = np.hypot(*np.diff(rows[:, 1:], axis=0).T)
-        waits = np.flatnonzero(step < 1e-6)
-        # Where the schedule stands still (each wait, then the goal) and until when: a robot behind its schedule
-        # brakes for a wait until the wait is over, not only until it starts.
-        stops = np.append(waits, len(rows) - 1)
-        until = np.append(rows[waits + 1, 0], rows[-1, 0])
 
         def act(t: float, x: float, y: float, yaw: float) -> tuple[float, float]:
             dx, dy = timed.at(t + CONTROL_PERIOD) - (x, y)
             if math.hypot(dx, dy) > ON_THE_SPOT:
-                v, w = (float(a) for a in timed.action(x, y, yaw, t))
-                err = (math.atan2(dy, dx) - yaw + math.pi) % (2.0 * math.pi) - math.pi  # what the follower aims at
-                if accel is not None:
-                    stop = rows[stops[np.searchsorted(until, t)] if t <= rows[-1, 0] else -1, 1:]
-                    v = braked(v, float(np.hypot(*(stop - (x, y)))), accel)
-                return v, braked(w, err, turn_accel)
+                v, w = timed.action(x, y, yaw, t)
+                return float(v), float(w)
             # Where the schedule waits (or the goal): stand, facing where it goes next, so that setting off costs
             # no turn (heading for a point millimetres away would only jitter).
             ahead = rows[(rows[:, 0] > t) & (np.hypot(rows[:, 1] - x, rows[:, 2] - y) > LAG / 2)]
             if not len(ahead):
                 return 0.0, 0.0
             err = (math.atan2(ahead[0, 2] - y, ahead[0, 1] - x) - yaw + math.pi) % (2.0 * math.pi) - math.pi
-            return 0.0, braked(float(np.clip(err / CONTROL_PERIOD, -turn, turn)), err, turn_accel)
+            return 0.0, float(np.clip(err / CONTROL_PERIOD, -w_max, w_max))
 
         return act
     pursuit = PathFollower(plan.waypoints.tolist(), v_max=min(plan.speed if speed is None else speed, v_cap),
                            w_max=min(TURN_RATE, w_cap), lookahead=LOOKAHEAD)
     # tuple() of a generator is typed tuple[float, ...]; the follower's action is always (v, w)
     return lambda t, x, y, yaw: tuple(float(a) for a in pursuit.action(x, y, yaw))  # type: ignore[return-value]
-
-
-def braked(w: float, err: float, turn_accel: Optional[float]) -> float:
-    """A rate ``w`` (a turn rate, or a speed) toward something ``err`` away (rad, or m), no faster than a robot
-    whose rate changes at most :data:`BRAKING` x ``turn_accel`` (rad/s^2, or m/s^2) can stop from there
-    (``w`` itself with no limit).
-
-    Gazebo's DiffDrive ramps the twist it is told at its wheels' acceleration (worldgen.export.robot), so a
-    follower that asks 8 rad/s until it faces its target swings on past it: from 8 rad/s the robot needs
-    2.0 rad to stop at 15.6 rad/s^2 (a 0.2 m robot), and reversing the turn took it 0.3 s and more; catching
-    up at 0.75 m/s with a schedule that stops, it ran 7 cm past (barn seed 2 among movers, into an obstacle
-    the schedule passes 5 cm from)."""
-    if turn_accel is None:
-        return w
-    return math.copysign(min(abs(w), math.sqrt(2.0 * BRAKING * turn_accel * abs(err))), w)
 
 
 def run_loop(backend, task: dict, straight: bool = False, speed: float = MAX_SPEED,
