@@ -134,8 +134,10 @@ class GazeboBackend:
         self._bridge: subprocess.Popen | None = None
         self._model: IO[str] | None = None  # the robot's SDF, a file the bridge reads
 
-    def start(self, spawn: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
-        """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose."""
+    def start(self, spawn: tuple[float, float, float, float],
+              first: tuple[float, float] = (0.0, 0.0)) -> tuple[float, float, float, float]:
+        """Start the server, spawn the robot at (x, y, z, yaw), connect the bridge; the first pose, after
+        :attr:`first_steps` steps under the twist ``first`` (v, w)."""
         install = self.install or locate()
         exe = build_bridge(install.env, install.release)
         self._pose = None
@@ -155,10 +157,10 @@ class GazeboBackend:
             [str(exe), self._server.world, CMD_VEL.gazebo_topic, GROUND_TRUTH.gazebo_topic, str(round(self.dt * 1e9)),
              model.name, self._robot_name, *(repr(float(v)) for v in spawn), *self._door_topics],
             env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, bufsize=1)
-        first = self._read()
-        if first != "ready":
-            raise GazeboError(f"the drive bridge did not connect: {first}")
-        return self.step(0.0, 0.0, self.first_steps)
+        answer = self._read()
+        if answer != "ready":
+            raise GazeboError(f"the drive bridge did not connect: {answer}")
+        return self.step(first[0], first[1], self.first_steps)
 
     def _read(self) -> str:
         assert self._bridge is not None and self._bridge.stdout is not None
