@@ -76,6 +76,18 @@ def test_a_stamped_command_from_jazzy_nav2_starts_the_run_too(world, tmp_path):
     assert read_run(bag, world).start_time == pytest.approx(2.0)
 
 
+def test_a_first_command_sent_before_any_clock_is_timed_by_the_next_one(world, tmp_path):
+    """worldgen drive in Gazebo commands at time 0, before the first pose and /clock (0.05 s): the unstamped
+    Twist is timed by the first clocked message after it. It was timed by its receive time in ns read as s,
+    past the bag's end, and the run was judged from its last pose ("the run starts 8.41 m from the spawn")."""
+    drive = along(world)
+    commands = np.vstack([[0.0, 0.5, 0.0], np.column_stack([drive[1:, 0], np.full(len(drive) - 1, 0.5),
+                                                          np.zeros(len(drive) - 1)])])
+    bag = write_bag(tmp_path / "run", world, drive[1:], commands=commands)
+    run = read_run(bag, world)
+    assert run.start_time == pytest.approx(drive[1, 0]) and len(run.trajectory) == len(drive) - 1
+
+
 @pytest.mark.parametrize("storage,distro", [("sqlite3", "humble"), ("mcap", "jazzy")])
 def test_drifting_odometry(world, tmp_path, storage, distro):
     truth = along(world)

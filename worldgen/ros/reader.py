@@ -227,6 +227,9 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
     if not gt and odom_topic in topics:
         st["odom"] = _Series(min_dt)
     ref = None  # (receive ns, simulation s) of the latest stamped message: clocks unstamped ones
+    # The receive time (ns) of a first non-zero Twist that came before any stamped message: the first one after
+    # it times it (a drive that commands at time 0 sends it before the simulator's first tick is recorded).
+    early = None
     decode = decoder(reader, conns, distro)
     for conn, recv, raw in reader.messages(connections=conns):
         topic = conn.topic
@@ -240,10 +243,13 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
         elif topic == cmd_topic:
             st["cmd_seen"] = True
             t, vx, vy, wz = v
-            if st["first_cmd"] is None and (abs(vx) > 1e-9 or abs(vy) > 1e-9 or abs(wz) > 1e-9):
-                if t is None:  # a Twist has no stamp: the simulation time it was received at
-                    t = ref[1] + (recv - ref[0]) * 1e-9 if ref is not None else recv * 1e-9
-                st["first_cmd"] = t
+            if st["first_cmd"] is None and early is None and (abs(vx) > 1e-9 or abs(vy) > 1e-9 or abs(wz) > 1e-9):
+                if t is not None:
+                    st["first_cmd"] = t
+                elif ref is not None:  # a Twist has no stamp: the simulation time it was received at
+                    st["first_cmd"] = ref[1] + (recv - ref[0]) * 1e-9
+                else:  # unstamped, before any clock: timed by the next stamped message
+                    early = recv
         elif topic in goal_topics:
             if st["first_goal"] is None:
                 st["first_goal"] = v[0]
@@ -266,6 +272,10 @@ def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topic
                 else:
                     continue
                 ref = (recv, t)
+        if early is not None and ref is not None:
+            st["first_cmd"], early = ref[1] - (ref[0] - early) * 1e-9, None
+    if early is not None:  # no clock in the whole bag: its receive time is all there is
+        st["first_cmd"] = early * 1e-9
     return st
 
 
