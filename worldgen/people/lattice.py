@@ -1,0 +1,283 @@
+"""A route off the static path: where a robot that turns on the spot can be, step by step, among agents on
+known schedules (the witness :mod:`worldgen.people.offpath` reads an off-path certificate's route from).
+
+The floor near a task (the box round its spawn, goal and static path, :data:`BORDER` wider, inside the
+scene's bounds) is a grid of cells ``h`` apart through the spawn; time is steps of :data:`DT`. The robot is
+in a cell facing one of 8 headings (multiples of 45 degrees). In a step it waits, or moves one cell along its
+heading (a diagonal cell is ``h sqrt 2`` away: ``h`` is chosen so that that is :data:`PACE` of the top speed
+in a step, the axes being slower still); it turns 45 degrees on the spot in :func:`turn_steps` steps, the turn
+itself at the stated turn rate plus the time a stop and a start cost at the stated acceleration. So the
+witness is slower than the robot everywhere, which lets the exact sweep along its route keep up with it.
+
+A cell is free of the static world when its centre is ``robot.inflation`` from every footprint below the
+robot's top (doors at their open limit, as the static planner has them), plus the most a straight move to a
+neighbour can dip toward a convex footprint; free of an agent at a step when its centre is farther than the
+agent's reach from every position the agent's tube allows round the step. The reach is the certificate's
+(robot inflation, the agent's radius and tube, MARGIN and the tracking margin, and what both close in half a
+step) plus ``room``: how far the exact sweep may drift from the witness's timing and still find the cell clear.
+
+None of this is the certificate: the route is proven again by FCL and timed by the exact sweep
+(:func:`worldgen.people.timed.timed_path`), which alone decides. A forward sweep keeps the (heading, cell)
+states the robot can be in; the first step a cell within :data:`GOAL_SHARE` of the goal tolerance is held
+gives the route, read back as the cells where the heading changes.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Optional, Sequence
+
+import numpy as np
+
+from worldgen.scene.motion import positions_at
+
+__all__ = ["DT", "BORDER", "PACE", "GOAL_SHARE", "HEADINGS", "turn_steps", "lattice_route"]
+
+#: s between two steps of the lattice.
+DT = 0.1
+#: m the grid reaches beyond the box round spawn, goal and static path.
+BORDER = 2.0
+#: Share of the top speed a diagonal move makes (the axes sqrt 2 slower): room for the exact sweep's speeding up.
+PACE = 0.9
+#: Share of the goal tolerance within which a cell counts as the goal's (the route then ends at the goal itself).
+GOAL_SHARE = 0.25
+#: The 8 headings as (rows, columns) a move shifts: heading k is k x 45 degrees from +x (rows are y, columns x).
+HEADINGS = ((0, 1), (1, 1), (1, 0), (1, -1), (0, -1), (-1, -1), (-1, 0), (-1, 1))
+#: m added to every growth of a footprint: more than shapely's chords lose on a rounded corner.
+_ROUNDING = 1e-3
+#: Steps whose agents' blocked cells are worked out at once.
+_CHUNK = 64
+
+
+def turn_steps(angle: float, limits) -> int:
+    """Steps a turn of ``angle`` rad on the spot takes within ``limits`` (:class:`~worldgen.people.timed.Limits`),
+    with the stop before it and the start after it (``max_speed / acceleration`` between them)."""
+    return math.ceil(angle / (limits.turn_rate * DT) - 1e-9) + math.ceil(limits.max_speed / (limits.acceleration * DT))
+
+
+def lattice_route(footprints, bounds, spawn, yaw: float, goal, tolerance: float, waypoints,
+                  tracks: Sequence[np.ndarray], radii: Sequence[float], tubes, loops: Sequence[bool],
+                  inflation: float, keep: float, limits, horizon: float, room: float) -> Optional[np.ndarray]:
+    """(m, 2) the route (spawn first, then every cell where the witness turns, then the goal) of the earliest
+    witness from ``spawn`` (facing ``yaw``) to ``goal`` within ``horizon`` s, or None.
+
+    ``footprints`` (the robot's, doors open) and ``bounds`` the static world; ``tracks`` (k, 3) ``t, x, y``,
+    ``radii``, ``tubes`` (``d``, ``tau``) and ``loops`` the agents; ``inflation`` the robot's, ``keep`` what the
+    certificate keeps beyond it (MARGIN and the tracking margin), ``room`` what the witness keeps beyond that."""
+    top = limits.max_speed
+    h = PACE * top * DT / math.sqrt(2.0)
+    xs, ys = _axes(bounds, spawn, goal, waypoints, h)
+    si, sj = int(np.argmin(np.abs(ys - spawn[1]))), int(np.argmin(np.abs(xs - spawn[0])))
+    # Between neighbouring centres (a move of L <= h sqrt 2) the distance to a convex footprint dips below the
+    # ends' by at most L^2 / (8 inflation): centres that much farther out keep the whole move off it.
+    static = _clear_of(footprints, bounds, xs, ys, inflation + h * h / (4.0 * inflation) + _ROUNDING)
+    static[si, sj] = True  # the spawn is the world's, proven clear
+    gx, gy = np.meshgrid(xs, ys)
+    at_goal = (np.hypot(gx - goal[0], gy - goal[1]) <= tolerance * GOAL_SHARE) & static
+    if not at_goal.any():
+        return None
+    fastest = max([_fastest(t) for t in tracks], default=0.0)
+    reach = np.array([inflation + keep + room + float(r) + float(tube.d) + (top + fastest) * DT / 2
+                      for r, tube in zip(radii, tubes)])
+    window = np.array([0 if tube.tau <= 0 else math.ceil(tube.tau / DT + 0.5 - 1e-9) for tube in tubes], dtype=int)
+    offset = [abs((k * math.pi / 4 - yaw + math.pi) % (2 * math.pi) - math.pi) for k in range(8)]
+    first = [math.ceil(a / (limits.turn_rate * DT) - 1e-9) for a in offset]  # steps to face heading k at the spawn
+    agents = (tracks, loops, reach, window)
+    got = _sweep(xs, ys, static, at_goal, (si, sj), first, turn_steps(math.pi / 4, limits), agents,
+                 int(math.ceil(horizon / DT)))
+    if got is None:
+        return None
+    pts = np.array([[xs[j], ys[i]] for i, j in got])
+    pts[0] = spawn[:2]
+    return _corners(np.vstack([pts, np.asarray(goal[:2], dtype=float)[None]]))
+
+
+def _sweep(xs, ys, static, at_goal, spawn: tuple[int, int], first, turn: int, agents,
+           steps: int) -> Optional[list[tuple[int, int]]]:
+    """The cells of the earliest witness (see the module's docstring) within ``steps`` steps, or None."""
+    tracks, loops, reach, window = agents
+    shape = (8,) + static.shape
+    movable = static[None] & np.stack([_shifted(static, -di, -dj) for di, dj in HEADINGS])  # moves stay on free floor
+    held: list[np.ndarray] = []  # per step, the (8, ny, nx) states, bit-packed
+    frees: list[np.ndarray] = []  # per step, the free cells, bit-packed
+    recent: list[np.ndarray] = []  # the last ``turn`` steps' states, unpacked
+    run = np.zeros(static.shape, dtype=np.int32)  # steps each cell has been free in a row, up to this one
+    blocked = np.zeros((0,) + static.shape, dtype=bool)
+    # Once every person stands (after its last row and its tube's time), the cells they cover stay covered:
+    # the goal is then reachable through the rest (the loops only take more) or never.
+    still = [not loop for loop in loops]
+    settled = math.ceil(max([float(t[-1, 0]) for t, s in zip(tracks, still) if s] + [0.0]) / DT) \
+        + int(window.max(initial=0)) + 1
+    left, right = [(d - 1) % 8 for d in range(8)], [(d + 1) % 8 for d in range(8)]
+    for k in range(steps + 1):
+        if k == len(blocked):
+            blocked = np.concatenate([blocked, _blocked(xs, ys, tracks, loops, reach, window, k, _CHUNK)])
+        free = static & ~blocked[k]
+        run = np.where(free, run + 1, 0)
+        now = np.zeros(shape, dtype=bool)
+        if k:
+            before = recent[-1]
+            now |= before
+            moved = before & movable
+            for d, (di, dj) in enumerate(HEADINGS):
+                now[d] |= _shifted(moved[d], di, dj)
+            if k >= turn:
+                back = recent[-turn]
+                now |= (back[left] | back[right]) & (run > turn)[None]
+        for d in range(8):
+            if k == first[d]:
+                now[d, spawn[0], spawn[1]] |= bool(run[spawn] > k)
+        now &= free[None]
+        held.append(np.packbits(now))
+        frees.append(np.packbits(free))
+        recent = (recent + [now])[-max(turn, 1):]
+        if (now & at_goal[None]).any():
+            return _read_back(lambda step: _unpacked(held[step], shape),
+                              lambda step: _unpacked(frees[step], static.shape), k, movable, turn, first, spawn,
+                              at_goal)
+        if not now.any():
+            return None
+        if k == settled:
+            standing = _blocked(xs, ys, [t for t, s in zip(tracks, still) if s], [False] * sum(still),
+                                reach[still], np.zeros(sum(still), dtype=int), k, 1)[0]
+            if not _reaches_goal(now, static & ~standing, at_goal):
+                return None
+    return None
+
+
+def _axes(bounds, spawn, goal, waypoints, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """The grid's x and y coordinates: through the spawn, ``h`` apart, over the box round the task."""
+    pts = np.vstack([np.asarray(waypoints, dtype=float).reshape(-1, 2), np.asarray(spawn[:2], float),
+                     np.asarray(goal[:2], float)])
+    (bx0, by0), (bx1, by1) = bounds
+    x0, y0 = max(pts[:, 0].min() - BORDER, bx0), max(pts[:, 1].min() - BORDER, by0)
+    x1, y1 = min(pts[:, 0].max() + BORDER, bx1), min(pts[:, 1].max() + BORDER, by1)
+    sx, sy = float(spawn[0]), float(spawn[1])
+    xs = sx + h * np.arange(math.ceil((x0 - sx) / h), math.floor((x1 - sx) / h) + 1)
+    ys = sy + h * np.arange(math.ceil((y0 - sy) / h), math.floor((y1 - sy) / h) + 1)
+    return xs, ys
+
+
+def _clear_of(footprints, bounds, xs: np.ndarray, ys: np.ndarray, least: float) -> np.ndarray:
+    """(ny, nx) bool: grid points at least ``least`` from every footprint (a polygon or a disc) and from the
+    bounds. Each footprint is grown by ``least`` + :data:`_ROUNDING` (shapely's rounded corners are chords)."""
+    import shapely
+
+    gx, gy = np.meshgrid(xs, ys)
+    (bx0, by0), (bx1, by1) = bounds
+    inside = (gx - bx0 >= least) & (bx1 - gx >= least) & (gy - by0 >= least) & (by1 - gy >= least)
+    if not footprints:
+        return inside
+    shapes = [f.polygon if not f.is_disc else shapely.Point(f.centre).buffer(f.radius, quad_segs=16)
+              for f in footprints]
+    grown = shapely.union_all([shape.buffer(least + _ROUNDING, quad_segs=16) for shape in shapes])
+    shapely.prepare(grown)
+    return inside & ~shapely.contains_xy(grown, gx, gy)
+
+
+def _fastest(track: np.ndarray) -> float:
+    d = np.diff(np.asarray(track, dtype=float), axis=0)
+    return float(np.max(np.hypot(d[:, 1], d[:, 2]) / np.maximum(d[:, 0], 1e-12))) if len(d) else 0.0
+
+
+def _blocked(xs, ys, tracks, loops, reach, window, k0: int, n: int) -> np.ndarray:
+    """(n, ny, nx) bool: the cells some agent is within its reach of at steps ``k0`` to ``k0 + n - 1``, an agent
+    with a tube at any step of its ``window`` round the step."""
+    out = np.zeros((n, len(ys), len(xs)), dtype=bool)
+    for j, track in enumerate(tracks):
+        w = int(window[j])
+        ks = np.arange(k0 - w, k0 + n + w)
+        pos = positions_at([np.asarray(track, dtype=float)], [bool(loops[j])], np.maximum(ks, 0) * DT)[:, 0]
+        raw = np.zeros((len(ks), len(ys), len(xs)), dtype=bool)
+        r = float(reach[j])
+        for s, (px, py) in enumerate(pos):
+            j0, j1 = np.searchsorted(xs, px - r), np.searchsorted(xs, px + r, side="right")
+            i0, i1 = np.searchsorted(ys, py - r), np.searchsorted(ys, py + r, side="right")
+            if i0 >= i1 or j0 >= j1:
+                continue
+            dx, dy = xs[j0:j1] - px, ys[i0:i1] - py
+            raw[s, i0:i1, j0:j1] |= dy[:, None] ** 2 + dx[None, :] ** 2 < r * r
+        out |= _any_within(raw, 2 * w + 1) if w else raw
+    return out
+
+
+def _any_within(raw: np.ndarray, span: int) -> np.ndarray:
+    """(len(raw) - span + 1, ...) bool: whether any of ``span`` consecutive steps of ``raw`` holds, by doubling
+    (each pass ORs the runs of the one before with their shift: log2(span) passes of bool arrays)."""
+    acc, run = raw, 1
+    while 2 * run <= span:
+        acc = acc[:-run] | acc[run:]
+        run *= 2
+    n = len(raw) - span + 1
+    return acc[:n] | acc[span - run:span - run + n]
+
+
+def _reaches_goal(states: np.ndarray, free: np.ndarray, at_goal: np.ndarray) -> bool:
+    """Whether a cell of ``at_goal`` is 8-connected to a cell of ``states`` (any heading) through ``free``
+    cells: once every agent stands still, the lattice can reach no other cell."""
+    comp = states.any(axis=0) & free
+    while not (comp & at_goal).any():
+        grown = comp.copy()
+        for di, dj in HEADINGS:
+            grown |= _shifted(comp, di, dj)
+        grown &= free
+        if np.array_equal(grown, comp):
+            return False
+        comp = grown
+    return True
+
+
+def _unpacked(packed: np.ndarray, shape: tuple) -> np.ndarray:
+    return np.unpackbits(packed, count=int(np.prod(shape))).reshape(shape).astype(bool)
+
+
+def _shifted(a: np.ndarray, di: int, dj: int) -> np.ndarray:
+    """``a`` moved ``di`` rows and ``dj`` columns (what leaves the grid is lost, what enters is False)."""
+    out = np.zeros_like(a)
+    ny, nx = a.shape
+    out[max(di, 0):ny + min(di, 0), max(dj, 0):nx + min(dj, 0)] = a[max(-di, 0):ny - max(di, 0),
+                                                                    max(-dj, 0):nx - max(dj, 0)]
+    return out
+
+
+def _read_back(states, frees, k: int, movable, turn: int, first, spawn: tuple[int, int], at_goal
+               ) -> list[tuple[int, int]]:
+    """The cells of one witness, the spawn's first, from step ``k``'s state at the goal back (``states`` and
+    ``frees``: a step's (8, ny, nx) states and (ny, nx) free cells): each step's predecessor a move along the
+    heading where the stored states allow one, else a wait, else a turn."""
+    d, i, j = (int(v) for v in np.argwhere(states(k) & at_goal[None])[0])
+    cells = [(i, j)]
+
+    def stood(i: int, j: int, lo: int, hi: int) -> bool:
+        return all(frees(s)[i, j] for s in range(lo, hi + 1))
+
+    while k > 0:
+        if (i, j) == spawn and k == first[d] and stood(i, j, 0, k):
+            break  # it stood at the spawn from t = 0, turning to this heading
+        di, dj = HEADINGS[d]
+        pi, pj = i - di, j - dj
+        prev = states(k - 1)
+        inside = 0 <= pi < prev.shape[1] and 0 <= pj < prev.shape[2]
+        if inside and prev[d, pi, pj] and movable[d, pi, pj]:
+            i, j, k = pi, pj, k - 1
+            cells.append((i, j))
+        elif prev[d, i, j]:
+            k -= 1
+        else:
+            back = states(k - turn)
+            d = next(e for e in ((d - 1) % 8, (d + 1) % 8) if back[e, i, j] and stood(i, j, k - turn, k))
+            k -= turn
+    return cells[::-1]
+
+
+def _corners(pts: np.ndarray) -> np.ndarray:
+    """``pts`` less repeated points and points on the straight line between their neighbours."""
+    keep = np.r_[True, np.any(np.abs(np.diff(pts, axis=0)) > 1e-12, axis=1)]
+    pts = pts[keep]
+    if len(pts) < 3:
+        return pts
+    d = np.diff(pts, axis=0)
+    cross = d[:-1, 0] * d[1:, 1] - d[:-1, 1] * d[1:, 0]
+    dot = np.einsum("ij,ij->i", d[:-1], d[1:])
+    straight = (np.abs(cross) <= 1e-12 * np.hypot(*d[:-1].T) * np.hypot(*d[1:].T)) & (dot > 0)
+    return pts[np.r_[True, ~straight, True]]

@@ -1,0 +1,111 @@
+"""The certificate off the static path: where the sweep along a task's path finds no timed path (a mover pacing
+along a corridor's centreline, a person standing on it once the walk ends), a route that steps aside, timed by
+the same sweep (docs/people.md, "Off the path").
+
+1. :func:`worldgen.people.lattice.lattice_route` finds a witness through space and time among the agents, a
+   robot on a grid of cells that waits, moves and turns on the spot no faster than the robot, keeping
+   ``room`` more than the certificate from every agent; its route is the polyline through the cells where
+   it turns.
+2. The route is proven clear of the static geometry by FCL, the robot's disc swept along it keeping
+   ``robot.clearance`` (and 10 um more, for world.json's 6-decimal rows), as the static path was.
+3. :func:`worldgen.people.timed.timed_path` times the route exactly as it times a static path: top speed,
+   acceleration, every corner turned on the spot at the turn rate (none passed moving: ``worldgen check``
+   re-derives those from the recorded static path only), and the same reach from every person, tube and
+   looping mover. What it finds is the certificate, checked by ``worldgen check`` from world.json alone like
+   any other; the witness only says where to look.
+
+Each of :data:`ROOMS` is tried in turn until one gives a certificate: a wide room leaves the exact timing
+(slower through its turns and starts than the witness) slack to pass the agents the witness passed, a narrow
+one finds ways a wide one cannot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Optional, Sequence
+
+import numpy as np
+
+from worldgen.feasibility.report import Check, FeasibilityReport
+from worldgen.people.behaviours import Tube, tube_of
+from worldgen.people.lattice import lattice_route
+from worldgen.people.timed import MARGIN, TRACKING, Limits, TimedPath, _among, timed_path
+
+__all__ = ["ROOMS", "AFTER", "off_path", "certify_off_path"]
+
+#: m the witness keeps from every agent beyond the certificate's reach, tried in turn.
+ROOMS = (0.15, 0.05)
+#: s the witness may take beyond the time everyone stops (or the slowest loop comes round) and twice the
+#: static path at the witness's axis speed.
+AFTER = 10.0
+
+
+def off_path(scene, colliders, task, waypoints, robot, limits: Limits, tracks: Sequence[np.ndarray],
+             radii: Sequence[float], tubes: Sequence[Tube], loops: Sequence[bool]) -> Optional[TimedPath]:
+    """A timed path for ``task`` off its static path ``waypoints`` (k, 2) among the agents (``tracks``,
+    ``radii``, ``tubes``, ``loops``), within ``limits``, its route clear of ``colliders`` (the scene's,
+    doors open) by FCL; None where no room of :data:`ROOMS` gives one."""
+    from worldgen.feasibility.verify import verify_path
+    from worldgen.people.lattice import PACE
+    from worldgen.scene.doors import open_scene
+    from worldgen.scene.footprint import robot_footprints
+
+    footprints = robot_footprints(open_scene(scene), robot)
+    w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+    length = float(np.hypot(*np.diff(w, axis=0).T).sum())
+    loops = [bool(x) for x in loops]
+    end = max([float(t[-1, 0]) for t in tracks] + [0.0])
+    horizon = end + 2.0 * length / (PACE * limits.max_speed / np.sqrt(2.0)) + AFTER
+    spawn, goal = task.spawn, task.goal
+    for room in ROOMS:
+        route = lattice_route(footprints, scene.bounds, (spawn.x, spawn.y), float(spawn.yaw), (goal.x, goal.y),
+                              float(task.goal_tolerance), w, tracks, radii, tubes, loops, robot.inflation,
+                              MARGIN + TRACKING, limits, horizon, room)
+        if route is None:
+            continue  # a narrower room may find a way a wider one blocks
+        if verify_path(colliders, robot, route).distance < robot.clearance + 1e-5:
+            continue
+        timed = timed_path(route, tracks, radii, robot.inflation, limits, tubes, heading=float(spawn.yaw),
+                           loops=loops)
+        if timed is not None:
+            return timed
+    return None
+
+
+def certify_off_path(report: FeasibilityReport, scene, tasks, robot, limits: Limits,
+                     behaviours: Optional[Sequence[str]] = None) -> FeasibilityReport:
+    """``report`` (:func:`worldgen.people.timed.certify`'s) with a timed path off the static path for every task
+    that has a static path and no timed path along it, and its ``timed_path`` check made again: passed when
+    every task now has one. ``behaviours`` as for ``certify``."""
+    agents = list(scene.movers)
+    tracks = [np.asarray(m.trajectory, dtype=float) for m in agents]
+    radii = [m.radius for m in agents]
+    loops = [m.loop and not m.person for m in agents]
+    reacting = iter(tube_of(b) for b in behaviours) if behaviours is not None else None
+    tubes = [next(reacting) if reacting is not None and m.person else Tube(0.0, 0.0) for m in agents]
+    colliders = None
+    found, moved, missing = list(report.timed_paths), 0, []
+    for q, (task, path) in enumerate(zip(tasks, report.paths)):
+        if found[q] is not None or path is None:
+            if path is None:
+                missing.append(f"{task.id}: no static path")
+            continue
+        if colliders is None:
+            from worldgen.feasibility.collision import Colliders
+            from worldgen.scene.doors import open_scene
+
+            colliders = Colliders(open_scene(scene))
+        found[q] = off_path(scene, colliders, task, path.waypoints, robot, limits, tracks, radii, tubes, loops)
+        moved += found[q] is not None
+        if found[q] is None:
+            missing.append(f"{task.id}: they leave no way through at <= {limits.max_speed:g} m/s, along the path "
+                           "or off it")
+    checks = tuple(c for c in report.checks if c.name != "timed_path")
+    among = _among(agents)
+    if missing:
+        check = Check("timed_path", False, None, f"no timed path among the {among} for " + "; ".join(missing))
+    else:
+        latest = max(t.arrival for t in found if t is not None)
+        check = Check("timed_path", True, latest, f"{len(found)} timed path(s) among {among} ({moved} off the "
+                      f"static path), latest arrival {latest:.2f} s")
+    return replace(report, checks=checks + (check,), timed_paths=tuple(found))
