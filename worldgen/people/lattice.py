@@ -19,19 +19,24 @@ step) plus ``room``: how far the exact sweep may drift from the witness's timing
 None of this is the certificate: the route is proven again by FCL and timed by the exact sweep
 (:func:`worldgen.people.timed.timed_path`), which alone decides. A forward sweep keeps the (heading, cell)
 states the robot can be in; the first step a cell within :data:`GOAL_SHARE` of the goal tolerance is held
-gives the route, read back as the cells where the heading changes.
+gives the route, read back as the cells where the heading changes. Two things end it early: no state left,
+and (once every person stands) no free cell of the goal's connected to a state through cells no standing
+person covers. :func:`lattice_reachable` asks the same of a robot that turns in no time (one state a cell,
+8 times fewer): where even it finds no way, the turning sweep is not run.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Optional, Sequence
 
 import numpy as np
 
 from worldgen.scene.motion import positions_at
 
-__all__ = ["DT", "BORDER", "PACE", "GOAL_SHARE", "HEADINGS", "turn_steps", "lattice_route"]
+__all__ = ["DT", "BORDER", "PACE", "GOAL_SHARE", "HEADINGS", "Floor", "Agents", "floor_of", "turn_steps",
+           "lattice_reachable", "lattice_route"]
 
 #: s between two steps of the lattice.
 DT = 0.1
@@ -55,17 +60,25 @@ def turn_steps(angle: float, limits) -> int:
     return math.ceil(angle / (limits.turn_rate * DT) - 1e-9) + math.ceil(limits.max_speed / (limits.acceleration * DT))
 
 
-def lattice_route(footprints, bounds, spawn, yaw: float, goal, tolerance: float, waypoints,
-                  tracks: Sequence[np.ndarray], radii: Sequence[float], tubes, loops: Sequence[bool],
-                  inflation: float, keep: float, limits, horizon: float, room: float) -> Optional[np.ndarray]:
-    """(m, 2) the route (spawn first, then every cell where the witness turns, then the goal) of the earliest
-    witness from ``spawn`` (facing ``yaw``) to ``goal`` within ``horizon`` s, or None.
+@dataclass(frozen=True, eq=False)
+class Floor:
+    """The grid of one task: ``xs`` (nx,) and ``ys`` (ny,) its coordinates (m), ``static`` (ny, nx) the cells free
+    of the static world, ``at_goal`` the goal's cells, ``spawn`` the spawn's (row, column), ``ends`` the spawn's
+    and the goal's (x, y)."""
 
-    ``footprints`` (the robot's, doors open) and ``bounds`` the static world; ``tracks`` (k, 3) ``t, x, y``,
-    ``radii``, ``tubes`` (``d``, ``tau``) and ``loops`` the agents; ``inflation`` the robot's, ``keep`` what the
-    certificate keeps beyond it (MARGIN and the tracking margin), ``room`` what the witness keeps beyond that."""
-    top = limits.max_speed
-    h = PACE * top * DT / math.sqrt(2.0)
+    xs: np.ndarray
+    ys: np.ndarray
+    static: np.ndarray
+    at_goal: np.ndarray
+    spawn: tuple[int, int]
+    ends: tuple[tuple[float, float], tuple[float, float]]
+
+
+def floor_of(footprints, bounds, spawn, goal, tolerance: float, waypoints, inflation: float,
+             limits) -> Optional[Floor]:
+    """The :class:`Floor` of a task from ``spawn`` to ``goal`` (x, y) whose static path is ``waypoints`` (k, 2),
+    among ``footprints`` (the robot's, doors open) inside ``bounds``; None where no cell is the goal's."""
+    h = PACE * limits.max_speed * DT / math.sqrt(2.0)
     xs, ys = _axes(bounds, spawn, goal, waypoints, h)
     si, sj = int(np.argmin(np.abs(ys - spawn[1]))), int(np.argmin(np.abs(xs - spawn[0])))
     # Between neighbouring centres (a move of L <= h sqrt 2) the distance to a convex footprint dips below the
@@ -76,43 +89,95 @@ def lattice_route(footprints, bounds, spawn, yaw: float, goal, tolerance: float,
     at_goal = (np.hypot(gx - goal[0], gy - goal[1]) <= tolerance * GOAL_SHARE) & static
     if not at_goal.any():
         return None
-    fastest = max([_fastest(t) for t in tracks], default=0.0)
-    reach = np.array([inflation + keep + room + float(r) + float(tube.d) + (top + fastest) * DT / 2
-                      for r, tube in zip(radii, tubes)])
-    window = np.array([0 if tube.tau <= 0 else math.ceil(tube.tau / DT + 0.5 - 1e-9) for tube in tubes], dtype=int)
+    return Floor(xs, ys, static, at_goal, (si, sj), ((float(spawn[0]), float(spawn[1])), (float(goal[0]), float(goal[1]))))
+
+
+class Agents:
+    """Where the agents block a :class:`Floor`, step by step: a cell is blocked when an agent (``tracks`` (k, 3)
+    ``t, x, y``, ``radii``, ``tubes``, ``loops``) is within its reach, ``keep`` (the robot's inflation and what
+    the certificate keeps beyond it) + its radius + its tube's ``d`` + ``room`` + what the robot at ``top`` m/s
+    and the fastest agent close in half a step, at a step of its tube's window round the step."""
+
+    def __init__(self, floor: Floor, tracks: Sequence[np.ndarray], radii: Sequence[float], tubes,
+                 loops: Sequence[bool], keep: float, room: float, top: float):
+        fastest = max([_fastest(t) for t in tracks], default=0.0)
+        self.floor, self.tracks, self.loops = floor, list(tracks), [bool(x) for x in loops]
+        self.reach = np.array([keep + room + float(r) + float(tube.d) + (top + fastest) * DT / 2
+                               for r, tube in zip(radii, tubes)])
+        self.window = np.array([0 if tube.tau <= 0 else math.ceil(tube.tau / DT + 0.5 - 1e-9) for tube in tubes],
+                               dtype=int)
+        self._blocked = np.zeros((0,) + floor.static.shape, dtype=bool)
+        still = [not loop for loop in self.loops]
+        # From this step on every person stands (after its last row and its tube's time): the cells they cover
+        # stay covered, and the goal is reachable through the rest (the loops only take more) or never.
+        self.settled = math.ceil(max([float(t[-1, 0]) for t, s in zip(self.tracks, still) if s] + [0.0]) / DT) \
+            + int(self.window.max(initial=0)) + 1
+        self._still = np.array(still, dtype=bool)
+
+    def free(self, k: int) -> np.ndarray:
+        """(ny, nx) the cells free of the static world and of every agent at step ``k``."""
+        while k >= len(self._blocked):
+            more = _blocked(self.floor.xs, self.floor.ys, self.tracks, self.loops, self.reach, self.window,
+                            len(self._blocked), _CHUNK)
+            self._blocked = np.concatenate([self._blocked, more])
+        return self.floor.static & ~self._blocked[k]
+
+    def lasting(self) -> np.ndarray:
+        """(ny, nx) the cells free of the static world and of every person standing where it ends, for ever."""
+        who = np.flatnonzero(self._still)
+        stand = _blocked(self.floor.xs, self.floor.ys, [self.tracks[j] for j in who], [False] * len(who),
+                         self.reach[who], np.zeros(len(who), dtype=int), self.settled, 1)[0]
+        return self.floor.static & ~stand
+
+
+def lattice_reachable(agents: Agents, steps: int) -> bool:
+    """Whether a robot that turns in no time reaches the goal's cells within ``steps`` steps (each a wait or
+    a move to one of the 8 neighbours): where it does not, no witness of :func:`lattice_route` does."""
+    floor = agents.floor
+    now = np.zeros(floor.static.shape, dtype=bool)
+    now[floor.spawn] = True
+    for k in range(steps + 1):
+        if k:
+            grown = now.copy()
+            for di, dj in HEADINGS:
+                grown |= _shifted(now, di, dj)
+            now = grown
+        now &= agents.free(k)
+        if (now & floor.at_goal).any():
+            return True
+        if not now.any() or (k == agents.settled and not _reaches_goal(now[None], agents.lasting(), floor.at_goal)):
+            return False
+    return False
+
+
+def lattice_route(agents: Agents, yaw: float, limits, steps: int) -> Optional[np.ndarray]:
+    """(m, 2) the route (the spawn, every cell where the witness turns, the goal) of the earliest witness that
+    starts at rest facing ``yaw`` and turns within ``limits`` (:func:`turn_steps`), within ``steps`` steps;
+    None where there is none."""
+    floor = agents.floor
     offset = [abs((k * math.pi / 4 - yaw + math.pi) % (2 * math.pi) - math.pi) for k in range(8)]
     first = [math.ceil(a / (limits.turn_rate * DT) - 1e-9) for a in offset]  # steps to face heading k at the spawn
-    agents = (tracks, loops, reach, window)
-    got = _sweep(xs, ys, static, at_goal, (si, sj), first, turn_steps(math.pi / 4, limits), agents,
-                 int(math.ceil(horizon / DT)))
+    got = _sweep(agents, first, turn_steps(math.pi / 4, limits), steps)
     if got is None:
         return None
-    pts = np.array([[xs[j], ys[i]] for i, j in got])
-    pts[0] = spawn[:2]
-    return _corners(np.vstack([pts, np.asarray(goal[:2], dtype=float)[None]]))
+    pts = np.array([[floor.xs[j], floor.ys[i]] for i, j in got])
+    pts[0] = floor.ends[0]
+    return _corners(np.vstack([pts, np.asarray(floor.ends[1], dtype=float)[None]]))
 
 
-def _sweep(xs, ys, static, at_goal, spawn: tuple[int, int], first, turn: int, agents,
-           steps: int) -> Optional[list[tuple[int, int]]]:
+def _sweep(agents: Agents, first, turn: int, steps: int) -> Optional[list[tuple[int, int]]]:
     """The cells of the earliest witness (see the module's docstring) within ``steps`` steps, or None."""
-    tracks, loops, reach, window = agents
+    floor = agents.floor
+    static, at_goal, spawn = floor.static, floor.at_goal, floor.spawn
     shape = (8,) + static.shape
     movable = static[None] & np.stack([_shifted(static, -di, -dj) for di, dj in HEADINGS])  # moves stay on free floor
     held: list[np.ndarray] = []  # per step, the (8, ny, nx) states, bit-packed
     frees: list[np.ndarray] = []  # per step, the free cells, bit-packed
     recent: list[np.ndarray] = []  # the last ``turn`` steps' states, unpacked
     run = np.zeros(static.shape, dtype=np.int32)  # steps each cell has been free in a row, up to this one
-    blocked = np.zeros((0,) + static.shape, dtype=bool)
-    # Once every person stands (after its last row and its tube's time), the cells they cover stay covered:
-    # the goal is then reachable through the rest (the loops only take more) or never.
-    still = [not loop for loop in loops]
-    settled = math.ceil(max([float(t[-1, 0]) for t, s in zip(tracks, still) if s] + [0.0]) / DT) \
-        + int(window.max(initial=0)) + 1
     left, right = [(d - 1) % 8 for d in range(8)], [(d + 1) % 8 for d in range(8)]
     for k in range(steps + 1):
-        if k == len(blocked):
-            blocked = np.concatenate([blocked, _blocked(xs, ys, tracks, loops, reach, window, k, _CHUNK)])
-        free = static & ~blocked[k]
+        free = agents.free(k)
         run = np.where(free, run + 1, 0)
         now = np.zeros(shape, dtype=bool)
         if k:
@@ -135,13 +200,8 @@ def _sweep(xs, ys, static, at_goal, spawn: tuple[int, int], first, turn: int, ag
             return _read_back(lambda step: _unpacked(held[step], shape),
                               lambda step: _unpacked(frees[step], static.shape), k, movable, turn, first, spawn,
                               at_goal)
-        if not now.any():
+        if not now.any() or (k == agents.settled and not _reaches_goal(now, agents.lasting(), at_goal)):
             return None
-        if k == settled:
-            standing = _blocked(xs, ys, [t for t, s in zip(tracks, still) if s], [False] * sum(still),
-                                reach[still], np.zeros(sum(still), dtype=int), k, 1)[0]
-            if not _reaches_goal(now, static & ~standing, at_goal):
-                return None
     return None
 
 

@@ -21,6 +21,7 @@ one finds ways a wide one cannot.
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from typing import Optional, Sequence
 
@@ -28,7 +29,7 @@ import numpy as np
 
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.people.behaviours import Tube, tube_of
-from worldgen.people.lattice import lattice_route
+from worldgen.people.lattice import DT, PACE, Agents, floor_of, lattice_reachable, lattice_route
 from worldgen.people.timed import MARGIN, TRACKING, Limits, TimedPath, _among, timed_path
 
 __all__ = ["ROOMS", "AFTER", "off_path", "certify_off_path"]
@@ -46,27 +47,29 @@ def off_path(scene, colliders, task, waypoints, robot, limits: Limits, tracks: S
     ``radii``, ``tubes``, ``loops``), within ``limits``, its route clear of ``colliders`` (the scene's,
     doors open) by FCL; None where no room of :data:`ROOMS` gives one."""
     from worldgen.feasibility.verify import verify_path
-    from worldgen.people.lattice import PACE
     from worldgen.scene.doors import open_scene
     from worldgen.scene.footprint import robot_footprints
 
-    footprints = robot_footprints(open_scene(scene), robot)
-    w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
-    length = float(np.hypot(*np.diff(w, axis=0).T).sum())
-    loops = [bool(x) for x in loops]
-    end = max([float(t[-1, 0]) for t in tracks] + [0.0])
-    horizon = end + 2.0 * length / (PACE * limits.max_speed / np.sqrt(2.0)) + AFTER
     spawn, goal = task.spawn, task.goal
+    w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+    floor = floor_of(robot_footprints(open_scene(scene), robot), scene.bounds, (spawn.x, spawn.y), (goal.x, goal.y),
+                     float(task.goal_tolerance), w, robot.inflation, limits)
+    if floor is None:
+        return None
+    length = float(np.hypot(*np.diff(w, axis=0).T).sum())
+    end = max([float(t[-1, 0]) for t in tracks] + [0.0])
+    steps = math.ceil((end + 2.0 * length / (PACE * limits.max_speed / math.sqrt(2.0)) + AFTER) / DT)
+    keep = robot.inflation + MARGIN + TRACKING
+    among = {room: Agents(floor, tracks, radii, tubes, loops, keep, room, limits.max_speed) for room in ROOMS}
+    # A wider room blocks more: where a robot that turns in no time finds no way at the narrowest, none does.
+    if not lattice_reachable(among[min(ROOMS)], steps):
+        return None
     for room in ROOMS:
-        route = lattice_route(footprints, scene.bounds, (spawn.x, spawn.y), float(spawn.yaw), (goal.x, goal.y),
-                              float(task.goal_tolerance), w, tracks, radii, tubes, loops, robot.inflation,
-                              MARGIN + TRACKING, limits, horizon, room)
-        if route is None:
+        route = lattice_route(among[room], float(spawn.yaw), limits, steps)
+        if route is None or verify_path(colliders, robot, route).distance < robot.clearance + 1e-5:
             continue  # a narrower room may find a way a wider one blocks
-        if verify_path(colliders, robot, route).distance < robot.clearance + 1e-5:
-            continue
         timed = timed_path(route, tracks, radii, robot.inflation, limits, tubes, heading=float(spawn.yaw),
-                           loops=loops)
+                           loops=[bool(x) for x in loops])
         if timed is not None:
             return timed
     return None
