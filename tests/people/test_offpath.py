@@ -109,3 +109,18 @@ def test_generation_falls_back_off_the_path_only_where_the_sweep_along_it_fails(
     check_timed(meta, world)
     along = worldgen.generate("corridor", seed=0, width=3.0, n_movers=1)
     assert "off the static path" not in along.feasibility.checks[-1].detail
+
+
+def test_a_corner_passed_moving_is_granted_only_to_rows_that_come_and_leave_along_the_paths_legs():
+    """worldgen check lets a turn of at most 0.3 rad at a waypoint of the recorded path go without a stand where
+    the arc of the path's two legs covers it; rows off the path that pass through that waypoint from elsewhere
+    turn there by their own angle, which no arc of the path's covers: they get no such leave (the FCL chord is
+    never asked, hence no colliders)."""
+    from worldgen.verify.timed import _moving
+
+    task = {"path": {"waypoints": [[0.0, 0.0], [1.0, 0.0], [2.0, 0.2]]}}  # a 0.197 rad corner at (1, 0)
+    robot = {"max_turn_rate": 1.0, "max_speed": 0.5}
+    off = np.array([[0.0, 0.5, 0.5], [2.0, 1.0, 0.0], [4.0, 2.0, 0.2]])  # comes to it across the first leg
+    assert _moving(task, off, robot, None, None) == []
+    leaves = np.array([[0.0, 0.0, 0.0], [2.0, 1.0, 0.0], [4.0, 1.5, 0.5]])  # leaves it off the second leg
+    assert _moving(task, leaves, robot, None, None) == []
