@@ -2,7 +2,8 @@
 known schedules (the witness :mod:`worldgen.people.offpath` reads an off-path certificate's route from).
 
 The floor near a task (the box round its spawn, goal and static path, :data:`BORDER` wider, inside the
-scene's bounds) is a grid of cells ``h`` apart through the spawn; time is steps of :data:`DT`. The robot is
+scene's bounds) is a grid of cells ``h`` apart through the spawn; time is steps of :data:`DT` (longer on a
+floor that would hold more than :data:`MAX_CELLS` cells: the cells grow with the step). The robot is
 in a cell facing one of 8 headings (multiples of 45 degrees). In a step it waits, or moves one cell along its
 heading (a diagonal cell is ``h sqrt 2`` away: ``h`` is chosen so that that is :data:`PACE` of the top speed
 in a step, the axes being slower still); it turns 45 degrees on the spot in :func:`turn_steps` steps, the turn
@@ -33,13 +34,17 @@ from typing import Optional, Sequence
 
 import numpy as np
 
+from worldgen.people.timed import DT as CERTIFICATE_DT
 from worldgen.scene.motion import positions_at
 
-__all__ = ["DT", "BORDER", "PACE", "GOAL_SHARE", "HEADINGS", "Floor", "Agents", "floor_of", "turn_steps",
+__all__ = ["DT", "MAX_CELLS", "BORDER", "PACE", "GOAL_SHARE", "HEADINGS", "Floor", "Agents", "floor_of", "turn_steps",
            "lattice_reachable", "lattice_route"]
 
-#: s between two steps of the lattice.
+#: s between two steps of the lattice, at most.
 DT = 0.1
+#: Most cells a grid holds: a larger floor takes longer steps (and larger cells) instead, which bounds the
+#: sweep's time (8 states a cell, every step) at some 10 ms a step.
+MAX_CELLS = 60_000
 #: m the grid reaches beyond the box round spawn, goal and static path.
 BORDER = 2.0
 #: Share of the top speed a diagonal move makes (the axes sqrt 2 slower): room for the exact sweep's speeding up.
@@ -54,17 +59,18 @@ _ROUNDING = 1e-3
 _CHUNK = 64
 
 
-def turn_steps(angle: float, limits) -> int:
-    """Steps a turn of ``angle`` rad on the spot takes within ``limits`` (:class:`~worldgen.people.timed.Limits`),
-    with the stop before it and the start after it (``max_speed / acceleration`` between them)."""
-    return math.ceil(angle / (limits.turn_rate * DT) - 1e-9) + math.ceil(limits.max_speed / (limits.acceleration * DT))
+def turn_steps(angle: float, limits, dt: float = DT) -> int:
+    """Steps of ``dt`` s a turn of ``angle`` rad on the spot takes within ``limits``
+    (:class:`~worldgen.people.timed.Limits`), with the stop before it and the start after it (``max_speed /
+    acceleration`` between them)."""
+    return math.ceil(angle / (limits.turn_rate * dt) - 1e-9) + math.ceil(limits.max_speed / (limits.acceleration * dt))
 
 
 @dataclass(frozen=True, eq=False)
 class Floor:
     """The grid of one task: ``xs`` (nx,) and ``ys`` (ny,) its coordinates (m), ``static`` (ny, nx) the cells free
     of the static world, ``at_goal`` the goal's cells, ``spawn`` the spawn's (row, column), ``ends`` the spawn's
-    and the goal's (x, y)."""
+    and the goal's (x, y), ``dt`` its step (s)."""
 
     xs: np.ndarray
     ys: np.ndarray
@@ -72,14 +78,20 @@ class Floor:
     at_goal: np.ndarray
     spawn: tuple[int, int]
     ends: tuple[tuple[float, float], tuple[float, float]]
+    dt: float
 
 
 def floor_of(footprints, bounds, spawn, goal, tolerance: float, waypoints, inflation: float,
              limits) -> Optional[Floor]:
     """The :class:`Floor` of a task from ``spawn`` to ``goal`` (x, y) whose static path is ``waypoints`` (k, 2),
     among ``footprints`` (the robot's, doors open) inside ``bounds``; None where no cell is the goal's."""
-    h = PACE * limits.max_speed * DT / math.sqrt(2.0)
+    dt = DT
+    h = PACE * limits.max_speed * dt / math.sqrt(2.0)
     xs, ys = _axes(bounds, spawn, goal, waypoints, h)
+    if len(xs) * len(ys) > MAX_CELLS:
+        dt *= math.sqrt(len(xs) * len(ys) / MAX_CELLS)
+        h = PACE * limits.max_speed * dt / math.sqrt(2.0)
+        xs, ys = _axes(bounds, spawn, goal, waypoints, h)
     si, sj = int(np.argmin(np.abs(ys - spawn[1]))), int(np.argmin(np.abs(xs - spawn[0])))
     # Between neighbouring centres (a move of L <= h sqrt 2) the distance to a convex footprint dips below the
     # ends' by at most L^2 / (8 inflation): centres that much farther out keep the whole move off it.
@@ -89,44 +101,60 @@ def floor_of(footprints, bounds, spawn, goal, tolerance: float, waypoints, infla
     at_goal = (np.hypot(gx - goal[0], gy - goal[1]) <= tolerance * GOAL_SHARE) & static
     if not at_goal.any():
         return None
-    return Floor(xs, ys, static, at_goal, (si, sj), ((float(spawn[0]), float(spawn[1])), (float(goal[0]), float(goal[1]))))
+    return Floor(xs, ys, static, at_goal, (si, sj), ((float(spawn[0]), float(spawn[1])), (float(goal[0]), float(goal[1]))),
+                 dt)
 
 
 class Agents:
     """Where the agents block a :class:`Floor`, step by step: a cell is blocked when an agent (``tracks`` (k, 3)
     ``t, x, y``, ``radii``, ``tubes``, ``loops``) is within its reach, ``keep`` (the robot's inflation and what
     the certificate keeps beyond it) + its radius + its tube's ``d`` + ``room`` + what the robot at ``top`` m/s
-    and the fastest agent close in half a step, at a step of its tube's window round the step."""
+    and the fastest agent close in half a step, at a step of its tube's window round the step.
+
+    The spawn's cell is blocked only within the certificate's own reach (no room, its own step): the robot
+    stands exactly there until it sets off, in the witness as in the certificate, and a mover that starts
+    0.6 m from it (movers start ``robot.inflation + radius`` from it) would else block the witness at t = 0."""
 
     def __init__(self, floor: Floor, tracks: Sequence[np.ndarray], radii: Sequence[float], tubes,
                  loops: Sequence[bool], keep: float, room: float, top: float):
         fastest = max([_fastest(t) for t in tracks], default=0.0)
         self.floor, self.tracks, self.loops = floor, list(tracks), [bool(x) for x in loops]
-        self.reach = np.array([keep + room + float(r) + float(tube.d) + (top + fastest) * DT / 2
+        dt = floor.dt
+        self.reach = np.array([keep + room + float(r) + float(tube.d) + (top + fastest) * dt / 2
                                for r, tube in zip(radii, tubes)])
-        self.window = np.array([0 if tube.tau <= 0 else math.ceil(tube.tau / DT + 0.5 - 1e-9) for tube in tubes],
+        self._at_spawn = (np.array([floor.ends[0][0]]), np.array([floor.ends[0][1]]))
+        self._spawn_reach = np.array([keep + float(r) + float(tube.d) + (top + fastest) * CERTIFICATE_DT / 2
+                                      for r, tube in zip(radii, tubes)])
+        self.window = np.array([0 if tube.tau <= 0 else math.ceil(tube.tau / dt + 0.5 - 1e-9) for tube in tubes],
                                dtype=int)
         self._blocked = np.zeros((0,) + floor.static.shape, dtype=bool)
         still = [not loop for loop in self.loops]
         # From this step on every person stands (after its last row and its tube's time): the cells they cover
         # stay covered, and the goal is reachable through the rest (the loops only take more) or never.
-        self.settled = math.ceil(max([float(t[-1, 0]) for t, s in zip(self.tracks, still) if s] + [0.0]) / DT) \
+        self.settled = math.ceil(max([float(t[-1, 0]) for t, s in zip(self.tracks, still) if s] + [0.0]) / dt) \
             + int(self.window.max(initial=0)) + 1
         self._still = np.array(still, dtype=bool)
 
     def free(self, k: int) -> np.ndarray:
         """(ny, nx) the cells free of the static world and of every agent at step ``k``."""
         while k >= len(self._blocked):
-            more = _blocked(self.floor.xs, self.floor.ys, self.tracks, self.loops, self.reach, self.window,
-                            len(self._blocked), _CHUNK)
+            k0 = len(self._blocked)
+            more = _blocked(self.floor.xs, self.floor.ys, self.tracks, self.loops, self.reach, self.window, k0,
+                            _CHUNK, self.floor.dt)
+            more[(slice(None),) + self.floor.spawn] = _blocked(*self._at_spawn, self.tracks, self.loops,
+                                                               self._spawn_reach, self.window, k0, _CHUNK,
+                                                               self.floor.dt)[:, 0, 0]
             self._blocked = np.concatenate([self._blocked, more])
         return self.floor.static & ~self._blocked[k]
 
     def lasting(self) -> np.ndarray:
         """(ny, nx) the cells free of the static world and of every person standing where it ends, for ever."""
         who = np.flatnonzero(self._still)
-        stand = _blocked(self.floor.xs, self.floor.ys, [self.tracks[j] for j in who], [False] * len(who),
-                         self.reach[who], np.zeros(len(who), dtype=int), self.settled, 1)[0]
+        tracks, none, still = [self.tracks[j] for j in who], np.zeros(len(who), dtype=int), [False] * len(who)
+        stand = _blocked(self.floor.xs, self.floor.ys, tracks, still, self.reach[who], none, self.settled, 1,
+                         self.floor.dt)[0]
+        stand[self.floor.spawn] = _blocked(*self._at_spawn, tracks, still, self._spawn_reach[who], none, self.settled,
+                                           1, self.floor.dt)[0, 0, 0]
         return self.floor.static & ~stand
 
 
@@ -156,8 +184,8 @@ def lattice_route(agents: Agents, yaw: float, limits, steps: int) -> Optional[np
     None where there is none."""
     floor = agents.floor
     offset = [abs((k * math.pi / 4 - yaw + math.pi) % (2 * math.pi) - math.pi) for k in range(8)]
-    first = [math.ceil(a / (limits.turn_rate * DT) - 1e-9) for a in offset]  # steps to face heading k at the spawn
-    got = _sweep(agents, first, turn_steps(math.pi / 4, limits), steps)
+    first = [math.ceil(a / (limits.turn_rate * floor.dt) - 1e-9) for a in offset]  # steps to face heading k first
+    got = _sweep(agents, first, turn_steps(math.pi / 4, limits, floor.dt), steps)
     if got is None:
         return None
     pts = np.array([[floor.xs[j], floor.ys[i]] for i, j in got])
@@ -176,6 +204,7 @@ def _sweep(agents: Agents, first, turn: int, steps: int) -> Optional[list[tuple[
     recent: list[np.ndarray] = []  # the last ``turn`` steps' states, unpacked
     run = np.zeros(static.shape, dtype=np.int32)  # steps each cell has been free in a row, up to this one
     left, right = [(d - 1) % 8 for d in range(8)], [(d + 1) % 8 for d in range(8)]
+    last = max(first)  # until then the spawn still seeds headings it has turned to
     for k in range(steps + 1):
         free = agents.free(k)
         run = np.where(free, run + 1, 0)
@@ -200,7 +229,8 @@ def _sweep(agents: Agents, first, turn: int, steps: int) -> Optional[list[tuple[
             return _read_back(lambda step: _unpacked(held[step], shape),
                               lambda step: _unpacked(frees[step], static.shape), k, movable, turn, first, spawn,
                               at_goal)
-        if not now.any() or (k == agents.settled and not _reaches_goal(now, agents.lasting(), at_goal)):
+        if k >= last and (not now.any() or (k == max(agents.settled, last)
+                                            and not _reaches_goal(now, agents.lasting(), at_goal))):
             return None
     return None
 
@@ -240,14 +270,14 @@ def _fastest(track: np.ndarray) -> float:
     return float(np.max(np.hypot(d[:, 1], d[:, 2]) / np.maximum(d[:, 0], 1e-12))) if len(d) else 0.0
 
 
-def _blocked(xs, ys, tracks, loops, reach, window, k0: int, n: int) -> np.ndarray:
+def _blocked(xs, ys, tracks, loops, reach, window, k0: int, n: int, dt: float) -> np.ndarray:
     """(n, ny, nx) bool: the cells some agent is within its reach of at steps ``k0`` to ``k0 + n - 1``, an agent
     with a tube at any step of its ``window`` round the step."""
     out = np.zeros((n, len(ys), len(xs)), dtype=bool)
     for j, track in enumerate(tracks):
         w = int(window[j])
         ks = np.arange(k0 - w, k0 + n + w)
-        pos = positions_at([np.asarray(track, dtype=float)], [bool(loops[j])], np.maximum(ks, 0) * DT)[:, 0]
+        pos = positions_at([np.asarray(track, dtype=float)], [bool(loops[j])], np.maximum(ks, 0) * dt)[:, 0]
         raw = np.zeros((len(ks), len(ys), len(xs)), dtype=bool)
         r = float(reach[j])
         for s, (px, py) in enumerate(pos):

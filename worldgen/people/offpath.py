@@ -29,7 +29,7 @@ import numpy as np
 
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.people.behaviours import Tube, tube_of
-from worldgen.people.lattice import DT, PACE, Agents, floor_of, lattice_reachable, lattice_route
+from worldgen.people.lattice import PACE, Agents, floor_of, lattice_reachable, lattice_route
 from worldgen.people.timed import MARGIN, TRACKING, Limits, TimedPath, _among, timed_path
 
 __all__ = ["ROOMS", "AFTER", "off_path", "certify_off_path"]
@@ -58,7 +58,7 @@ def off_path(scene, colliders, task, waypoints, robot, limits: Limits, tracks: S
         return None
     length = float(np.hypot(*np.diff(w, axis=0).T).sum())
     end = max([float(t[-1, 0]) for t in tracks] + [0.0])
-    steps = math.ceil((end + 2.0 * length / (PACE * limits.max_speed / math.sqrt(2.0)) + AFTER) / DT)
+    steps = math.ceil((end + 2.0 * length / (PACE * limits.max_speed / math.sqrt(2.0)) + AFTER) / floor.dt)
     keep = robot.inflation + MARGIN + TRACKING
     among = {room: Agents(floor, tracks, radii, tubes, loops, keep, room, limits.max_speed) for room in ROOMS}
     # A wider room blocks more: where a robot that turns in no time finds no way at the narrowest, none does.
