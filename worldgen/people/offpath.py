@@ -32,13 +32,16 @@ from worldgen.people.behaviours import Tube, tube_of
 from worldgen.people.lattice import PACE, Agents, floor_of, lattice_reachable, lattice_route
 from worldgen.people.timed import MARGIN, TRACKING, Limits, TimedPath, _among, timed_path
 
-__all__ = ["ROOMS", "AFTER", "off_path", "certify_off_path"]
+__all__ = ["ROOMS", "AFTER", "MAX_WORK", "off_path", "certify_off_path"]
 
 #: m the witness keeps from every agent beyond the certificate's reach, tried in turn.
 ROOMS = (0.15, 0.05)
 #: s the witness may take beyond the time everyone stops (or the slowest loop comes round) and twice the
 #: static path at the witness's axis speed.
 AFTER = 10.0
+#: Most cell-steps a witness is sought over (its stored states take a byte each): 2,000 steps of a 10 x 3 m
+#: corridor, 200 s; a longer horizon is cut there.
+MAX_WORK = 60_000_000
 
 
 def off_path(scene, colliders, task, waypoints, robot, limits: Limits, tracks: Sequence[np.ndarray],
@@ -59,6 +62,7 @@ def off_path(scene, colliders, task, waypoints, robot, limits: Limits, tracks: S
     length = float(np.hypot(*np.diff(w, axis=0).T).sum())
     end = max([float(t[-1, 0]) for t in tracks] + [0.0])
     steps = math.ceil((end + 2.0 * length / (PACE * limits.max_speed / math.sqrt(2.0)) + AFTER) / floor.dt)
+    steps = min(steps, MAX_WORK // floor.static.size)  # a slow mover's long loop would hold every step's states
     keep = robot.inflation + MARGIN + TRACKING
     among = {room: Agents(floor, tracks, radii, tubes, loops, keep, room, limits.max_speed) for room in ROOMS}
     # A wider room blocks more: where a robot that turns in no time finds no way at the narrowest, none does.
