@@ -1,25 +1,21 @@
 """A route off the static path: where a robot that turns on the spot can be, step by step, among agents on
 known schedules (the witness :mod:`worldgen.people.offpath` reads an off-path certificate's route from).
 
-The floor near a task (the box round its spawn, goal and static path, :data:`BORDER` wider, inside the
-scene's bounds) is a grid of cells ``h`` apart through the spawn; time is steps of :data:`DT` (longer on a
-floor that would hold more than :data:`MAX_CELLS` cells: the cells grow with the step). The robot is
-in a cell facing one of 8 headings (multiples of 45 degrees). In a step it waits, or moves one cell along its
-heading (a diagonal cell is ``h sqrt 2`` away: ``h`` is chosen so that that is :data:`PACE` of the top speed
-in a step, the axes being slower still); it turns 45 degrees on the spot in :func:`turn_steps` steps, the turn
-itself at the stated turn rate plus the time a stop and a start cost at the stated acceleration. So the
-witness is slower than the robot everywhere, which lets the exact sweep along its route keep up with it.
+On a task's grid (:mod:`worldgen.people.grid`: cells ``h`` apart, steps of ``dt``) the robot is in a cell
+facing one of 8 headings (multiples of 45 degrees). In a step it waits, or moves one cell along its heading
+(a diagonal cell is ``h sqrt 2`` away, :data:`~worldgen.people.grid.PACE` of the top speed in a step, the axes
+being slower still); it turns 45 degrees on the spot in :func:`turn_steps` steps, the turn itself at the
+stated turn rate plus the time a stop and a start cost at the stated acceleration. So the witness is slower
+than the robot everywhere, which lets the exact sweep along its route keep up with it.
 
-A cell is free of the static world when its centre is ``robot.inflation`` from every footprint below the
-robot's top (doors at their open limit, as the static planner has them), plus the most a straight move to a
-neighbour can dip toward a convex footprint; free of an agent at a step when its centre is farther than the
-agent's reach from every position the agent's tube allows round the step. The reach is the certificate's
-(robot inflation, the agent's radius and tube, MARGIN and the tracking margin, and what both close in half a
-step) plus ``room``: how far the exact sweep may drift from the witness's timing and still find the cell clear.
+A cell is free of an agent at a step when its centre is farther than the agent's reach from every position
+the agent's tube allows round the step (:class:`Agents`). The reach is the certificate's (robot inflation,
+the agent's radius and tube, MARGIN and the tracking margin, and what both close in half a step) plus
+``room``: how far the exact sweep may drift from the witness's timing and still find the cell clear.
 
 None of this is the certificate: the route is proven again by FCL and timed by the exact sweep
 (:func:`worldgen.people.timed.timed_path`), which alone decides. A forward sweep keeps the (heading, cell)
-states the robot can be in; the first step a cell within :data:`GOAL_SHARE` of the goal tolerance is held
+states the robot can be in; the first step one of the goal's cells is held
 gives the route, read back as the cells where the heading changes. Two things end it early: no state left,
 and (once every person stands) no free cell of the goal's connected to a state through cells no standing
 person covers. :func:`lattice_reachable` asks the same of a robot that turns in no time (one state a cell,
@@ -29,32 +25,18 @@ person covers. :func:`lattice_reachable` asks the same of a robot that turns in 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Optional, Sequence
 
 import numpy as np
 
+from worldgen.people.grid import DT, Floor
 from worldgen.people.timed import DT as CERTIFICATE_DT
 from worldgen.scene.motion import positions_at
 
-__all__ = ["DT", "MAX_CELLS", "BORDER", "PACE", "GOAL_SHARE", "HEADINGS", "Floor", "Agents", "floor_of", "turn_steps",
-           "lattice_reachable", "lattice_route"]
+__all__ = ["HEADINGS", "Agents", "turn_steps", "lattice_reachable", "lattice_route"]
 
-#: s between two steps of the lattice, at most.
-DT = 0.1
-#: Most cells a grid holds: a larger floor takes longer steps (and larger cells) instead, which bounds the
-#: sweep's time (8 states a cell, every step) at some 10 ms a step.
-MAX_CELLS = 60_000
-#: m the grid reaches beyond the box round spawn, goal and static path.
-BORDER = 2.0
-#: Share of the top speed a diagonal move makes (the axes sqrt 2 slower): room for the exact sweep's speeding up.
-PACE = 0.9
-#: Share of the goal tolerance within which a cell counts as the goal's (the route then ends at the goal itself).
-GOAL_SHARE = 0.25
 #: The 8 headings as (rows, columns) a move shifts: heading k is k x 45 degrees from +x (rows are y, columns x).
 HEADINGS = ((0, 1), (1, 1), (1, 0), (1, -1), (0, -1), (-1, -1), (-1, 0), (-1, 1))
-#: m added to every growth of a footprint: more than shapely's chords lose on a rounded corner.
-_ROUNDING = 1e-3
 #: Steps whose agents' blocked cells are worked out at once.
 _CHUNK = 64
 
@@ -64,45 +46,6 @@ def turn_steps(angle: float, limits, dt: float = DT) -> int:
     (:class:`~worldgen.people.timed.Limits`), with the stop before it and the start after it (``max_speed /
     acceleration`` between them)."""
     return math.ceil(angle / (limits.turn_rate * dt) - 1e-9) + math.ceil(limits.max_speed / (limits.acceleration * dt))
-
-
-@dataclass(frozen=True, eq=False)
-class Floor:
-    """The grid of one task: ``xs`` (nx,) and ``ys`` (ny,) its coordinates (m), ``static`` (ny, nx) the cells free
-    of the static world, ``at_goal`` the goal's cells, ``spawn`` the spawn's (row, column), ``ends`` the spawn's
-    and the goal's (x, y), ``dt`` its step (s)."""
-
-    xs: np.ndarray
-    ys: np.ndarray
-    static: np.ndarray
-    at_goal: np.ndarray
-    spawn: tuple[int, int]
-    ends: tuple[tuple[float, float], tuple[float, float]]
-    dt: float
-
-
-def floor_of(footprints, bounds, spawn, goal, tolerance: float, waypoints, inflation: float,
-             limits) -> Optional[Floor]:
-    """The :class:`Floor` of a task from ``spawn`` to ``goal`` (x, y) whose static path is ``waypoints`` (k, 2),
-    among ``footprints`` (the robot's, doors open) inside ``bounds``; None where no cell is the goal's."""
-    dt = DT
-    h = PACE * limits.max_speed * dt / math.sqrt(2.0)
-    xs, ys = _axes(bounds, spawn, goal, waypoints, h)
-    if len(xs) * len(ys) > MAX_CELLS:
-        dt *= math.sqrt(len(xs) * len(ys) / MAX_CELLS)
-        h = PACE * limits.max_speed * dt / math.sqrt(2.0)
-        xs, ys = _axes(bounds, spawn, goal, waypoints, h)
-    si, sj = int(np.argmin(np.abs(ys - spawn[1]))), int(np.argmin(np.abs(xs - spawn[0])))
-    # Between neighbouring centres (a move of L <= h sqrt 2) the distance to a convex footprint dips below the
-    # ends' by at most L^2 / (8 inflation): centres that much farther out keep the whole move off it.
-    static = _clear_of(footprints, bounds, xs, ys, inflation + h * h / (4.0 * inflation) + _ROUNDING)
-    static[si, sj] = True  # the spawn is the world's, proven clear
-    gx, gy = np.meshgrid(xs, ys)
-    at_goal = (np.hypot(gx - goal[0], gy - goal[1]) <= tolerance * GOAL_SHARE) & static
-    if not at_goal.any():
-        return None
-    return Floor(xs, ys, static, at_goal, (si, sj), ((float(spawn[0]), float(spawn[1])), (float(goal[0]), float(goal[1]))),
-                 dt)
 
 
 class Agents:
@@ -233,36 +176,6 @@ def _sweep(agents: Agents, first, turn: int, steps: int) -> Optional[list[tuple[
                                             and not _reaches_goal(now, agents.lasting(), at_goal))):
             return None
     return None
-
-
-def _axes(bounds, spawn, goal, waypoints, h: float) -> tuple[np.ndarray, np.ndarray]:
-    """The grid's x and y coordinates: through the spawn, ``h`` apart, over the box round the task."""
-    pts = np.vstack([np.asarray(waypoints, dtype=float).reshape(-1, 2), np.asarray(spawn[:2], float),
-                     np.asarray(goal[:2], float)])
-    (bx0, by0), (bx1, by1) = bounds
-    x0, y0 = max(pts[:, 0].min() - BORDER, bx0), max(pts[:, 1].min() - BORDER, by0)
-    x1, y1 = min(pts[:, 0].max() + BORDER, bx1), min(pts[:, 1].max() + BORDER, by1)
-    sx, sy = float(spawn[0]), float(spawn[1])
-    xs = sx + h * np.arange(math.ceil((x0 - sx) / h), math.floor((x1 - sx) / h) + 1)
-    ys = sy + h * np.arange(math.ceil((y0 - sy) / h), math.floor((y1 - sy) / h) + 1)
-    return xs, ys
-
-
-def _clear_of(footprints, bounds, xs: np.ndarray, ys: np.ndarray, least: float) -> np.ndarray:
-    """(ny, nx) bool: grid points at least ``least`` from every footprint (a polygon or a disc) and from the
-    bounds. Each footprint is grown by ``least`` + :data:`_ROUNDING` (shapely's rounded corners are chords)."""
-    import shapely
-
-    gx, gy = np.meshgrid(xs, ys)
-    (bx0, by0), (bx1, by1) = bounds
-    inside = (gx - bx0 >= least) & (bx1 - gx >= least) & (gy - by0 >= least) & (by1 - gy >= least)
-    if not footprints:
-        return inside
-    shapes = [f.polygon if not f.is_disc else shapely.Point(f.centre).buffer(f.radius, quad_segs=16)
-              for f in footprints]
-    grown = shapely.union_all([shape.buffer(least + _ROUNDING, quad_segs=16) for shape in shapes])
-    shapely.prepare(grown)
-    return inside & ~shapely.contains_xy(grown, gx, gy)
 
 
 def _fastest(track: np.ndarray) -> float:

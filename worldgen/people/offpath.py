@@ -29,16 +29,20 @@ import numpy as np
 
 from worldgen.feasibility.report import Check, FeasibilityReport
 from worldgen.people.behaviours import Tube, tube_of
-from worldgen.people.lattice import PACE, Agents, floor_of, lattice_reachable, lattice_route
+from worldgen.people.grid import PACE, floor_of
+from worldgen.people.lattice import Agents, lattice_reachable, lattice_route
 from worldgen.people.timed import MARGIN, TRACKING, Limits, TimedPath, _among, timed_path
 
-__all__ = ["ROOMS", "AFTER", "MAX_WORK", "off_path", "certify_off_path"]
+__all__ = ["ROOMS", "AFTER", "DOOR_STRAY", "MAX_WORK", "off_path", "certify_off_path"]
 
 #: m the witness keeps from every agent beyond the certificate's reach, tried in turn.
 ROOMS = (0.15, 0.05)
 #: s the witness may take beyond the time everyone stops (or the slowest loop comes round) and twice the
 #: static path at the witness's axis speed.
 AFTER = 10.0
+#: m a route may stray from the static path within a door's reach (its hinge, its leaf's width and the robot's
+#: inflation): about where a doorway's own slack puts it.
+DOOR_STRAY = 0.15
 #: Most cell-steps a witness is sought over (its stored states take a byte each): 2,000 steps of a 10 x 3 m
 #: corridor, 200 s; a longer horizon is cut there.
 MAX_WORK = 60_000_000
@@ -50,11 +54,14 @@ def off_path(scene, colliders, task, waypoints, robot, limits: Limits, tracks: S
     ``radii``, ``tubes``, ``loops``), within ``limits``, its route clear of ``colliders`` (the scene's,
     doors open) by FCL; None where no room of :data:`ROOMS` gives one."""
     from worldgen.feasibility.verify import verify_path
-    from worldgen.scene.doors import open_scene
+    from worldgen.scene.doors import door_records, open_scene
     from worldgen.scene.footprint import robot_footprints
 
     spawn, goal = task.spawn, task.goal
     w = np.asarray(waypoints, dtype=float).reshape(-1, 2)
+    # A leaf at its open limit stands where the static world has it; a closed or ajar one is moved by the robot.
+    doors = [(d["hinge"][0], d["hinge"][1], d["width"] + robot.inflation) for d in door_records(scene)
+             if d["state"] != "open"]
     floor = floor_of(robot_footprints(open_scene(scene), robot), scene.bounds, (spawn.x, spawn.y), (goal.x, goal.y),
                      float(task.goal_tolerance), w, robot.inflation, limits)
     if floor is None:
@@ -70,13 +77,40 @@ def off_path(scene, colliders, task, waypoints, robot, limits: Limits, tracks: S
         return None
     for room in ROOMS:
         route = lattice_route(among[room], float(spawn.yaw), limits, steps)
-        if route is None or verify_path(colliders, robot, route).distance < robot.clearance + 1e-5:
+        if route is None or _strays(route, w, doors) or \
+                verify_path(colliders, robot, route).distance < robot.clearance + 1e-5:
             continue  # a narrower room may find a way a wider one blocks
         timed = timed_path(route, tracks, radii, robot.inflation, limits, tubes, heading=float(spawn.yaw),
                            loops=[bool(x) for x in loops])
         if timed is not None:
             return timed
     return None
+
+
+def _strays(route: np.ndarray, waypoints: np.ndarray, doors) -> bool:
+    """Whether ``route`` (m, 2) comes farther than :data:`DOOR_STRAY` from the static path ``waypoints`` anywhere
+    within the disc of a door not open (``doors``: (x, y, r), its hinge and its leaf's width plus the robot's
+    inflation).
+
+    Such a leaf stands where the static world has it, open, only once the robot has pushed or pulled it there,
+    and the static path is the way through that the drive opens: a route that stepped into an ajar push leaf's
+    sweep from beside it pressed the leaf shut on the robot, stuck (door seed 101, certified off the path by
+    force in benchmarks/bench_offpath.py)."""
+    import shapely
+
+    if not doors:
+        return False
+    seg = np.diff(route, axis=0)
+    n = np.maximum(1, np.ceil(np.hypot(*seg.T) / 0.02)).astype(int)
+    pts = np.vstack([route[i] + seg[i] * np.linspace(0.0, 1.0, k, endpoint=False)[:, None] for i, k in enumerate(n)]
+                    + [route[-1:]])
+    inside = np.zeros(len(pts), dtype=bool)
+    for x, y, r in doors:
+        inside |= np.hypot(pts[:, 0] - x, pts[:, 1] - y) <= r
+    if not inside.any():
+        return False
+    line = shapely.LineString(waypoints) if len(waypoints) > 1 else shapely.Point(waypoints[0])
+    return bool((shapely.distance(shapely.points(pts[inside]), line) > DOOR_STRAY).any())
 
 
 def certify_off_path(report: FeasibilityReport, scene, tasks, robot, limits: Limits,
