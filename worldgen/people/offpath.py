@@ -7,7 +7,8 @@ the same sweep (docs/people.md, "Off the path").
    ``room`` more than the certificate from every agent; its route is the polyline through the cells where
    it turns.
 2. The route is proven clear of the static geometry by FCL, the robot's disc swept along it keeping
-   ``robot.clearance`` (and 10 um more, for world.json's 6-decimal rows), as the static path was.
+   ``robot.clearance`` (and 10 um more, for world.json's 6-decimal rows), as the static path was; near a
+   door not open it keeps within :data:`DOOR_STRAY` of the static path (:func:`_strays`).
 3. :func:`worldgen.people.timed.timed_path` times the route exactly as it times a static path: top speed,
    acceleration, every corner turned on the spot at the turn rate (none passed moving: ``worldgen check``
    re-derives those from the recorded static path only), and the same reach from every person, tube and
