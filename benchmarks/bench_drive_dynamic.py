@@ -1,13 +1,14 @@
 """``worldgen drive`` in random dynamic worlds (issue 37): how many drives succeed, and why the others fail.
 
     .venv/bin/python benchmarks/bench_drive_dynamic.py [--worlds N] [--start SEED] [--all-cores]
-        [--sim mujoco|gazebo] [--gz-release RELEASE]
+        [--sim mujoco|gazebo] [--gz-release RELEASE] [--generator NAME]
 
 World k is drawn from its own seed (``--start`` + k): a generator (cluttered, door, barn, corridor,
 minimal, in turn), and for it movers (0 to 3), people (0 to 6, each behaviour in turn and a mix) and, in
 the door generator, every door's state and swing drawn (``state=random``, ``swing=random``). A draw the
 generator refuses (no timed path among the people, a door that cannot swing) is counted as refused and
-not driven. A drive succeeds when the judge passes the run (the goal reached in time, no collision) and
+not driven. ``--generator`` keeps only the draws of that generator (the same draws, the others skipped, not
+counted). A drive succeeds when the judge passes the run (the goal reached in time, no collision) and
 MuJoCo saw no contact of the robot but with door leaves (Gazebo's bridge reports no contacts: there the judge,
 which places every person and mover where world.json has them, decides alone). A failure is listed with what the drive
 followed (``plan``), how it ended, the first contact, the world's parameters and a ``cause`` read from
@@ -90,25 +91,31 @@ def cause(world, outcome) -> str:
     return "; ".join(why) or "unknown"
 
 
-def run(n: int, start: int, sim: str = "mujoco", gz_release=None) -> dict:
+def run(n: int, start: int, sim: str = "mujoco", gz_release=None, only=None) -> dict:
     import worldgen
     from worldgen.errors import InfeasibleError, WorldgenError
     from worldgen.sim.drive import drive
 
-    out = {"sim": sim, "gz_release": gz_release, "worlds": n, "start": start, "driven": 0, "refused": 0, "succeeded": 0,
-           "plans": {}, "drives": [], "failures": [], "refusals": []}
+    out = {"sim": sim, "gz_release": gz_release, "worlds": n, "start": start, "generator": only, "driven": 0,
+           "refused": 0, "succeeded": 0, "plans": {}, "drives": [], "failures": [], "refusals": []}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory(prefix="bench-drive-") as tmp:
         for k in range(n):
             generator, params = draw(k, start)
             seed = start + k
+            if only is not None and generator != only:
+                continue
+            cpu = time.process_time()
             try:
                 world = worldgen.generate(generator, seed=seed, **params)
             except InfeasibleError as exc:
                 out["refused"] += 1
                 out["refusals"].append({"generator": generator, "seed": seed, "params": params,
+                                        "generate_cpu": round(time.process_time() - cpu, 2),
                                         "why": str(exc).splitlines()[0][:200]})
+                print(f"{k:4d} {generator:9s} seed {seed:5d} refused", flush=True)
                 continue
+            cpu = time.process_time() - cpu
             # Gazebo loads world.sdf from disk
             where = world.write(Path(tmp) / "worlds", preview=False) if sim == "gazebo" else world
             t1 = time.perf_counter()
@@ -128,6 +135,8 @@ def run(n: int, start: int, sim: str = "mujoco", gz_release=None) -> dict:
             out["succeeded"] += ok
             meta = world.metadata_for({})
             out["drives"].append({"generator": generator, "seed": seed, "plan": outcome.plan, "ok": bool(ok),
+                                  "generate_cpu": round(cpu, 2), "attempts": world.attempts,
+                                  "off_path": "off the static path" in world.feasibility.checks[-1].detail,
                                   "wall": round(wall, 2), "sim_seconds": round(outcome.sim_seconds, 2),
                                   "movers": len(meta.get("dynamic_obstacles") or []),
                                   "people": len(meta.get("people") or []), "doors": len(meta.get("doors") or [])})
@@ -152,10 +161,11 @@ def main() -> None:
     parser.add_argument("--all-cores", action="store_true")
     parser.add_argument("--sim", choices=("mujoco", "gazebo"), default="mujoco")
     parser.add_argument("--gz-release", default=None, help="with --sim gazebo: the release (default: drive's)")
+    parser.add_argument("--generator", choices=GENERATORS, default=None, help="only the draws of this generator")
     args = parser.parse_args()
     if not args.all_cores and hasattr(os, "sched_setaffinity"):
         os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
-    result = run(args.worlds, args.start, args.sim, args.gz_release)
+    result = run(args.worlds, args.start, args.sim, args.gz_release, args.generator)
     result["machine"] = platform.platform()
     print(f"driven {result['driven']} of {result['worlds']} ({result['refused']} refused by the generator): "
           f"{result['succeeded']} succeeded; plans {result['plans']}; {result['seconds']} s")

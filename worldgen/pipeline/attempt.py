@@ -26,7 +26,7 @@ from worldgen.scene import Robot
 from worldgen.seeding import attempt_rng, mover_rng, people_rng
 from worldgen.world import World
 
-__all__ = ["Request", "Attempt", "prepare", "attempt", "first_feasible"]
+__all__ = ["Request", "Attempt", "prepare", "attempt", "first_feasible", "off_path_world"]
 
 #: Where a long request says what it is doing, one level below the request's own line (worldgen.cli.progress).
 _progress = logging.getLogger("worldgen.progress.attempt")
@@ -124,6 +124,7 @@ def first_feasible(request: Request) -> World:
     failures: Counter[str] = Counter()
     details: dict[str, str] = {}
     last: Optional[World] = None
+    stalled: list[World] = []  # draws that failed only for want of a timed path along the static path
     budget = request.params["max_attempts"]
     for number in range(budget):
         _progress.info("%s seed %d: attempt %d of max_attempts=%d", spec.name, seed, number + 1, budget)
@@ -135,6 +136,14 @@ def first_feasible(request: Request) -> World:
             details.setdefault(check, detail)
         if got.world is not None:
             last = got.world
+            if {check for check, _ in got.failed} == {"timed_path"}:
+                stalled.append(got.world)
+    for world in stalled:  # only now, so that every world the sweep along the path makes keeps its draw
+        _progress.info("%s seed %d: attempt %d: a timed path off the static path", spec.name, seed, world.attempts)
+        found = off_path_world(request, world)
+        if found.feasibility.feasible:
+            return found
+        details["timed_path"] = next(c.detail for c in found.feasibility.failed() if c.name == "timed_path")
     if request.allow_infeasible and last is not None:
         return last
     summary = ", ".join(f"{check} failed {count}x" for check, count in sorted(failures.items()))
@@ -146,6 +155,22 @@ def first_feasible(request: Request) -> World:
         f"no feasible '{spec.name}' world for seed {seed} within max_attempts={budget}: {summary}{hint}",
         dict(failures),
     )
+
+
+def off_path_world(request: Request, world: World) -> World:
+    """``world`` (a draw of ``request`` whose only failed check is ``timed_path``) with a timed path off the
+    static path for each task the sweep along it left without one (:mod:`worldgen.people.offpath`): a
+    feasible world where every task now has one, else one whose ``timed_path`` check says so."""
+    from worldgen.people.behaviours import behaviours_of
+    from worldgen.people.offpath import certify_off_path
+    from worldgen.people.timed import limits_of
+
+    params = request.params
+    behaviours = behaviours_of(params) if params.get("n_people") else None
+    report = certify_off_path(world.feasibility, world.scene, world.tasks, request.robot, limits_of(params),
+                              behaviours)
+    return World(world.generator, world.seed, params, world.scene, world.tasks, request.robot, report,
+                 world.attempts, request.allow_infeasible)
 
 
 def _failed(report) -> tuple[tuple[str, str], ...]:

@@ -210,6 +210,7 @@ def _pose_topics(topics: dict[str, str], pose_topic: str, odom_topic: str) -> bo
             or odom_topic in topics)
 
 
+# long: one pass over the bag's messages, a few lines for each topic's case, sharing the clock between them
 def _stream(reader, topics, pose_topic, model, odom_topic, cmd_topic, goal_topics, map_frame, odom_frame, base_frames,
             start, min_dt, distro) -> dict:
     """One pass over the topics that matter; returns the pose series and the start events."""

@@ -14,8 +14,9 @@ both stale, so a world with people is settled after its edits:
    (:func:`worldgen.people.crowd.walk_plan`) through the edited scene with the world's own parameters, and
    keep their names, so each keeps its behaviour and tube (world.json reads them off the name);
 3. every task is certified among them and the scripted movers still there
-   (:func:`worldgen.people.timed.certify`), each person with its behaviour; a world with movers and no
-   people is certified among its movers alone.
+   (:func:`worldgen.people.timed.certify`), each person with its behaviour, off the static path where no
+   timed path keeps to it (:func:`worldgen.people.offpath.certify_off_path`, as generation does); a world
+   with movers and no people is certified among its movers alone.
 
 Removing a person changes the others' walk (nobody steps round it any more), and removing an obstacle
 changes the walk and the reference paths: the re-walk is the truth, and what is certified. With nobody
@@ -34,6 +35,7 @@ import numpy as np
 from worldgen.errors import ParameterError
 from worldgen.people.behaviours import behaviours_of
 from worldgen.people.crowd import walk_plan
+from worldgen.people.offpath import certify_off_path
 from worldgen.people.places import PeoplePlan, draw_people
 from worldgen.people.timed import certify, limits_of
 from worldgen.scene import Scene
@@ -77,7 +79,7 @@ def settle(world, plan: Optional[PeoplePlan], scene: Scene, tasks, report):
     if not kept or plan is None:
         if not static.movers:
             return static, report
-        return static, certify(report, static, tasks, world.robot, limits_of(world.params))
+        return static, _certified(report, static, tasks, world.robot, limits_of(world.params), None)
     rows = np.array([person_index(m.name) for m in kept])
     some = PeoplePlan(plan.starts[rows], plan.places[rows], plan.speeds[rows], plan.radius, plan.duration,
                       plan.depart[rows], None if plan.groups is None else plan.groups[rows])
@@ -85,8 +87,17 @@ def settle(world, plan: Optional[PeoplePlan], scene: Scene, tasks, report):
     people = tuple(replace(m, name=k.name) for m, k in zip(walked, kept))
     scene = static.with_movers(static.movers + people)
     behaviours = behaviours_of(world.params)
-    return scene, certify(report, scene, tasks, world.robot, limits_of(world.params),
-                          [behaviours[i] for i in rows])
+    return scene, _certified(report, scene, tasks, world.robot, limits_of(world.params),
+                             [behaviours[i] for i in rows])
+
+
+def _certified(report, scene: Scene, tasks, robot, limits, behaviours):
+    """``report`` with every task's certificate, as generation makes it: along the static path, and off it for
+    a task that has none along it (:mod:`worldgen.people.offpath`)."""
+    certified = certify(report, scene, tasks, robot, limits, behaviours)
+    if certified.feasible or any(c.name != "timed_path" for c in certified.failed()):
+        return certified
+    return certify_off_path(certified, scene, tasks, robot, limits, behaviours)
 
 
 def _drew(plan: PeoplePlan, people) -> bool:

@@ -2,10 +2,10 @@
 
 The timed path (``tasks[].timed_path``, docs/people.md) is checked on its own terms, without the code
 that found it (:mod:`worldgen.people.timed`): rows from the spawn at t = 0 to the goal at
-``arrival_time``, times increasing, no faster than ``robot.max_speed``; every row on the recorded path
-(``tasks[].path.waypoints``) and each two consecutive rows on one leg of it, so the robot between them
-stays on the path and never cuts a corner; the rows' polyline clear of the static geometry by FCL (the
-regenerated scene, doors at their open limit, as the path was proven); and, sampled every
+``arrival_time``, times increasing, no faster than ``robot.max_speed``; the rows' polyline clear of the
+static geometry by FCL (the regenerated scene, doors at their open limit, as the path was proven), whether
+it keeps to the recorded path (``tasks[].path.waypoints``) or steps off it (a certificate off the path,
+docs/people.md): the polyline is what the robot drives, and what is proven; and, sampled every
 :data:`TIMED_STEP` s, every person's ``trajectory`` (straight between rows, standing after the last) and
 every mover's (``dynamic_obstacles[]``: the same, repeating from its first row after its last where
 ``loop``) never closer than ``robot.radius + robot.clearance + radius`` plus ``w TIMED_STEP / 2``, ``w`` the
@@ -26,12 +26,13 @@ robot drives: from one row interval to the next the speed changes by at most ``m
 the shorter interval (at rest before t = 0 and after the goal); wherever the direction of travel turns
 by an angle (at the spawn from the spawn's yaw) the robot stands at least that angle over
 ``max_turn_rate`` in between (:data:`TURN_SLACK` rad forgiven for the rounding of the rows); and every
-distance above is kept with ``tracking_margin`` more. A turn of at most ``CUT_ANGLE`` at a waypoint the rows
-pass through needs no stand where it is a corner passed moving (docs/people.md): the arc tangent to both
-legs is re-derived here from the recorded path and limits (or one of its ``SHRINK`` shares), the arc must
-keep the clearance by FCL (along its inscribed chords, with its bulge beyond them), the rows within its
-reach of the waypoint must be no faster than its radius times ``max_turn_rate``, and while the schedule
-is within that reach every person is kept the largest arc's deviation farther.
+distance above is kept with ``tracking_margin`` more. A turn of at most ``CUT_ANGLE`` at a waypoint of the
+recorded path the rows pass through, coming along one of its legs and leaving along the next, needs no stand
+where it is a corner passed moving (docs/people.md): the arc tangent to both legs is re-derived here from the
+recorded path and limits (or one of its ``SHRINK`` shares), the arc must keep the clearance by FCL (along its
+inscribed chords, with its bulge beyond them), the rows within its reach of the waypoint must be no faster
+than its radius times ``max_turn_rate``, and while the schedule is within that reach every person is kept the
+largest arc's deviation farther.
 """
 
 from __future__ import annotations
@@ -88,7 +89,6 @@ def check_timed(meta: dict, world) -> None:
             raise TimedPathError(f"{task['id']} has a timed_path but no path for it to follow")
         rows = np.asarray(rows, dtype=float).reshape(-1, 3)
         _timed_rows(task, rows, v_max)
-        _timed_on_path(task, rows)
         if colliders is None:
             from worldgen.feasibility.collision import Colliders
             from worldgen.scene.doors import open_scene
@@ -197,27 +197,6 @@ def _timed_rows(task: dict, rows: np.ndarray, v_max: float) -> None:
                              f"above robot.max_speed {v_max:g} m/s")
 
 
-def _timed_on_path(task: dict, rows: np.ndarray) -> None:
-    """Every row on the recorded path, and each two rows in a row on one leg of it (so the robot between
-    them is too: it never cuts a corner)."""
-    wp = np.asarray(task["path"]["waypoints"], dtype=float).reshape(-1, 2)
-    a, b = (wp[:-1], wp[1:]) if len(wp) > 1 else (wp, wp)
-    ab = b - a
-    ap = rows[:, None, 1:] - a[None]
-    u = np.clip(np.einsum("kij,ij->ki", ap, ab) / np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300), 0.0, 1.0)
-    near = np.hypot(*(a[None] + u[..., None] * ab[None] - rows[:, None, 1:]).transpose(2, 0, 1)) <= ON_PATH
-    off = np.flatnonzero(~near.any(axis=1))
-    if len(off):
-        k = int(off[0])
-        raise TimedPathError(f"{task['id']} timed_path row {k} (t = {rows[k, 0]:g} s) at {rows[k, 1:].tolist()} is off "
-                             "the recorded path")
-    apart = np.flatnonzero(~(near[:-1] & near[1:]).any(axis=1))
-    if len(apart):
-        k = int(apart[0])
-        raise TimedPathError(f"{task['id']} timed_path leaves the recorded path between t = {rows[k, 0]:g} and "
-                             f"{rows[k + 1, 0]:g} s (the rows lie on different legs: it cuts a corner)")
-
-
 def _drivable(task: dict, rows: np.ndarray, turn_rate: float, acceleration: float, moving=frozenset()) -> None:
     """Speed changes within ``acceleration``; a stand of at least angle / ``turn_rate`` wherever the way turns,
     but at the rows of ``moving`` (indices: corners passed on the move, already checked by :func:`_moving`)."""
@@ -280,6 +259,10 @@ def _moving(task: dict, rows: np.ndarray, robot: dict, colliders, body) -> list:
         at = np.flatnonzero(np.hypot(*(rows[1:-1, 1:] - wp[j]).T) <= ON_PATH) + 1
         if not len(at) or np.hypot(*(rows[at[0] - 1, 1:] - wp[j])) <= ON_PATH:
             continue  # not passed through (it stands there, or never comes)
+        k = int(at[0])
+        if max(_seg_dist(rows[k - 1, 1:], wp[j - 1:j], wp[j:j + 1])[0],
+               _seg_dist(rows[k + 1, 1:], wp[j:j + 1], wp[j + 1:j + 2])[0]) > ON_PATH:
+            continue  # it comes or leaves off the path's legs there (a timed path off the path): no arc of the path's
         rho = ell / np.tan(half[j])
         for share in SHRINK:
             reach, cap = ell * share, rho * share * omega
