@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from support.fuzzing import draw_request, run_requests
 
-#: 50 a generator (300 requests, about 10 s); benchmarks/fuzz_sweep.py runs thousands.
-REQUESTS_PER_GENERATOR = 50
+#: 30 a generator (180 requests, about 15 s); benchmarks/fuzz_sweep.py runs thousands.
+REQUESTS_PER_GENERATOR = 30
 
 
 @pytest.mark.slow

@@ -50,8 +50,13 @@ def make(case: str):
 #: generators' own worlds stand for them in the suite (20 s it could not keep within its 10 minutes once movers
 #: were certified and terrain came); with WORLDGEN_GAZEBO_ALL=1 every release loads them too.
 STATIC_PRESETS = {"clutter_50_boxes", "drl_arena", "empty_room", "lidar_wall", "narrow_corridor", "room_5_obstacles"}
+#: Presets whose people walk as crowd_reacting's do (actors on scripted walks, one or a few): crowd_reacting's
+#: world stands for them in the suite (15 s), test_gazebo_people.py plays person_crossing's actors; with
+#: WORLDGEN_GAZEBO_ALL=1 every release loads them too.
+PEOPLE_PRESETS = {"group_in_corridor", "person_crossing", "person_head_on", "person_in_doorway", "person_overtaking"}
 CASES = [f"generator:{g}" for g in GENERATORS] + [f"preset:{p}" for p in names()
-                                                  if every_case() or p not in STATIC_PRESETS] + ["doors", "movers"]
+                                                  if every_case() or p not in STATIC_PRESETS | PEOPLE_PRESETS] + \
+    ["doors", "movers"]
 #: What the later releases run in the suite (about 3.2 s a world): every generator once (the door generator's
 #: world has its doors) and the movers' actors; people's actors run in Harmonic in test_gazebo_people.py.
 SAMPLE = {f"generator:{g}" for g in GENERATORS} | {"movers"}

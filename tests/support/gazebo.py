@@ -53,13 +53,14 @@ def every_case() -> bool:
     return os.environ.get("WORLDGEN_GAZEBO_ALL") == "1"
 
 
-def release_cases(cases: list[str], sample: set[str]) -> list:
-    """``(release, case)`` parameters: every case in the default release; in the others the ``sample`` cases,
-    and the rest too when :func:`every_case` says so (else they are left out of the run, not skipped)."""
+def release_cases(cases: list[str], sample: set[str], first: set[str] | None = None) -> list:
+    """``(release, case)`` parameters: every case in the default release (or only those of ``first``); in the
+    others the ``sample`` cases; the rest too when :func:`every_case` says so (else they are left out of the
+    run, not skipped)."""
     from worldgen.export.contract import SIM_GZ_RELEASES
 
     default, *others = SIM_GZ_RELEASES
-    out = [pytest.param(default, c, id=f"{default}-{c}") for c in cases]
+    out = [pytest.param(default, c, id=f"{default}-{c}") for c in cases if first is None or c in first or every_case()]
     for rel in others:
         out += [pytest.param(rel, c, id=f"{rel}-{c}") for c in cases if c in sample or every_case()]
     return out
