@@ -79,6 +79,7 @@ bench: $(RL_STAMP) $(ROS_STAMP)
 	nice -n 10 $(PY) benchmarks/bench_difficulty.py
 	nice -n 10 $(PY) benchmarks/bench_leveling.py
 	nice -n 10 $(PY) benchmarks/bench_ladder.py
+	WORLDGEN_SWEEPS=1 $(PY) -m pytest -q -p no:cacheprovider tests/envs/test_ladder.py
 	$(PY) benchmarks/bench_curriculum.py
 	$(PY) benchmarks/bench_people.py
 	$(PY) benchmarks/bench_reacting.py

@@ -78,9 +78,9 @@ def _drive(folder: Path, out: Path, *extra: str):
     return result, judge([bag], world=folder).report["runs"][0]
 
 
-#: Fortress drives barn, corridor and door worlds, Harmonic door, cluttered and minimal ones (every generator in
-#: one release; all of them in both with WORLDGEN_GAZEBO_ALL=1).
-@pytest.mark.parametrize(("release", "generator"), release_cases(list(GENERATORS), {"door", "cluttered", "minimal"},
+#: Fortress drives barn, corridor and door worlds, Harmonic door and cluttered ones (minimal's in MuJoCo; every
+#: generator in both releases with WORLDGEN_GAZEBO_ALL=1).
+@pytest.mark.parametrize(("release", "generator"), release_cases(list(GENERATORS), {"door", "cluttered"},
                                                                   first={"barn", "corridor", "door"}))
 def test_gazebo_drive_reaches_the_goal_without_contact(worlds, tmp_path, release, generator, installs):
     installs(release)
