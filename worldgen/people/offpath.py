@@ -28,11 +28,11 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from worldgen.feasibility.report import Check, FeasibilityReport
-from worldgen.people.behaviours import Tube, tube_of
+from worldgen.feasibility.report import FeasibilityReport
+from worldgen.people.behaviours import Tube
 from worldgen.people.grid import PACE, floor_of
 from worldgen.people.lattice import Agents, lattice_reachable, lattice_route
-from worldgen.people.timed import MARGIN, TRACKING, Limits, TimedPath, _among, timed_path
+from worldgen.people.timed import MARGIN, TRACKING, Limits, TimedPath, agents_of, timed_check, timed_path
 
 __all__ = ["ROOMS", "AFTER", "DOOR_STRAY", "MAX_WORK", "off_path", "certify_off_path"]
 
@@ -119,12 +119,7 @@ def certify_off_path(report: FeasibilityReport, scene, tasks, robot, limits: Lim
     """``report`` (:func:`worldgen.people.timed.certify`'s) with a timed path off the static path for every task
     that has a static path and no timed path along it, and its ``timed_path`` check made again: passed when
     every task now has one. ``behaviours`` as for ``certify``."""
-    agents = list(scene.movers)
-    tracks = [np.asarray(m.trajectory, dtype=float) for m in agents]
-    radii = [m.radius for m in agents]
-    loops = [m.loop and not m.person for m in agents]
-    reacting = iter(tube_of(b) for b in behaviours) if behaviours is not None else None
-    tubes = [next(reacting) if reacting is not None and m.person else Tube(0.0, 0.0) for m in agents]
+    agents, tracks, radii, loops, tubes = agents_of(scene, behaviours)
     colliders = None
     found, moved, missing = list(report.timed_paths), 0, []
     for q, (task, path) in enumerate(zip(tasks, report.paths)):
@@ -143,11 +138,4 @@ def certify_off_path(report: FeasibilityReport, scene, tasks, robot, limits: Lim
             missing.append(f"{task.id}: they leave no way through at <= {limits.max_speed:g} m/s, along the path "
                            "or off it")
     checks = tuple(c for c in report.checks if c.name != "timed_path")
-    among = _among(agents)
-    if missing:
-        check = Check("timed_path", False, None, f"no timed path among the {among} for " + "; ".join(missing))
-    else:
-        latest = max(t.arrival for t in found if t is not None)
-        check = Check("timed_path", True, latest, f"{len(found)} timed path(s) among {among} ({moved} off the "
-                      f"static path), latest arrival {latest:.2f} s")
-    return replace(report, checks=checks + (check,), timed_paths=tuple(found))
+    return replace(report, checks=checks + (timed_check(agents, found, missing, off=moved),), timed_paths=tuple(found))

@@ -45,7 +45,7 @@ from worldgen.people.corners import arc_clear, cap_moves, passed_moving
 from worldgen.scene.robot import ACCELERATION, TURN_RATE
 
 __all__ = ["DT", "MARGIN", "TRACKING", "SPARE", "TURN_RATE", "ACCELERATION", "MAX_LEVELS", "Limits", "limits_of",
-           "TimedPath", "timed_path", "person_speed", "certify", "tube_steps", "turn_angles"]
+           "TimedPath", "timed_path", "person_speed", "certify", "agents_of", "timed_check", "tube_steps", "turn_angles"]
 
 #: Time step (s) of the sweep, and the shortest time between two rows of a timed path.
 DT = 0.05
@@ -317,40 +317,41 @@ def certify(report: FeasibilityReport, scene, tasks, robot, limits,
     agents leave the robot no way through along its path.
     """
     lim = limits if isinstance(limits, Limits) else Limits(float(limits))
-    agents = list(scene.movers)
-    tracks = [np.asarray(m.trajectory, dtype=float) for m in agents]
-    radii = [m.radius for m in agents]
-    loops = [m.loop and not m.person for m in agents]
-    tubes = None
-    if behaviours is not None:
-        reacting = iter(tube_of(b) for b in behaviours)
-        tubes = [next(reacting) if m.person else Tube(0.0, 0.0) for m in agents]
+    agents, tracks, radii, loops, tubes = agents_of(scene, behaviours)
     clear = arc_clear(scene, robot)
     found, missing = [], []
     for task, path in zip(tasks, report.paths):
         timed = None if path is None else timed_path(path.waypoints, tracks, radii, robot.inflation, lim, tubes,
-                                                     heading=float(task.spawn.yaw), loops=loops,
-                                                     clear=clear)
+                                                     heading=float(task.spawn.yaw), loops=loops, clear=clear)
         found.append(timed)
         if timed is None:
             why = "no static path" if path is None else f"they leave no way through at <= {lim.max_speed:g} m/s"
             missing.append(f"{task.id}: {why}")
-    among = _among(agents)
-    if missing:
-        check = Check("timed_path", False, None, f"no timed path among the {among} for " + "; ".join(missing))
-    else:
-        latest = max(t.arrival for t in found if t is not None)  # none missing: all found
-        check = Check("timed_path", True, latest,
-                      f"{len(found)} timed path(s) among {among}, latest arrival {latest:.2f} s")
-    return replace(report, checks=report.checks + (check,), timed_paths=tuple(found))
+    return replace(report, checks=report.checks + (timed_check(agents, found, missing),), timed_paths=tuple(found))
 
 
-def _among(agents) -> str:
-    """'3 people', '2 movers', '3 people and 2 movers': what a certificate was made among."""
-    people = sum(1 for m in agents if m.person)
-    movers = len(agents) - people
+def agents_of(scene, behaviours: Optional[Sequence[str]] = None) -> tuple[list, list, list, list, list]:
+    """Everything of ``scene`` that moves, as a certificate takes it: (agents, (m, 3) tracks, radii, whether each
+    loops (a mover's script; a person stands at its end), tubes (from ``behaviours``, one a person, in order))."""
+    agents = list(scene.movers)
+    reacting = iter(tube_of(b) for b in behaviours) if behaviours is not None else None
+    return (agents, [np.asarray(m.trajectory, dtype=float) for m in agents], [m.radius for m in agents],
+            [m.loop and not m.person for m in agents],
+            [next(reacting) if reacting is not None and m.person else Tube(0.0, 0.0) for m in agents])
+
+
+def timed_check(agents, found: Sequence[Optional[TimedPath]], missing: Sequence[str], off: Optional[int] = None) -> Check:
+    """The ``timed_path`` check of the certificates ``found`` among ``agents``: failed with the tasks ``missing``
+    one (each "id: why"), else passed at the latest arrival (``off``: how many are off the static path)."""
+    people, movers = sum(1 for m in agents if m.person), sum(1 for m in agents if not m.person)
     parts = [f"{people} people"] * bool(people) + [f"{movers} mover{'s' * (movers != 1)}"] * bool(movers)
-    return " and ".join(parts) or "0 people"
+    among = " and ".join(parts) or "0 people"  # '3 people', '2 movers', '3 people and 2 movers'
+    if missing:
+        return Check("timed_path", False, None, f"no timed path among the {among} for " + "; ".join(missing))
+    latest = max(t.arrival for t in found if t is not None)  # none missing: all found
+    moved = "" if off is None else f" ({off} off the static path)"
+    return Check("timed_path", True, latest, f"{len(found)} timed path(s) among {among}{moved}, latest arrival "
+                 f"{latest:.2f} s")
 
 
 def _at(w: np.ndarray, cum: np.ndarray, s: np.ndarray) -> np.ndarray:
