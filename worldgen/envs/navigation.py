@@ -95,7 +95,7 @@ from worldgen.envs.terrain import add_base, lidar_frame, settle
 from worldgen.errors import CallOrderError, ParameterError
 from worldgen.groundtruth.folder import robot_description_of
 from worldgen.judge.figures import Contact
-from worldgen.scene.robot import MAX_SPEED, TURN_RATE, RobotDescription
+from worldgen.scene.robot import MAX_SPEED, TURN_RATE
 from worldgen.seeding import check_seed, draw_seed, env_rngs
 
 if TYPE_CHECKING:  # the checker reads Gymnasium's types; at run time a missing extra is one clear line
@@ -163,12 +163,11 @@ class NavigationEnv(gym.Env):
         v = cfg.linear_velocity if cfg.linear_velocity is not None else (0.0, speed)
         return v, cfg.angular_velocity if cfg.angular_velocity is not None else turn
 
-    def _robot(self, world: EpisodeWorld) -> tuple[RobotDescription, tuple[float, float], float]:
-        """The episode's robot (its world's description) and its servos' (v_min, v_max), w_max: the settings
-        where given, else the robot's own limits."""
+    def _servo_limits(self, world: EpisodeWorld) -> tuple[tuple[float, float], float]:
+        """The episode's servos' (v_min, v_max), w_max: the settings where given, else the limits of its world's
+        robot description."""
         robot = world.description if world.description is not None else robot_description_of(world.metadata())
-        v_range, w_max = servo_limits(robot, self.config.linear_velocity, self.config.angular_velocity)
-        return robot, v_range, w_max
+        return servo_limits(robot, self.config.linear_velocity, self.config.angular_velocity)
 
     # -- episode --------------------------------------------------------------------------------------------
     def _reseed(self, seed: Optional[int]) -> None:
@@ -210,7 +209,7 @@ class NavigationEnv(gym.Env):
         cfg = self.config
         spawn = world.task["spawn"]
         movers = walkers_of(world)  # people who react to the robot among them (docs/people.md)
-        _, (v_lo, v_max), w_max = self._robot(world)
+        (v_lo, v_max), w_max = self._servo_limits(world)
         floor = add_base(world.mjcf, world.robot, (v_lo, v_max), w_max, world.terrain, world.floor)
         add_openers(world.mjcf, world.doors, cfg.doors)
         sim = compile_world(world.mjcf, (spawn[0], spawn[1], spawn[5]), floor, [m["name"] for m in world.movers])

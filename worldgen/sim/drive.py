@@ -222,8 +222,9 @@ def _backend(sim: str, world: WorldFolder, gz_release: Optional[str] = None, pla
     robot = robot_sdf(meta, gz_release=install.release.name, sensors=False, odom_rate=1.0 / ((per - 0.5) * dt))
     # The DiffDrive changes its speed at most the robot's acceleration (worldgen.export.robot), its turn rate at
     # that over half the track (a wheel's rim).
-    accel = world.robot_description.acceleration
-    turn_accel = accel / (dimensions(meta).wheel_separation / 2.0)
+    description = world.robot_description
+    accel = description.acceleration
+    turn_accel = accel / (dimensions(description).wheel_separation / 2.0)
     # The pull doors on the plan's way get a joint controller in a copy of the world (worldgen.sim.gazebo_doors);
     # a build without the system refuses here, before anything starts.
     from worldgen.sim.gazebo_doors import GazeboDoors, plan_points, pulled_doors, world_with_openers
